@@ -1,0 +1,57 @@
+"""Block kernels: loop over the points of one grid chunk, no per-point allocation."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .charpoly import allocate, charpoly_point
+from .options import kernel
+from .sturm import count_complex_pairs
+
+
+@kernel
+def charpoly_block(body, joint, g, E, kappa, nmodes, free, out):
+    """Rigorous enclosures of p(lambda) for a block of points.
+
+    Parameters
+    ----------
+    body : float64[npts, n, 6]
+        (m [kg], A [kg m^2], C [kg m^2], c [m], s [m], omega [rad/s]) per body, bottom first.
+    joint : float64[npts, n]
+        K_0 (base, fixed support only) and K_1..K_{n-1} [N m/rad].
+    g : float64[npts]
+        Gravity [m/s^2] (ignored for a free system).
+    E, kappa : float64[npts, n, Lmax]
+        Liquid modes E [kg m^2] and kappa [1]; only the first nmodes[k] of body k are read.
+    nmodes : int64[n]
+    free : bool
+    out : float64[npts, sum(nmodes + 2) + 1, 3]
+        Written: coefficients as (hi, lo, rad) with p_i in [hi + lo - rad, hi + lo + rad],
+        ascending powers of lambda.
+    """
+    npts, n = body.shape[0], body.shape[1]
+    rowdeg = nmodes + 2
+    degree = int(rowdeg.sum())
+    ws = allocate(n, max(1, nmodes.max()), degree)
+    for p in range(npts):
+        charpoly_point(body[p], joint[p], g[p], E[p], kappa[p], nmodes, rowdeg, free, ws, out[p])
+
+
+@kernel
+def count_block(body, joint, g, E, kappa, nmodes, free, out_nc, out_status):
+    """Number of complex-conjugate root pairs N_c of p(lambda) for a block of points.
+
+    Inputs as for ``charpoly_block``.  Writes ``out_nc`` (int16[npts], -1 where
+    undecided or degenerate) and ``out_status`` (int8[npts], codes of kernels.status).
+    """
+    npts, n = body.shape[0], body.shape[1]
+    rowdeg = nmodes + 2
+    degree = int(rowdeg.sum())
+    ws = allocate(n, max(1, nmodes.max()), degree)
+    c = np.empty((degree + 1, 3))
+    W = np.empty((2, degree + 1, 3))
+    for p in range(npts):
+        charpoly_point(body[p], joint[p], g[p], E[p], kappa[p], nmodes, rowdeg, free, ws, c)
+        nc, status = count_complex_pairs(c, W)
+        out_nc[p] = nc
+        out_status[p] = status

@@ -1,0 +1,44 @@
+"""stabmap: stability atlases of spinning chains of gyroscopes with liquid-filled cavities.
+
+>>> import stabmap
+>>> scene = stabmap.example("paper-n3-fixed")     # or stabmap.load_scene("scene.toml")
+>>> ds = stabmap.compute_atlas(scene)              # xarray.Dataset
+>>> stabmap.write_atlas(ds, "atlas.nc")
+"""
+
+from __future__ import annotations
+
+__version__ = "0.1.0"
+
+import kernels as _kernels
+
+if getattr(_kernels, "STABMAP_KERNELS", None) != 1:
+    raise ImportError(
+        f"the 'kernels' package found at {getattr(_kernels, '__file__', '?')} is not stabmap's "
+        "(an unrelated PyPI package has the same name); uninstall it: pip uninstall kernels"
+    )
+
+from .atlas import compute as compute_atlas  # noqa: E402
+from .errors import StabmapError  # noqa: E402
+from .examples import example, example_names  # noqa: E402
+from .io import open_atlas, write_atlas  # noqa: E402
+from .query import label_at, summary  # noqa: E402
+from .scene import Axis, Body, Scene  # noqa: E402
+from .scene import load as load_scene  # noqa: E402
+from .scene import loads as loads_scene  # noqa: E402
+
+__all__ = [
+    "Axis",
+    "Body",
+    "Scene",
+    "StabmapError",
+    "compute_atlas",
+    "example",
+    "example_names",
+    "label_at",
+    "load_scene",
+    "loads_scene",
+    "open_atlas",
+    "summary",
+    "write_atlas",
+]

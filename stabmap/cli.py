@@ -1,0 +1,162 @@
+"""The ``stabmap`` command: one thin subcommand per job, each calling the Python API."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+from . import __version__
+from .errors import StabmapError
+
+
+def _pairs(items: list[str], what: str) -> dict[str, float]:
+    out = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key:
+            raise StabmapError(f"{what} {item!r}: write NAME=VALUE, e.g. omega=42.5")
+        try:
+            out[key.strip()] = float(value)
+        except ValueError:
+            raise StabmapError(f"{what} {item!r}: {value!r} is not a number") from None
+    return out
+
+
+def _cmd_atlas(args) -> None:
+    from .atlas import compute
+    from .examples import example
+    from .io import check_writable, write_atlas
+    from .plot import plot_atlas
+    from .scene import load
+
+    if (args.scene is None) == (args.example is None):
+        raise StabmapError("give a scene file or --example NAME (not both); see 'stabmap examples'")
+    check_writable(args.output)
+    if args.png:
+        check_writable(args.png)
+    scene = load(args.scene) if args.scene else example(args.example)
+    if args.workers is not None and args.workers < 1:
+        raise StabmapError(f"--workers must be >= 1, got {args.workers}")
+    t0 = time.perf_counter()
+    ds = compute(scene, workers=args.workers, progress=not args.quiet)
+    write_atlas(ds, args.output)
+    stats = _summary_line(ds)
+    print(f"wrote {args.output}: {stats} in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+    if args.png:
+        plot_atlas(ds, args.png)
+        print(f"wrote {args.png}", file=sys.stderr)
+
+
+def _summary_line(ds) -> str:
+    from .query import summary
+
+    s = summary(ds)
+    exact = s["decided_by"]["exact_rational_arithmetic"]
+    return f"{s['points']} points, {100 * s['stable_fraction']:.1f} % stable, {exact} decided in exact arithmetic"
+
+
+def _cmd_info(args) -> None:
+    from .io import open_atlas
+    from .query import summary
+    from .variables import N_COMPLEX_PAIRS
+
+    ds = open_atlas(args.atlas)
+    s = summary(ds)
+    a = ds.attrs
+    print(f"{args.atlas}: {a.get('title', '')}")
+    print(f"  support {a.get('support')}, {a.get('n_bodies')} bodies, characteristic polynomial of degree <= {a.get('polynomial_degree_bound')}")
+    print("  axes:")
+    for d in ds[N_COMPLEX_PAIRS].dims:
+        c = ds[d]
+        print(f"    {d:<10} {c.size:>7} points  {float(c.min()):.6g} .. {float(c.max()):.6g} {c.attrs.get('units', '')}  ({c.attrs.get('scale', '')})  {c.attrs.get('long_name', '')}")
+    fixed = [k for k in ds.coords if ds[k].ndim == 0]
+    if fixed:
+        print("  fixed: " + ", ".join(f"{k} = {float(ds[k]):.6g}" for k in fixed))
+    print(f"  points: {s['points']}, stable: {s['stable']} ({100 * s['stable_fraction']:.2f} %)" + (f", degenerate: {s['degenerate']}" if s["degenerate"] else ""))
+    print("  complex root pairs: " + ", ".join(f"{k}: {v}" for k, v in s["n_complex_pairs"].items()))
+    print("  decided by: " + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in s["decided_by"].items()))
+    print(f"  made by {a.get('source', '?')}; {a.get('history', '')}")
+
+
+def _cmd_query(args) -> None:
+    from .io import open_atlas
+    from .query import label_at
+
+    ds = open_atlas(args.atlas)
+    label = label_at(ds, **_pairs(args.point, "point"))
+    for k, v in label.requested.items():
+        units = ds[k].attrs.get("units", "")
+        note = " (outside the grid: nearest edge)" if k in label.outside else ""
+        print(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g} {units}{note}")
+    print(f"n_complex_pairs = {label.n_complex_pairs}")
+    print(f"stability = {label.stability} (decided by {label.decided_by.replace('_', ' ')})")
+
+
+def _cmd_plot(args) -> None:
+    from .io import open_atlas
+    from .plot import plot_atlas
+
+    ds = open_atlas(args.atlas)
+    plot_atlas(ds, args.output, x=args.x, y=args.y, sel=_pairs(args.sel, "--sel"))
+    print(f"wrote {args.output}", file=sys.stderr)
+
+
+def _cmd_examples(args) -> None:
+    from .examples import example, example_names
+
+    for name in example_names():
+        print(f"{name:<18} {example(name).title}")
+
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="stabmap", description="Stability atlases of spinning chains of gyroscopes with liquid-filled cavities.")
+    p.add_argument("--version", action="version", version=f"stabmap {__version__}")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    a = sub.add_parser("atlas", help="compute an atlas from a scene and write netCDF4")
+    a.add_argument("scene", nargs="?", help="scene TOML file")
+    a.add_argument("--example", metavar="NAME", help="a bundled example scene (see 'stabmap examples')")
+    a.add_argument("-o", "--output", required=True, help="netCDF file to write, e.g. atlas.nc")
+    a.add_argument("--png", metavar="FILE", help="also draw the atlas to this PNG/PDF")
+    a.add_argument("--workers", type=int, help="threads (default: all cores)")
+    a.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    a.set_defaults(func=_cmd_atlas)
+
+    i = sub.add_parser("info", help="what an atlas file holds")
+    i.add_argument("atlas")
+    i.set_defaults(func=_cmd_info)
+
+    q = sub.add_parser("query", help="the label at a point (nearest grid point)")
+    q.add_argument("atlas")
+    q.add_argument("point", nargs="*", metavar="NAME=VALUE")
+    q.set_defaults(func=_cmd_query)
+
+    pl = sub.add_parser("plot", help="draw a 2-D stability map")
+    pl.add_argument("atlas")
+    pl.add_argument("-o", "--output", required=True, help="PNG or PDF file")
+    pl.add_argument("--x", help="axis along x (default: the first axis)")
+    pl.add_argument("--y", help="axis along y (default: the second axis)")
+    pl.add_argument("--sel", nargs="*", default=[], metavar="NAME=VALUE", help="values of the other axes (nearest)")
+    pl.set_defaults(func=_cmd_plot)
+
+    e = sub.add_parser("examples", help="list the bundled example scenes")
+    e.set_defaults(func=_cmd_examples)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parser().parse_args(argv)
+    try:
+        args.func(args)
+    except StabmapError as exc:
+        print(f"stabmap: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("stabmap: interrupted; no output file was written", file=sys.stderr)
+        return 130
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

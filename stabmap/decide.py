@@ -1,0 +1,28 @@
+"""Decide N_c for a block of points: the certified kernel first, exact arithmetic for the rest."""
+
+from __future__ import annotations
+
+import numpy as np
+
+import kernels
+
+from . import exact
+from .points import PointArrays
+
+# Values of the ``decided_by`` flag variable.
+BY_INTERVAL = 0
+BY_EXACT = 1
+
+
+def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
+    """Return (n_complex_pairs int16, decided_by int8) for every point; -1 marks p identically zero."""
+    npts = points.body.shape[0]
+    nc = np.empty(npts, dtype=np.int16)
+    status = np.empty(npts, dtype=np.int8)
+    kernels.count_block(*points.kernel_args(), nc, status)
+    decided_by = np.full(npts, BY_INTERVAL, dtype=np.int8)
+    undecided = np.flatnonzero(status == kernels.UNDECIDED)
+    if undecided.size:
+        nc[undecided] = exact.decide_points(*points.kernel_args(), undecided)
+        decided_by[undecided] = BY_EXACT
+    return nc, decided_by

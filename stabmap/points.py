@@ -1,0 +1,82 @@
+"""Turn a scene and a block of its grid into the kernels' plain per-point arrays."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .parameters import BODY_COLUMNS, parse_name
+from .scene import Scene
+
+
+@dataclass
+class PointArrays:
+    """Arguments of ``kernels.count_block`` for npts points (layout: kernels/charpoly.py)."""
+
+    body: np.ndarray  # (npts, n, 6)
+    joint: np.ndarray  # (npts, n): K_0, K_1..K_{n-1}
+    g: np.ndarray  # (npts,)
+    E: np.ndarray  # (npts, n, Lmax)
+    kappa: np.ndarray  # (npts, n, Lmax)
+    nmodes: np.ndarray  # (n,) int64
+    free: bool
+
+    def kernel_args(self):
+        return self.body, self.joint, self.g, self.E, self.kappa, self.nmodes, self.free
+
+
+def base_arrays(scene: Scene):
+    """Parameter arrays of the scene with no grid axis applied (body, joint, g, E, kappa)."""
+    n = scene.n
+    body = np.empty((n, 6))
+    for k, b in enumerate(scene.bodies):
+        omega = b.omega if b.omega is not None else scene.omega
+        body[k] = (b.m, b.A, b.C, b.c, b.s, 0.0 if omega is None else omega)
+    joint = np.array((scene.K_0,) + scene.joint_stiffness(), dtype=np.float64)
+    lmax = max(1, int(scene.nmodes.max()))
+    E = np.zeros((n, lmax))
+    kappa = np.ones((n, lmax))
+    for k, b in enumerate(scene.bodies):
+        E[k, : len(b.E)] = b.E
+        kappa[k, : len(b.kappa)] = b.kappa
+    return body, joint, float(scene.g), E, kappa
+
+
+def block_arrays(scene: Scene, location: list[tuple[int, int]]) -> PointArrays:
+    """Per-point arrays for the block ``location`` = [(start, stop) per grid axis], C order."""
+    body0, joint0, g0, E0, kappa0 = base_arrays(scene)
+    shape = tuple(stop - start for start, stop in location)
+    npts = int(np.prod(shape, dtype=np.int64))
+    body = np.broadcast_to(body0, shape + body0.shape).copy()
+    joint = np.broadcast_to(joint0, shape + joint0.shape).copy()
+    g = np.full(shape, g0)
+    own_omega = [b.omega is not None for b in scene.bodies]
+    # A common-omega axis first, so that an omega_k axis for the same body wins.
+    order = sorted(range(len(scene.grid)), key=lambda d: scene.grid[d].name != "omega")
+    for d in order:
+        axis = scene.grid[d]
+        start, stop = location[d]
+        view = [None] * len(shape)
+        view[d] = slice(None)
+        values = axis.array[start:stop][tuple(view)]
+        name = parse_name(axis.name, scene.n, scene.support)
+        if name.kind == "global" and name.symbol == "g":
+            g[...] = values
+        elif name.kind == "global":
+            for k in range(scene.n):
+                if not own_omega[k]:
+                    body[..., k, 5] = values
+        elif name.kind == "joint":
+            joint[..., name.index] = values
+        else:
+            body[..., name.index - 1, BODY_COLUMNS.index(name.symbol)] = values
+    return PointArrays(
+        body=body.reshape(npts, scene.n, 6),
+        joint=joint.reshape(npts, scene.n),
+        g=g.reshape(npts),
+        E=np.ascontiguousarray(np.broadcast_to(E0, (npts,) + E0.shape)),
+        kappa=np.ascontiguousarray(np.broadcast_to(kappa0, (npts,) + kappa0.shape)),
+        nmodes=scene.nmodes,
+        free=scene.free,
+    )
