@@ -1,4 +1,4 @@
-"""Exact decision of a point in rational arithmetic (python-flint).
+"""Exact decision of a point: the polynomial in rational arithmetic, its real roots certified (python-flint).
 
 Used for every point the interval kernel cannot prove.  The parameters are
 taken at their exact binary values, so the exact path decides the very point
@@ -48,66 +48,56 @@ def char_poly(body, joint, g, E, kappa, nmodes, free: bool) -> flint.fmpq_poly:
         for k in range(n):
             a_k = m[k] * c[k] + s[k] * sum(m[k + 1 :], zero)
             Kmat[k][k] -= gq * a_k
-    lam = flint.fmpq_poly([0, 1])
     rows = []
     for k in range(n):
-        Q = flint.fmpq_poly([1])
-        R = flint.fmpq_poly([0])
-        for l in range(int(nmodes[k])):
-            beta = w[k] - 2 * w[k] / _q(kappa[k][l])
-            R = R * (lam + beta) + _q(E[k][l]) * Q
-            Q = Q * (lam + beta)
-        row = []
-        for j in range(n):
-            entry = flint.fmpq_poly([-Kmat[k][j], C[k] * w[k] if j == k else 0, M[k][j]]) * Q
-            if j == k:
-                entry -= lam * lam * (lam + w[k]) * R
-            row.append(entry)
-        rows.append(row)
-    return _bareiss_det(rows)
+        betas = [w[k] - 2 * w[k] / _q(kappa[k][l]) for l in range(int(nmodes[k]))]
+        rows.append((betas, [_q(E[k][l]) for l in range(int(nmodes[k]))]))
+    degree = sum(2 + len(b) for b, _ in rows)
+
+    def P(x: flint.fmpq) -> flint.fmpq_mat:
+        """diag(Q) Phi at lambda = x, a rational matrix."""
+        out = flint.fmpq_mat(n, n)
+        for k, (betas, Es) in enumerate(rows):
+            Q = flint.fmpq(1)
+            R = zero
+            for beta, e in zip(betas, Es):
+                R = R * (x + beta) + e * Q
+                Q = Q * (x + beta)
+            for j in range(n):
+                v = x * x * M[k][j] - Kmat[k][j]
+                if j == k:
+                    v = (v + x * C[k] * w[k]) * Q - x * x * (x + w[k]) * R
+                else:
+                    v *= Q
+                out[k, j] = v
+        return out
+
+    # p has degree <= sum(2 + L_k): interpolate it from that many + 1 exact determinants.
+    xs = [flint.fmpq(i) for i in range(degree + 1)]
+    return _interpolate(xs, [P(x).det() for x in xs])
 
 
-def _bareiss_det(a: list[list[flint.fmpq_poly]]) -> flint.fmpq_poly:
-    """Fraction-free Gaussian elimination over Q[lambda]; every division is exact."""
-    n = len(a)
-    a = [row[:] for row in a]
-    sign = 1
-    prev = flint.fmpq_poly([1])
-    for k in range(n - 1):
-        if a[k][k] == 0:
-            swap = next((i for i in range(k + 1, n) if a[i][k] != 0), None)
-            if swap is None:
-                return flint.fmpq_poly([0])
-            a[k], a[swap] = a[swap], a[k]
-            sign = -sign
-        for i in range(k + 1, n):
-            for j in range(k + 1, n):
-                a[i][j] = (a[i][j] * a[k][k] - a[i][k] * a[k][j]) // prev
-        prev = a[k][k]
-    return sign * a[n - 1][n - 1]
-
-
-def _distinct_real_roots(f: flint.fmpq_poly) -> int:
-    """Sturm count of the distinct real roots of f (exact)."""
-    seq = [f, f.derivative()]
-    while seq[-1].degree() > 0:
-        r = -(seq[-2] % seq[-1])
-        if r == 0:
-            break
-        seq.append(r)
-    plus = [1 if p.leading_coefficient() > 0 else -1 for p in seq]
-    minus = [sp if p.degree() % 2 == 0 else -sp for sp, p in zip(plus, seq)]
-
-    def variations(signs):
-        return sum(1 for x, y in zip(signs, signs[1:]) if x != y)
-
-    return variations(minus) - variations(plus)
+def _interpolate(xs: list, ys: list) -> flint.fmpq_poly:
+    """The polynomial through (xs, ys), exactly (Newton divided differences)."""
+    coef = list(ys)
+    m = len(xs)
+    for j in range(1, m):
+        for i in range(m - 1, j - 1, -1):
+            coef[i] = (coef[i] - coef[i - 1]) / (xs[i] - xs[i - j])
+    poly = flint.fmpq_poly([coef[-1]])
+    for i in range(m - 2, -1, -1):
+        poly = poly * flint.fmpq_poly([-xs[i], 1]) + coef[i]
+    return poly
 
 
 def count_real_roots(p: flint.fmpq_poly) -> int:
-    """Real roots of p counted with multiplicity (p nonzero)."""
-    _, factors = p.factor_squarefree()
-    return sum(e * _distinct_real_roots(f) for f, e in factors if f.degree() > 0)
+    """Real roots of the nonzero polynomial p, counted with multiplicity.
+
+    FLINT/Arb isolates every root of the exact polynomial (after an exact
+    square-free factorisation) and certifies which are real: those come back
+    with an imaginary part that is exactly zero.
+    """
+    return sum(mult for root, mult in p.numer().complex_roots() if root.imag.is_zero())
 
 
 def complex_pairs(p: flint.fmpq_poly) -> int:

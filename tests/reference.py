@@ -1,6 +1,6 @@
 """Exact (sympy, rational) reference for the characteristic polynomial.
 
-This module is a test oracle only. It restates ``/work/shared/MODEL.md``
+This module is a test oracle only. It restates ``../shared/MODEL.md`` (the project's physics brief)
 literally, in exact rational arithmetic, so the numeric engine can be checked
 against it. It deliberately imports nothing from ``stabmap`` or ``kernels``:
 an oracle that shares code with the thing it checks cannot catch that code's

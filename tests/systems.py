@@ -1,0 +1,73 @@
+"""Random and special test systems, given once as plain dicts for both the engine and the reference."""
+
+from __future__ import annotations
+
+import random
+from fractions import Fraction
+
+import numpy as np
+
+import kernels
+from stabmap.decide import decide
+from stabmap.points import block_arrays
+from stabmap.scene import from_dict
+
+
+def random_system(rng: random.Random, n: int, modes: int, support: str) -> dict:
+    """A chain with parameters spread over realistic ranges, some joints ideal, liquid optional."""
+    bodies = []
+    for k in range(n):
+        b = {
+            "m": rng.uniform(0.2, 3.0),
+            "A": rng.uniform(0.005, 0.1),
+            "C": rng.uniform(0.0, 0.1),
+            "c": rng.uniform(-0.2, 0.4),
+            "s": rng.uniform(0.05, 0.6),
+        }
+        if rng.random() < 0.3:
+            b["omega"] = rng.uniform(-80, 80)
+        if modes:
+            b["fluid"] = {
+                "E": [rng.uniform(1e-5, 0.3 * b["A"]) for _ in range(modes)],
+                "kappa": [rng.choice([-1, 1]) * rng.uniform(1.05, 4.0) for _ in range(modes)],
+            }
+        bodies.append(b)
+    scene = {"support": support, "omega": rng.uniform(-100, 100), "bodies": bodies}
+    scene["joints"] = [rng.choice([0.0, rng.uniform(0, 200)]) for _ in range(n - 1)]
+    if support == "fixed":
+        scene["g"] = rng.choice([9.81, -9.81, rng.uniform(-20, 20)])
+        scene["K_0"] = rng.choice([0.0, rng.uniform(0, 50)])
+    return scene
+
+
+def reference_args(system: dict) -> dict:
+    """Keyword arguments of tests.reference.char_poly for the same system."""
+    bodies = []
+    for b in system["bodies"]:
+        fluid = b.get("fluid", {})
+        bodies.append(
+            {
+                "m": b["m"], "A": b["A"], "C": b["C"], "c": b["c"], "s": b.get("s", 0.0),
+                "omega": b.get("omega", system.get("omega")),
+                "E": fluid.get("E", []), "kappa": fluid.get("kappa", []),
+            }
+        )
+    out = {"bodies": bodies, "support": system["support"], "joints": system.get("joints", [])}
+    if system["support"] == "fixed":
+        out["g"] = system.get("g", 9.81)
+        out["K0"] = system.get("K_0", 0.0)
+    return out
+
+
+def engine_point(system: dict):
+    """(N_c, decided_by) of the engine for the single point of a grid-less system."""
+    nc, by = decide(block_arrays(from_dict(system), []))
+    return int(nc[0]), int(by[0])
+
+
+def engine_enclosure(system: dict) -> list[tuple[Fraction, Fraction]]:
+    """The kernel's coefficient intervals (midpoint, radius) as exact fractions."""
+    pts = block_arrays(from_dict(system), [])
+    out = np.zeros((1, from_dict(system).degree + 1, 3))
+    kernels.charpoly_block(*pts.kernel_args(), out)
+    return [(Fraction(h) + Fraction(lo), Fraction(r)) for h, lo, r in out[0]]

@@ -1,0 +1,146 @@
+"""The engine against the independent sympy reference of MODEL.md, on random and special systems."""
+
+from __future__ import annotations
+
+import copy
+import random
+
+import pytest
+
+from stabmap.decide import BY_EXACT, BY_INTERVAL
+
+import reference as ref
+from systems import engine_enclosure, engine_point, random_system, reference_args
+
+CASES = [(n, modes, support) for n in (1, 2, 3, 4) for modes in (0, 1, 2) for support in ("fixed", "free")]
+
+
+@pytest.mark.parametrize("n,modes,support", CASES)
+def test_random_systems_match_exact_reference(n, modes, support):
+    rng = random.Random(1000 * n + 10 * modes + (support == "free"))
+    for _ in range(6):
+        system = random_system(rng, n, modes, support)
+        p = ref.char_poly(**reference_args(system))
+        # The kernel's intervals enclose every exact coefficient.
+        coeffs = [ref.exact(0)] * (len(engine_enclosure(system)))
+        exact_coeffs = list(reversed(p.all_coeffs())) if not p.is_zero else []
+        for i, (mid, rad) in enumerate(engine_enclosure(system)):
+            e = exact_coeffs[i] if i < len(exact_coeffs) else coeffs[i]
+            assert abs(ref.exact(mid) - e) <= ref.exact(rad), (system, i)
+        nc, _ = engine_point(system)
+        assert nc == ref.count_complex_pairs(p), system
+
+
+def test_most_random_points_are_decided_by_intervals():
+    rng = random.Random(7)
+    by = [engine_point(random_system(rng, 3, 2, "fixed"))[1] for _ in range(40)]
+    assert by.count(BY_INTERVAL) >= 30
+
+
+def _maievskii(omega: float) -> dict:
+    return {"support": "fixed", "g": 9.81, "omega": omega, "bodies": [{"m": 1.0, "A": 0.02, "C": 0.03, "c": 0.1}]}
+
+
+def test_maievskii_boundary_and_neighbours():
+    # C^2 w^2 = 4 (A + m c^2) m c g  at  w* = sqrt(4 * 0.03 * 0.981) / 0.03
+    w_star = (4 * (0.02 + 0.01) * 0.1 * 9.81) ** 0.5 / 0.03
+    for rel in (-1e-3, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-3):
+        system = _maievskii(w_star * (1 + rel))
+        expected = ref.count_complex_pairs(ref.char_poly(**reference_args(system)))
+        assert engine_point(system)[0] == expected
+    assert engine_point(_maievskii(w_star * 0.99))[0] == 1
+    assert engine_point(_maievskii(w_star * 1.01))[0] == 0
+
+
+def test_exact_double_root_counts_as_stable():
+    # m = 1, c = 1/4, g = 4, A = 3/16 (A + m c^2 = 1/4), C = 1, omega = 1: p = (lam + 2)^2 / 4... exactly a square
+    system = {"support": "fixed", "g": 4.0, "omega": 1.0, "bodies": [{"m": 1.0, "A": 0.1875, "C": 1.0, "c": 0.25}]}
+    p = ref.char_poly(**reference_args(system))
+    assert p.sqf_list()[1][0][1] == 2  # really a double root
+    assert engine_point(system) == (0, BY_EXACT)
+
+
+def _identical_free(n: int, omega: float, with_liquid: bool) -> dict:
+    body = {"m": 1.5, "A": 0.03, "C": 0.045, "c": 0.125, "s": 0.25}
+    if with_liquid:
+        body["fluid"] = {"E": [2e-3], "kappa": [1.5]}
+    return {"support": "free", "omega": omega, "bodies": [copy.deepcopy(body) for _ in range(n)]}
+
+
+@pytest.mark.parametrize("n", [2, 3, 4])
+@pytest.mark.parametrize("with_liquid", [False, True])
+def test_identical_free_bodies_repeated_and_zero_roots(n, with_liquid):
+    for omega in (-30.0, 7.0, 50.0):
+        system = _identical_free(n, omega, with_liquid)
+        p = ref.char_poly(**reference_args(system))
+        assert p.eval(0) == 0  # free systems have lambda = 0 roots
+        assert engine_point(system)[0] == ref.count_complex_pairs(p)
+
+
+def test_split_fixed_chain_with_identical_upper_bodies():
+    # a_2 = ... = a_n = 0 (upper joints at the centres of mass), identical upper bodies: p = F_1 F_2^(n-1)
+    upper = {"m": 1.0, "A": 0.02, "C": 0.03, "c": 0.0, "s": 0.0, "fluid": {"E": [1e-3], "kappa": [1.31]}}
+    system = {
+        "support": "fixed", "g": 9.81, "omega": 40.0,
+        "bodies": [{"m": 2.0, "A": 0.05, "C": 0.06, "c": 0.1, "s": 0.3}] + [copy.deepcopy(upper) for _ in range(3)],
+    }
+    p = ref.char_poly(**reference_args(system))
+    assert max(m for _, m in p.sqf_list()[1]) >= 3
+    assert engine_point(system)[0] == ref.count_complex_pairs(p)
+
+
+def test_zero_spin_and_kappa_two_give_exact_zeros():
+    system = {"support": "fixed", "g": 9.81, "omega": 0.0,
+              "bodies": [{"m": 1.0, "A": 0.02, "C": 0.03, "c": 0.1, "s": 0.2, "fluid": {"E": [1e-3], "kappa": [2.0]}},
+                         {"m": 1.0, "A": 0.02, "C": 0.03, "c": -0.1}]}
+    for omega in (0.0, 25.0):
+        system["omega"] = omega
+        p = ref.char_poly(**reference_args(system))
+        assert engine_point(system)[0] == ref.count_complex_pairs(p)
+
+
+@pytest.mark.parametrize("support", ["fixed", "free"])
+def test_eight_bodies(support):
+    rng = random.Random(88 if support == "fixed" else 89)
+    for _ in range(2):
+        system = random_system(rng, 8, 0, support)
+        p = ref.char_poly(**reference_args(system))
+        assert engine_point(system)[0] == ref.count_complex_pairs(p)
+
+
+def test_coefficients_spanning_many_decades():
+    rng = random.Random(5)
+    for scale in (1e-3, 1e3, 1e5):
+        system = random_system(rng, 3, 1, "fixed")
+        system["omega"] = scale
+        system["joints"] = [1e6, 0.0]
+        p = ref.char_poly(**reference_args(system))
+        assert engine_point(system)[0] == ref.count_complex_pairs(p)
+
+
+def test_omega_sign_symmetry_keeps_the_count():
+    rng = random.Random(11)
+    for support in ("fixed", "free"):
+        system = random_system(rng, 3, 2, support)
+        flipped = copy.deepcopy(system)
+        flipped["omega"] = -system["omega"]
+        for b in flipped["bodies"]:
+            if "omega" in b:
+                b["omega"] = -b["omega"]
+        assert engine_point(system)[0] == engine_point(flipped)[0]
+
+
+def test_reversed_free_chain_keeps_the_count():
+    rng = random.Random(12)
+    system = random_system(rng, 3, 1, "free")
+    bodies = system["bodies"]
+    for b in bodies:  # dyadic lengths, so that s - c is exact in binary
+        b["c"], b["s"] = round(b["c"] * 1024) / 1024, round(b["s"] * 1024) / 1024
+    # body k -> n+1-k with c -> s - c
+    rev = copy.deepcopy(system)
+    rev["bodies"] = [dict(b, c=b["s"] - b["c"]) for b in reversed(bodies)]
+    rev["joints"] = list(reversed(system["joints"]))
+    p1 = ref.char_poly(**reference_args(system))
+    p2 = ref.char_poly(**reference_args(rev))
+    assert p1 == p2
+    assert engine_point(system)[0] == engine_point(rev)[0]
