@@ -7,7 +7,6 @@ the float path was asked about.  Same per-point layout as ``kernels.charpoly``.
 
 from __future__ import annotations
 
-
 import flint
 import numpy as np
 
