@@ -42,7 +42,8 @@ def run(npts: int, n: int, modes: int, rng) -> dict:
     pts = random_points(rng, npts, n, modes)
     nc = np.empty(npts, np.int16)
     st = np.empty(npts, np.int8)
-    kernels.count_block(*[a[:1] if isinstance(a, np.ndarray) and a.ndim and a.shape[0] == npts else a for a in pts.kernel_args()], nc[:1], st[:1])
+    warm = random_points(rng, 1, n, modes)  # compile outside the timed call
+    kernels.count_block(*warm.kernel_args(), nc[:1], st[:1])
     t0 = time.perf_counter()
     kernels.count_block(*pts.kernel_args(), nc, st)
     t_kernel = time.perf_counter() - t0

@@ -67,7 +67,8 @@ def engine_point(system: dict):
 
 def engine_enclosure(system: dict) -> list[tuple[Fraction, Fraction]]:
     """The kernel's coefficient intervals (midpoint, radius) as exact fractions."""
-    pts = block_arrays(from_dict(system), [])
-    out = np.zeros((1, from_dict(system).degree + 1, 3))
+    scene = from_dict(system)
+    pts = block_arrays(scene, [])
+    out = np.zeros((1, scene.degree + 1, 3))
     kernels.charpoly_block(*pts.kernel_args(), out)
     return [(Fraction(h) + Fraction(lo), Fraction(r)) for h, lo, r in out[0]]
