@@ -10,13 +10,14 @@ of lambda everywhere (as ``numpy.polynomial``).
 STABMAP_KERNELS = 1
 
 from .block import charpoly_block, count_block  # noqa: E402
-from .status import DECIDED_FLOAT, DEGENERATE, UNDECIDED  # noqa: E402
+from .status import DECIDED_FLOAT, DECIDED_INCLUSION, DEGENERATE, UNDECIDED  # noqa: E402
 
 __all__ = [
     "STABMAP_KERNELS",
     "charpoly_block",
     "count_block",
     "DECIDED_FLOAT",
+    "DECIDED_INCLUSION",
     "UNDECIDED",
     "DEGENERATE",
 ]

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from .charpoly import allocate, charpoly_point
+from .count import allocate_count, count_point
 from .options import kernel
-from .sturm import count_complex_pairs
 
 
 @kernel
@@ -49,9 +49,9 @@ def count_block(body, joint, g, E, kappa, nmodes, free, out_nc, out_status):
     degree = int(rowdeg.sum())
     ws = allocate(n, max(1, nmodes.max()), degree)
     c = np.empty((degree + 1, 3))
-    W = np.empty((2, degree + 1, 3))
+    cs = allocate_count(degree)
     for p in range(npts):
         charpoly_point(body[p], joint[p], g[p], E[p], kappa[p], nmodes, rowdeg, free, ws, c)
-        nc, status = count_complex_pairs(c, W)
+        nc, status = count_point(c, cs)
         out_nc[p] = nc
         out_status[p] = status

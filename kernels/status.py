@@ -1,5 +1,6 @@
 """Per-point status codes written by the kernels."""
 
-DECIDED_FLOAT = 0  # interval arithmetic proved the count
+DECIDED_FLOAT = 0  # the interval Sturm sequence proved the count
 UNDECIDED = 1  # the intervals could not decide: the caller must use exact arithmetic
 DEGENERATE = 2  # p(lambda) is identically zero
+DECIDED_INCLUSION = 3  # disjoint root-inclusion disks proved the count

@@ -15,43 +15,10 @@ exact power of two.
 
 from __future__ import annotations
 
-import math
-
 from . import dd
 from .options import kernel
+from .scaling import nonzero_span, rescale, root_scale
 from .status import DECIDED_FLOAT, DEGENERATE, UNDECIDED
-
-
-@kernel
-def _rescale(X, deg, lam_shift):
-    """Exact power-of-two rescaling: lambda -> 2**lam_shift mu, then |lead| in [0.5, 1).
-
-    Returns False if that would push a nonzero coefficient out of the safe range
-    (then the scaling could stop being exact).
-    """
-    e = math.frexp(X[deg, 0])[1]
-    for i in range(deg + 1):
-        s = lam_shift * i - e
-        X[i, 0] = math.ldexp(X[i, 0], s)
-        X[i, 1] = math.ldexp(X[i, 1], s)
-        X[i, 2] = math.ldexp(X[i, 2], s)
-        a = abs(X[i, 0])
-        if a != 0.0 and (a > dd.LARGE or a < 1.0 / dd.LARGE):
-            return False
-    return True
-
-
-@kernel
-def _root_scale(X, deg):
-    """Power of two near the Fujiwara root bound max_i |c_i / c_deg|**(1 / (deg - i))."""
-    ed = math.frexp(X[deg, 0])[1]
-    best = -(1 << 30)
-    for i in range(deg):
-        if X[i, 0] != 0.0:
-            t = (math.frexp(X[i, 0])[1] - ed) // (deg - i)
-            if t > best:
-                best = t
-    return 0 if best == -(1 << 30) else best
 
 
 @kernel
@@ -71,22 +38,17 @@ def count_complex_pairs(c, W):
         status is DECIDED_FLOAT, UNDECIDED (n_complex_pairs = -1) or DEGENERATE
         (p identically zero, n_complex_pairs = -1).
     """
-    top = c.shape[0] - 1
-    while top >= 0 and dd.is_zero(c[top, 0], c[top, 1], c[top, 2]):
-        top -= 1
+    z, top = nonzero_span(c)
     if top < 0:
         return -1, DEGENERATE
     if not dd.certain_nonzero(c[top, 0], c[top, 1], c[top, 2]):
         return -1, UNDECIDED
-    z = 0
-    while dd.is_zero(c[z, 0], c[z, 1], c[z, 2]):
-        z += 1
     real = z  # exact zeros at the bottom are lambda = 0 roots
     d = top - z
     a, b = 0, 1
     A = W[a]
     A[: d + 1] = c[z : top + 1]
-    if d >= 1 and not _rescale(A, d, -_root_scale(A, d)):
+    if d >= 1 and not rescale(A, d, root_scale(A, d)):
         return -1, UNDECIDED
     while d >= 1:
         # The Sturm sequence of the current polynomial (degree d) starts with it and its derivative.
@@ -135,7 +97,7 @@ def count_complex_pairs(c, W):
                 for i in range(dr + 1):
                     A[i, 0] = -A[i, 0]
                     A[i, 1] = -A[i, 1]
-            if not _rescale(A, dr, 0):
+            if not rescale(A, dr, 0):
                 return -1, UNDECIDED
             a, b = b, a
             da, db = db, dr

@@ -10,8 +10,9 @@ from . import exact
 from .points import PointArrays
 
 # Values of the ``decided_by`` flag variable.
-BY_INTERVAL = 0
+BY_STURM = 0
 BY_EXACT = 1
+BY_INCLUSION = 2
 
 
 def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
@@ -20,7 +21,7 @@ def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
     nc = np.empty(npts, dtype=np.int16)
     status = np.empty(npts, dtype=np.int8)
     kernels.count_block(*points.kernel_args(), nc, status)
-    decided_by = np.full(npts, BY_INTERVAL, dtype=np.int8)
+    decided_by = np.where(status == kernels.DECIDED_INCLUSION, BY_INCLUSION, BY_STURM).astype(np.int8)
     undecided = np.flatnonzero(status == kernels.UNDECIDED)
     if undecided.size:
         nc[undecided] = exact.decide_points(*points.kernel_args(), undecided)

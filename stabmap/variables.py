@@ -25,10 +25,12 @@ ATTRS = {
     },
     DECIDED_BY: {
         "long_name": "arithmetic that decided n_complex_pairs at this point",
-        "flag_values": np.array([0, 1], dtype=np.int8),
-        "flag_meanings": "interval_arithmetic exact_rational_arithmetic",
-        "comment": "interval_arithmetic: proved by the certified double-double Sturm sequence; "
-        "exact_rational_arithmetic: the intervals could not decide and the point was recomputed exactly",
+        "flag_values": np.array([0, 1, 2], dtype=np.int8),
+        "flag_meanings": "interval_sturm_sequence exact_rational_arithmetic interval_root_inclusion",
+        "comment": "interval_sturm_sequence: proved by the double-double interval Sturm sequence; "
+        "interval_root_inclusion: proved by disjoint Gerschgorin inclusion disks around the roots; "
+        "exact_rational_arithmetic: neither could decide and the point was recomputed exactly. "
+        "All three are proofs; docs/certification.md",
     },
 }
 

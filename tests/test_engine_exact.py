@@ -7,7 +7,7 @@ import random
 
 import pytest
 
-from stabmap.decide import BY_EXACT, BY_INTERVAL
+from stabmap.decide import BY_EXACT, BY_STURM
 
 import reference as ref
 from systems import engine_enclosure, engine_point, random_system, reference_args
@@ -34,7 +34,7 @@ def test_random_systems_match_exact_reference(n, modes, support):
 def test_most_random_points_are_decided_by_intervals():
     rng = random.Random(7)
     by = [engine_point(random_system(rng, 3, 2, "fixed"))[1] for _ in range(40)]
-    assert by.count(BY_INTERVAL) >= 30
+    assert by.count(BY_STURM) >= 30
 
 
 def _maievskii(omega: float) -> dict:

@@ -1,0 +1,48 @@
+"""N_c of one interval polynomial: the Sturm sequence first, root inclusion where it cannot decide."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import dd
+from .inclusion import count_complex_pairs_inclusion
+from .options import kernel
+from .scaling import nonzero_span, rescale, root_scale
+from .status import UNDECIDED
+from .sturm import count_complex_pairs
+
+
+@kernel
+def allocate_count(degree):
+    """Scratch for ``count_point``: allocated once per block."""
+    W = np.empty((2, degree + 1, 3))
+    X = np.empty((degree + 1, 3))
+    a = np.empty(degree + 1)
+    z = np.empty(degree, np.complex128)
+    R = np.empty(degree)
+    group = np.empty(2 * degree, np.int64)
+    flags = np.empty(degree, np.bool_)
+    return W, X, a, z, R, group, flags
+
+
+@kernel
+def count_point(c, ws):
+    """(N_c, status) of the interval polynomial c (ascending, (hi, lo, rad)); ws from ``allocate_count``.
+
+    The Sturm sequence is cheap and decides nearly every point up to degree ~12;
+    root inclusion needs no remainder chain and decides well-separated roots at
+    any degree.  Whatever neither proves is UNDECIDED.
+    """
+    W, X, a, z, R, group, flags = ws
+    nc, status = count_complex_pairs(c, W)
+    if status != UNDECIDED:
+        return nc, status
+    low, top = nonzero_span(c)
+    d = top - low
+    if d < 2 or not dd.certain_nonzero(c[top, 0], c[top, 1], c[top, 2]):
+        return nc, status
+    X[: d + 1] = c[low : top + 1]
+    if not rescale(X, d, root_scale(X, d)):
+        return nc, status
+    # The exact zero roots are real, so N_c of the reduced polynomial is N_c of p.
+    return count_complex_pairs_inclusion(X, d, a, z, R, group, flags)
