@@ -38,6 +38,7 @@ from .status import DECIDED_INCLUSION, UNDECIDED
 
 TINY = 2.0**-1000  # absolute cover for underflow in a Horner value
 MAX_ITER = 120
+POLISH_SWEEPS = 2
 
 
 @kernel
@@ -84,6 +85,50 @@ def _value_and_slope(a, d, x):
 
 
 @kernel
+def _value_dd(X, d, zr, zi):
+    """p(z) for the interval polynomial X at the float point z, in double-double interval arithmetic.
+
+    Returns (p as a complex128 midpoint, an upper bound of |p(z)| over every
+    polynomial in the intervals, p'(z) as a complex128 midpoint).  The bound is
+    rigorous by construction of ``dd``; the derivative only steers iterations.
+    """
+    re = (X[d, 0], X[d, 1], X[d, 2])
+    im = (0.0, 0.0, 0.0)
+    dre = (0.0, 0.0, 0.0)
+    dim = (0.0, 0.0, 0.0)
+    for k in range(d - 1, -1, -1):
+        # p' <- p' z + p ; p <- p z + X_k
+        t = dd.add(*dd.mul(*dre, zr, 0.0, 0.0), *dd.neg(*dd.mul(*dim, zi, 0.0, 0.0)))
+        dim = dd.add(*dd.add(*dd.mul(*dre, zi, 0.0, 0.0), *dd.mul(*dim, zr, 0.0, 0.0)), *im)
+        dre = dd.add(*t, *re)
+        t = dd.add(*dd.mul(*re, zr, 0.0, 0.0), *dd.neg(*dd.mul(*im, zi, 0.0, 0.0)))
+        im = dd.add(*dd.mul(*re, zi, 0.0, 0.0), *dd.mul(*im, zr, 0.0, 0.0))
+        re = dd.add(*t, X[k, 0], X[k, 1], X[k, 2])
+    bre = abs(re[0]) * dd.ABS + re[2]
+    bim = abs(im[0]) * dd.ABS + im[2]
+    bound = math.sqrt(bre * bre + bim * bim) * (1.0 + 4.0 * dd.U)
+    return complex(re[0] + re[1], im[0] + im[1]), bound, complex(dre[0] + dre[1], dim[0] + dim[1])
+
+
+@kernel
+def _polish(X, d, z, sweeps):
+    """Aberth sweeps with p and p' in double-double: roots in tight clusters to full float precision."""
+    for _ in range(sweeps):
+        for i in range(d):
+            p, _, dp = _value_dd(X, d, z[i].real, z[i].imag)
+            if p == 0.0 or dp == 0.0:
+                continue
+            ratio = p / dp
+            s = 0.0j
+            for j in range(d):
+                if j != i:
+                    s += 1.0 / (z[i] - z[j])
+            step = ratio / (1.0 - ratio * s)
+            if math.isfinite(step.real) and math.isfinite(step.imag):
+                z[i] -= step
+
+
+@kernel
 def _aberth(a, d, z, done):
     """Aberth-Ehrlich iteration on the float polynomial a (ascending, degree d), in place."""
     done[:d] = False
@@ -112,8 +157,8 @@ def _aberth(a, d, z, done):
 
 
 @kernel
-def _snap_real(a, d, z):
-    """Put approximations of simple real roots exactly on the real axis (then polish them).
+def _snap_real(X, d, z):
+    """Put approximations of simple real roots exactly on the real axis (then Newton-polish them).
 
     A disk can certify a real root only if its centre is real.  An approximation
     is moved only if no other one approximates its conjugate (that would be a
@@ -132,9 +177,9 @@ def _snap_real(a, d, z):
             continue
         x = zi.real
         for _ in range(2):
-            p, dp, _ = _value_and_slope(a, d, x)
-            if dp != 0.0 and p != 0.0:
-                x -= p / dp
+            p, _, dp = _value_dd(X, d, x, 0.0)
+            if dp.real != 0.0 and p.real != 0.0:
+                x -= p.real / dp.real
         z[i] = complex(x, 0.0)
 
 
@@ -154,18 +199,9 @@ def _disk_radii(X, d, z, R):
     if not lead > 0.0:
         return False
     lead_m, lead_e = math.frexp(lead)
-    horner_rel = 8.0 * (d + 1) * dd.U
     for i in range(d):
         zi = z[i]
-        az = abs(zi) * (1.0 + 4.0 * dd.U)
-        s = X[d, 0] + 0.0j
-        bound = abs(X[d, 0])
-        extra = abs(X[d, 1]) + X[d, 2]
-        for k in range(d - 1, -1, -1):
-            s = s * zi + X[k, 0]
-            bound = bound * az + abs(X[k, 0])
-            extra = extra * az + abs(X[k, 1]) + X[k, 2]
-        num = (abs(s) * (1.0 + 4.0 * dd.U) + (horner_rel * bound + extra) * mu + (d + 1) * TINY) * mu
+        num = _value_dd(X, d, zi.real, zi.imag)[1] * mu
         if not math.isfinite(num):
             return False
         num_m, num_e = math.frexp(num)
@@ -204,7 +240,8 @@ def count_complex_pairs_inclusion(X, d, a, z, R, group, flags):
     for i in range(d):
         if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
             return -1, UNDECIDED
-    _snap_real(a, d, z)
+    _polish(X, d, z, POLISH_SWEEPS)
+    _snap_real(X, d, z)
     if not _disk_radii(X, d, z, R):
         return -1, UNDECIDED
     parent, size = group[:d], group[d : 2 * d]

@@ -8,7 +8,7 @@ import numpy as np
 import xarray as xr
 
 from .errors import StabmapError
-from .variables import DECIDED_BY, N_COMPLEX_PAIRS, STABILITY, flag_meaning
+from .variables import ATTRS, DECIDED_BY, N_COMPLEX_PAIRS, STABILITY, flag_meaning
 
 
 @dataclass(frozen=True)
@@ -57,5 +57,5 @@ def summary(ds: xr.Dataset) -> dict:
         "degenerate": int((nc < 0).sum()),
         "stable_fraction": float((nc == 0).mean()) if nc.size else float("nan"),
         "n_complex_pairs": {int(v): int(c) for v, c in zip(values, counts)},
-        "decided_by": {flag_meaning(DECIDED_BY, v): int((by == v).sum()) for v in (0, 1)},
+        "decided_by": {flag_meaning(DECIDED_BY, v): int((by == v).sum()) for v in ATTRS[DECIDED_BY]["flag_values"]},
     }
