@@ -35,6 +35,8 @@ __all__ = [
     "paper_F",
     "count_real_roots",
     "count_complex_pairs",
+    "sturm_complex_pairs",
+    "arb_complex_pairs",
 ]
 
 #: The spectral variable of every polynomial produced here.
@@ -363,5 +365,67 @@ def count_complex_pairs(poly):
         raise ValueError("the zero polynomial has no finite root count")
     missing = poly.degree() - count_real_roots(poly)
     # Real coefficients: non-real roots come in conjugate pairs.
+    assert missing % 2 == 0, missing
+    return missing // 2
+
+
+def _sturm_distinct_real(f):
+    """Distinct real roots of the nonzero ``flint.fmpq_poly`` f by an exact Sturm sequence."""
+    seq = [f, f.derivative()]
+    while seq[-1].degree() > 0:
+        r = seq[-2] % seq[-1]
+        if r == 0:
+            break
+        seq.append(-r)
+    seq = [q for q in seq if q != 0]
+
+    def changes(signs):
+        signs = [x for x in signs if x != 0]
+        return sum(1 for a, b in zip(signs, signs[1:]) if a != b)
+
+    lead = [(1 if q.coeffs()[-1] > 0 else -1) for q in seq]
+    at_minus = [lc if q.degree() % 2 == 0 else -lc for q, lc in zip(seq, lead)]
+    return changes(at_minus) - changes(lead)
+
+
+def _to_flint(poly):
+    import flint
+
+    poly = _as_poly(poly)
+    if poly.is_zero:
+        raise ValueError("the zero polynomial has no finite root count")
+    return flint.fmpq_poly([flint.fmpq(int(c.p), int(c.q)) for c in reversed(poly.all_coeffs())])
+
+
+def arb_complex_pairs(poly):
+    """``N_c`` from FLINT/Arb's certified isolation of every complex root (any degree, fast).
+
+    For the high-degree stress tests, where both sympy's root counting and
+    rational Sturm sequences take minutes: the polynomial still comes from
+    this module, only the root isolation is FLINT's.
+    """
+    g = _to_flint(poly)
+    real = sum(mult for root, mult in g.numer().complex_roots() if root.imag.is_zero())
+    missing = g.degree() - real
+    assert missing % 2 == 0, missing
+    return missing // 2
+
+
+def sturm_complex_pairs(poly):
+    """``N_c`` by exact Sturm sequences in python-flint rationals (about 1000x faster than sympy).
+
+    Same contract as :func:`count_complex_pairs`; rational remainders grow
+    fast, so use it up to degree ~16 (:func:`arb_complex_pairs` beyond).  Multiplicities come from the chain
+    g_0 = p, g_{j+1} = gcd(g_j, g_j'): p has sum_j (distinct real roots of g_j)
+    real roots counted with multiplicity.  Deliberately a different algorithm
+    from the engine's exact path, which isolates complex roots with Arb.
+    """
+    g = _to_flint(poly)
+    degree = g.degree()
+    real = 0
+    while g.degree() > 0:
+        real += _sturm_distinct_real(g)
+        g = g.gcd(g.derivative())
+    missing = degree - real
     assert missing % 2 == 0, missing
     return missing // 2
