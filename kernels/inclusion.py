@@ -16,14 +16,13 @@ own conjugate, a real root; a group of disks that misses the real axis holds
 only non-real roots.  Any other configuration (clusters across the axis, close
 or repeated roots) is UNDECIDED and goes to exact arithmetic.
 
-|p(z_i)| is bounded for every polynomial in the coefficient intervals: the
-floating-point Horner value plus a running error bound (8 (d + 1) u times
-sum |a_k| |z|^k, twice the classical complex Horner bound), plus the
-midpoint and radius parts of the coefficients, plus an absolute term for
-underflow.  Products are kept as mantissa and exponent so no partial product
-overflows or underflows, and every bound is rounded outward by a factor
-1 + 16 (d + 4) u.  The approximations themselves need no guarantee: a bad one
-only makes a disk too large to decide.
+|p(z_i)| is bounded for every polynomial in the coefficient intervals by
+Horner's rule in the rigorous double-double intervals of ``dd`` (float64
+Horner would cap the precision of clustered roots at about 1e-8).  Products
+are kept as mantissa and exponent so no partial product overflows or
+underflows, and every bound is rounded outward by a factor 1 + 16 (d + 4) u.
+The approximations themselves need no guarantee: a bad one only makes a disk
+too large to decide.
 """
 
 from __future__ import annotations
@@ -36,7 +35,7 @@ from . import dd
 from .options import kernel
 from .status import DECIDED_INCLUSION, UNDECIDED
 
-TINY = 2.0**-1000  # absolute cover for underflow in a Horner value
+TINY = 2.0**-1000  # floor of a radius, so an underflowing bound never becomes zero
 MAX_ITER = 120
 POLISH_SWEEPS = 2
 

@@ -13,3 +13,14 @@ def test_bench_kernel_quick(capsys):
     assert [r["degree"] for r in rows] == [2, 6, 12]
     assert all(r["undecided_pct"] <= 100 for r in rows)
     assert "| n | modes |" in capsys.readouterr().out
+
+
+def test_bench_accuracy_quick(capsys):
+    out = runpy.run_path(str(SCRIPTS / "bench_accuracy.py"))["main"](["--quick"])
+    rows = {(r[0], r[1]): r for r in out["rows"]}
+    # The certified path with its fallback is never wrong; the table must contain the baselines it beats.
+    for point_set in ("random-12", "random-24", "boundary", "repeated"):
+        assert rows[(point_set, "stabmap certified + exact fallback")][3] == 0
+        assert (point_set, "numpy.roots, tol 1e-10") in rows
+    assert [a[0] for a in out["atlases"]] == ["paper-n1-fixed", "paper-n2-fixed", "paper-n3-fixed"]
+    assert "| point set | method |" in capsys.readouterr().out
