@@ -110,6 +110,17 @@ def _value_dd(X, d, zr, zi):
 
 
 @kernel
+def _aberth_step(z, d, i, p, dp):
+    """Aberth's correction of z[i] from p(z[i]) and p'(z[i]): Newton's, repelled by the other approximations."""
+    ratio = p / dp
+    s = 0.0j
+    for j in range(d):
+        if j != i:
+            s += 1.0 / (z[i] - z[j])
+    return ratio / (1.0 - ratio * s)
+
+
+@kernel
 def _polish(X, d, z, sweeps):
     """Aberth sweeps with p and p' in double-double: roots in tight clusters to full float precision."""
     for _ in range(sweeps):
@@ -117,12 +128,7 @@ def _polish(X, d, z, sweeps):
             p, _, dp = _value_dd(X, d, z[i].real, z[i].imag)
             if p == 0.0 or dp == 0.0:
                 continue
-            ratio = p / dp
-            s = 0.0j
-            for j in range(d):
-                if j != i:
-                    s += 1.0 / (z[i] - z[j])
-            step = ratio / (1.0 - ratio * s)
+            step = _aberth_step(z, d, i, p, dp)
             if math.isfinite(step.real) and math.isfinite(step.imag):
                 z[i] -= step
 
@@ -140,12 +146,7 @@ def _aberth(a, d, z, done):
             if abs(p) <= dd.U * scale:
                 done[i] = True  # p(z) is rounding noise: no further digits to gain
                 continue
-            ratio = p / dp
-            s = 0.0j
-            for j in range(d):
-                if j != i:
-                    s += 1.0 / (z[i] - z[j])
-            step = ratio / (1.0 - ratio * s)
+            step = _aberth_step(z, d, i, p, dp)
             z[i] -= step
             if abs(step) <= 2.0**-50 * abs(z[i]):
                 done[i] = True

@@ -36,7 +36,7 @@ import kernels  # noqa: E402
 from bench_kernel import random_points  # noqa: E402
 from stabmap import exact  # noqa: E402
 from stabmap.atlas import compute  # noqa: E402
-from stabmap.decide import BY_EXACT, BY_INCLUSION, BY_STURM  # noqa: E402
+from stabmap.decide import BY_EXACT, BY_INCLUSION, BY_STURM, decided_by_from_status  # noqa: E402
 from stabmap.examples import example  # noqa: E402
 from stabmap.points import PointArrays  # noqa: E402
 
@@ -210,7 +210,7 @@ def score(name: str, pts_list, rows: list) -> None:
         nc[und] = exact.decide_points(*pts.kernel_args(), und)
         t_fallback += time.perf_counter() - t0
         certified.append(nc)
-        by.append(np.where(st == kernels.DECIDED_INCLUSION, BY_INCLUSION, np.where(st == kernels.UNDECIDED, BY_EXACT, BY_STURM)))
+        by.append(decided_by_from_status(st))
     truth, certified, by = np.concatenate(truth), np.concatenate(certified), np.concatenate(by)
     npts = truth.size
     per = lambda t: 1e6 * t / npts  # noqa: E731
