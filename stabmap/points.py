@@ -43,34 +43,30 @@ def base_arrays(scene: Scene):
     return body, joint, float(scene.g), E, kappa
 
 
-def block_arrays(scene: Scene, location: list[tuple[int, int]]) -> PointArrays:
-    """Per-point arrays for the block ``location`` = [(start, stop) per grid axis], C order."""
+def point_arrays(scene: Scene, values: dict[str, np.ndarray]) -> PointArrays:
+    """Per-point arrays for points given by grid-axis values (arrays broadcast together, C order)."""
     body0, joint0, g0, E0, kappa0 = base_arrays(scene)
-    shape = tuple(stop - start for start, stop in location)
+    arrays = {name: np.asarray(v, dtype=np.float64) for name, v in values.items()}
+    shape = np.broadcast_shapes(*(a.shape for a in arrays.values())) if arrays else ()
     npts = int(np.prod(shape, dtype=np.int64))
     body = np.broadcast_to(body0, shape + body0.shape).copy()
     joint = np.broadcast_to(joint0, shape + joint0.shape).copy()
     g = np.full(shape, g0)
     own_omega = [b.omega is not None for b in scene.bodies]
     # A common-omega axis first, so that an omega_k axis for the same body wins.
-    order = sorted(range(len(scene.grid)), key=lambda d: scene.grid[d].name != "omega")
-    for d in order:
-        axis = scene.grid[d]
-        start, stop = location[d]
-        view = [None] * len(shape)
-        view[d] = slice(None)
-        values = axis.array[start:stop][tuple(view)]
-        name = parse_name(axis.name, scene.n, scene.support)
+    for key in sorted(arrays, key=lambda key: key != "omega"):
+        value = arrays[key]
+        name = parse_name(key, scene.n, scene.support)
         if name.kind == "global" and name.symbol == "g":
-            g[...] = values
+            g[...] = value
         elif name.kind == "global":
             for k in range(scene.n):
                 if not own_omega[k]:
-                    body[..., k, 5] = values
+                    body[..., k, 5] = value
         elif name.kind == "joint":
-            joint[..., name.index] = values
+            joint[..., name.index] = value
         else:
-            body[..., name.index - 1, BODY_COLUMNS.index(name.symbol)] = values
+            body[..., name.index - 1, BODY_COLUMNS.index(name.symbol)] = value
     return PointArrays(
         body=body.reshape(npts, scene.n, 6),
         joint=joint.reshape(npts, scene.n),
@@ -80,3 +76,13 @@ def block_arrays(scene: Scene, location: list[tuple[int, int]]) -> PointArrays:
         nmodes=scene.nmodes,
         free=scene.free,
     )
+
+
+def block_arrays(scene: Scene, location: list[tuple[int, int]]) -> PointArrays:
+    """Per-point arrays for the block ``location`` = [(start, stop) per grid axis], C order."""
+    values = {}
+    for d, (axis, (start, stop)) in enumerate(zip(scene.grid, location)):
+        view = [None] * len(location)
+        view[d] = slice(None)
+        values[axis.name] = axis.array[start:stop][tuple(view)]
+    return point_arrays(scene, values)
