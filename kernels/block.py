@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .charpoly import allocate, charpoly_point
+from .charpoly import allocate, block_det, charpoly_point, diagonal_blocks, matrix_point, same_structure
 from .count import allocate_count, count_point
 from .options import kernel
+from .status import DECIDED_FLOAT, DECIDED_INCLUSION, DEGENERATE, UNDECIDED
 
 
 @kernel
@@ -34,7 +35,8 @@ def charpoly_block(body, joint, g, E, kappa, nmodes, free, out):
     degree = int(rowdeg.sum())
     ws = allocate(n, max(1, nmodes.max()), degree)
     for p in range(npts):
-        charpoly_point(body[p], joint[p], g[p], E[p], kappa[p], nmodes, rowdeg, free, ws, out[p])
+        reuse = same_structure(body, joint, g, p)
+        charpoly_point(body[p], joint[p], g[p], E[p], kappa[p], nmodes, rowdeg, free, ws, out[p], reuse)
 
 
 @kernel
@@ -43,6 +45,10 @@ def count_block(body, joint, g, E, kappa, nmodes, free, out_nc, out_status):
 
     Inputs as for ``charpoly_block``.  Writes ``out_nc`` (int16[npts], -1 where
     undecided or degenerate) and ``out_status`` (int8[npts], codes of kernels.status).
+
+    Where the characteristic matrix is block triangular (``diagonal_blocks``),
+    p is the product of the blocks' determinants and N_c the sum of theirs:
+    lower degrees, and no repeated roots shared between identical factors.
     """
     npts, n = body.shape[0], body.shape[1]
     rowdeg = nmodes + 2
@@ -50,8 +56,21 @@ def count_block(body, joint, g, E, kappa, nmodes, free, out_nc, out_status):
     ws = allocate(n, max(1, nmodes.max()), degree)
     c = np.empty((degree + 1, 3))
     cs = allocate_count(degree)
+    starts = np.empty(n + 1, np.int64)
     for p in range(npts):
-        charpoly_point(body[p], joint[p], g[p], E[p], kappa[p], nmodes, rowdeg, free, ws, c)
-        nc, status = count_point(c, cs)
-        out_nc[p] = nc
+        matrix_point(body[p], joint[p], g[p], E[p], kappa[p], nmodes, free, ws, same_structure(body, joint, g, p))
+        nblocks = diagonal_blocks(ws[5], starts)
+        total, status = 0, DECIDED_FLOAT
+        for b in range(nblocks):
+            d = block_det(ws, rowdeg, starts[b], starts[b + 1], c)
+            nc, st = count_point(c[: d + 1], cs)
+            if st == DEGENERATE or st == UNDECIDED:
+                total, status = -1, st
+                if st == DEGENERATE:
+                    break
+            elif status != UNDECIDED:
+                total += nc
+                if st == DECIDED_INCLUSION:
+                    status = DECIDED_INCLUSION
+        out_nc[p] = total
         out_status[p] = status

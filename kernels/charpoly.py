@@ -119,15 +119,18 @@ def _liquid_polys(omega, E, kappa, L, q, w):
 
 
 @kernel
-def _matrix(body, joint, g, E, kappa, nmodes, free, J, M, K, q, w, P):
+def _matrix(body, joint, g, E, kappa, nmodes, free, J, M, K, q, w, P, reuse):
     """Write P = diag(Q) Phi T as interval polynomials into P (n, n, 3 + Lmax, 3).
 
     Row k has degree 2 + nmodes[k]; unused trailing coefficients are exact zeros.
+    ``reuse``: M T and K T in M, K are those of this point already (only omega
+    or the liquid changed since the previous point).
     """
     n = body.shape[0]
-    _lever_arms(body, free, J)
-    _inertia_T(body, J, M)
-    _stiffness_T(body, joint, g, free, K)
+    if not reuse:
+        _lever_arms(body, free, J)
+        _inertia_T(body, J, M)
+        _stiffness_T(body, joint, g, free, K)
     P[:] = 0.0
     for k in range(n):
         L = nmodes[k]
@@ -209,6 +212,45 @@ def _laplace_det(P, rowdeg, D, out):
 
 
 @kernel
+def _zero_entry(P, i, j):
+    for a in range(P.shape[2]):
+        if not dd.is_zero(P[i, j, a, 0], P[i, j, a, 1], P[i, j, a, 2]):
+            return False
+    return True
+
+
+@kernel
+def _zero_rect(P, r0, r1, c0, c1):
+    for i in range(r0, r1):
+        for j in range(c0, c1):
+            if not _zero_entry(P, i, j):
+                return False
+    return True
+
+
+@kernel
+def diagonal_blocks(P, starts):
+    """Split P into diagonal blocks whose determinants multiply to det P; returns their number.
+
+    At a split s the rectangle rows < s, columns >= s or the rectangle rows >= s,
+    columns < s holds only exact zeros, so det P = det P[:s, :s] det P[s:, s:]
+    (and the sub-blocks inherit the zero rectangles).  Block b is
+    starts[b]:starts[b + 1]; starts needs n + 1 entries.  A chain whose upper
+    bodies have a_k = 0 and ideal joints splits into n blocks (MODEL.md).
+    """
+    n = P.shape[0]
+    nb = 0
+    starts[0] = 0
+    for s in range(1, n):
+        if _zero_rect(P, 0, s, s, n) or _zero_rect(P, s, n, 0, s):
+            nb += 1
+            starts[nb] = s
+    nb += 1
+    starts[nb] = n
+    return nb
+
+
+@kernel
 def allocate(n, lmax, degree):
     """Scratch arrays for one block: allocated once per block, reused for every point."""
     J = np.empty((n, n, 3))
@@ -222,8 +264,36 @@ def allocate(n, lmax, degree):
 
 
 @kernel
-def charpoly_point(body, joint, g, E, kappa, nmodes, rowdeg, free, ws, out):
-    """Enclosure of p(lambda) for one point into out (deg + 1, 3); ws from ``allocate``, rowdeg = nmodes + 2."""
+def same_structure(body, joint, g, p):
+    """True if point p has the inertia and stiffness of point p - 1 (only omega or the liquid differ)."""
+    if p == 0 or g[p] != g[p - 1]:
+        return False
+    for k in range(body.shape[1]):
+        if joint[p, k] != joint[p - 1, k]:
+            return False
+        for col in range(5):  # m, A, C, c, s; column 5 is omega
+            if body[p, k, col] != body[p - 1, k, col]:
+                return False
+    return True
+
+
+@kernel
+def matrix_point(body, joint, g, E, kappa, nmodes, free, ws, reuse):
+    """Build P = diag(Q) Phi T of one point into ws[5]; ws from ``allocate``."""
     J, M, K, q, w, P, D = ws
-    _matrix(body, joint, g, E, kappa, nmodes, free, J, M, K, q, w, P)
-    _laplace_det(P, rowdeg, D, out)
+    _matrix(body, joint, g, E, kappa, nmodes, free, J, M, K, q, w, P, reuse)
+
+
+@kernel
+def block_det(ws, rowdeg, i0, i1, out):
+    """Enclosure of det P[i0:i1, i0:i1] (after ``matrix_point``) into out; returns its degree bound."""
+    P, D = ws[5], ws[6]
+    _laplace_det(P[i0:i1, i0:i1], rowdeg[i0:i1], D, out)
+    return int(rowdeg[i0:i1].sum())
+
+
+@kernel
+def charpoly_point(body, joint, g, E, kappa, nmodes, rowdeg, free, ws, out, reuse=False):
+    """Enclosure of p(lambda) for one point into out (deg + 1, 3); ws from ``allocate``, rowdeg = nmodes + 2."""
+    matrix_point(body, joint, g, E, kappa, nmodes, free, ws, reuse)
+    block_det(ws, rowdeg, 0, body.shape[0], out)

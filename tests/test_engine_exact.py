@@ -144,3 +144,49 @@ def test_reversed_free_chain_keeps_the_count():
     p2 = ref.char_poly(**reference_args(rev))
     assert p1 == p2
     assert engine_point(system)[0] == engine_point(rev)[0]
+
+
+@pytest.mark.parametrize("omega", [-40.0, 3.0, 25.0])
+def test_split_chain_is_counted_factor_by_factor(omega):
+    # Upper bodies with c = s = 0 and ideal joints: a_k = 0 for k >= 2, so p = F_1 F_2^3 (MODEL.md).  The
+    # repeated factor F_2^3 defeats any count on p itself; block by block, the Sturm sequence proves it.
+    body = {"m": 1.0, "A": 0.1, "C": 0.05, "c": 0.5, "s": 1.0, "fluid": {"E": [0.01], "kappa": [3.0]}}
+    upper = dict(body, c=0.0, s=0.0)
+    system = {"support": "fixed", "g": 9.81, "omega": omega, "bodies": [body, upper, upper, upper]}
+    p = ref.char_poly(**reference_args(system))
+    assert max(m for _, m in p.sqf_list()[1]) >= 3
+    assert engine_point(system) == (ref.count_complex_pairs(p), BY_STURM)
+
+
+def test_block_triangular_detection_needs_exact_zeros():
+    # The same chain with a tiny c_2: no longer split, and the count must still be right.
+    body = {"m": 1.0, "A": 0.1, "C": 0.05, "c": 0.5, "s": 1.0}
+    system = {"support": "fixed", "g": 9.81, "omega": 7.0, "bodies": [body, dict(body, c=2.0**-40, s=0.0), dict(body, c=0.0, s=0.0)]}
+    p = ref.char_poly(**reference_args(system))
+    assert engine_point(system)[0] == ref.count_complex_pairs(p)
+
+
+def test_reused_inertia_and_stiffness_give_the_same_labels():
+    # count_block skips rebuilding M and K when only omega or the liquid changed since the previous point;
+    # every point must get the label it gets alone.
+    import numpy as np
+
+    import kernels
+    from stabmap.points import point_arrays
+    from stabmap.scene import from_dict
+
+    system = random_system(random.Random(5), 3, 1, "fixed")
+    system["bodies"][0].pop("omega", None)
+    scene = from_dict(system)
+    omega = np.repeat(np.linspace(-90, 90, 12), 3)
+    m_2 = np.tile([0.5, 0.5, 2.5], 12)  # runs of equal structure broken at every third point
+    pts = point_arrays(scene, {"omega": omega, "m_2": m_2})
+    nc = np.empty(omega.size, np.int16)
+    st = np.empty(omega.size, np.int8)
+    kernels.count_block(*pts.kernel_args(), nc, st)
+    for p in range(omega.size):
+        one = point_arrays(scene, {"omega": omega[p : p + 1], "m_2": m_2[p : p + 1]})
+        nc1, st1 = np.empty(1, np.int16), np.empty(1, np.int8)
+        kernels.count_block(*one.kernel_args(), nc1, st1)
+        assert (nc[p], st[p]) == (nc1[0], st1[0])
+    assert len(set(nc.tolist())) > 1
