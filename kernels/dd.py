@@ -21,6 +21,11 @@ characteristic polynomial survive and are factored out exactly.
 
 from __future__ import annotations
 
+from llvmlite import ir
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
+
 from .options import kernel
 
 U = 2.0**-53
@@ -29,7 +34,6 @@ ABS = 1.0 + 4.0 * U  # |h + l| <= |h| * ABS for a normalised double-double
 ADD_REL = 4.0 * 2.0**-106
 MUL_REL = 16.0 * 2.0**-106
 ETA = 2.0**-1000
-SPLIT = 134217729.0  # 2**27 + 1
 LARGE = 2.0**600  # magnitudes beyond which we refuse to decide (overflow/underflow margins)
 
 
@@ -46,16 +50,24 @@ def fast_two_sum(a, b):
     return s, b - (s - a)
 
 
+@intrinsic
+def _fused_multiply_add(typingctx, a, b, c):
+    """a * b + c rounded once (llvm.fma: one instruction on CPUs with FMA, an exact libm call elsewhere)."""
+    sig = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, signature, args):
+        d = ir.DoubleType()
+        fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(d, [d, d, d]), "llvm.fma.f64")
+        return builder.call(fn, args)
+
+    return sig, codegen
+
+
 @kernel
 def two_prod(a, b):
+    """p + e = a * b exactly (barring underflow): e is the rounding error of p = fl(a * b)."""
     p = a * b
-    t = SPLIT * a
-    ah = t - (t - a)
-    al = a - ah
-    t = SPLIT * b
-    bh = t - (t - b)
-    bl = b - bh
-    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
+    return p, _fused_multiply_add(a, b, -p)
 
 
 @kernel
