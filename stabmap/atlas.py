@@ -16,7 +16,7 @@ from . import __version__
 from .decide import decide
 from .errors import StabmapError
 from .parameters import parse_name
-from .points import block_arrays
+from .points import block_arrays, spin_axes_last
 from .scene import Scene, fixed_values
 from .variables import ATTRS, DECIDED_BY, N_COMPLEX_PAIRS, STABILITY, stability_from_pairs
 
@@ -43,9 +43,13 @@ def chunk_shape(shape: tuple[int, ...], workers: int, target: int | None = None)
 
 def _block(template, scene: Scene, block_info=None):
     location = block_info[0]["array-location"] if template.ndim else []
-    nc, decided_by = decide(block_arrays(scene, location))
-    shape = template.shape
-    return np.stack([nc.reshape(shape), decided_by.reshape(shape).astype(np.int16)], axis=-1)
+    order = spin_axes_last(scene)
+    nc, decided_by = decide(block_arrays(scene, location, order))
+    permuted = tuple(template.shape[d] for d in order)
+    back = np.argsort(order)
+    nc = nc.reshape(permuted).transpose(back)
+    decided_by = decided_by.reshape(permuted).transpose(back)
+    return np.stack([nc, decided_by.astype(np.int16)], axis=-1)
 
 
 def compute(scene: Scene, *, workers: int | None = None, progress: bool | None = None, chunk_points: int | None = None) -> xr.Dataset:

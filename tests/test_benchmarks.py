@@ -11,8 +11,15 @@ SCRIPTS = pathlib.Path(__file__).resolve().parents[1] / "scripts"
 def test_bench_kernel_quick(capsys):
     rows = runpy.run_path(str(SCRIPTS / "bench_kernel.py"))["main"](["--quick"])
     assert [r["degree"] for r in rows] == [2, 6, 12]
-    assert all(r["undecided_pct"] <= 100 for r in rows)
+    assert all(r["undecided_pct"] <= 100 and r["pts_per_s_1"] > 0 for r in rows)
     assert "| n | modes |" in capsys.readouterr().out
+
+
+def test_bench_atlas_quick(capsys):
+    out = runpy.run_path(str(SCRIPTS / "bench_atlas.py"))["main"](["--quick"])
+    assert out["cold_cached_s"] > 0
+    assert [r["points"] for r in out["growth"]] == [64, 256, 64, 256]
+    assert "| scene | degree |" in capsys.readouterr().out
 
 
 def test_bench_accuracy_quick(capsys):
@@ -24,3 +31,11 @@ def test_bench_accuracy_quick(capsys):
         assert (point_set, "numpy.roots, tol 1e-10") in rows
     assert [a[0] for a in out["atlases"]] == ["paper-n1-fixed", "paper-n2-fixed", "paper-n3-fixed"]
     assert "| point set | method |" in capsys.readouterr().out
+
+
+def test_bench_conditioning_quick(capsys):
+    rows = runpy.run_path(str(SCRIPTS / "bench_conditioning.py"))["main"](["--quick"])
+    for r in rows:
+        exact, blur15, blur13 = r["shares"]
+        assert 0 <= blur13 <= blur15 <= exact <= 1  # wider enclosures can only decide fewer points
+    assert "| n | modes | degree |" in capsys.readouterr().out
