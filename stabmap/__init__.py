@@ -23,6 +23,7 @@ from .errors import StabmapError  # noqa: E402
 from .examples import example, example_names  # noqa: E402
 from .io import open_atlas, write_atlas  # noqa: E402
 from .query import label_at, summary  # noqa: E402
+from .refine import compute_refined  # noqa: E402
 from .scene import Axis, Body, Scene  # noqa: E402
 from .scene import load as load_scene  # noqa: E402
 from .scene import loads as loads_scene  # noqa: E402
@@ -33,6 +34,7 @@ __all__ = [
     "Scene",
     "StabmapError",
     "compute_atlas",
+    "compute_refined",
     "example",
     "example_names",
     "label_at",

@@ -20,7 +20,7 @@ from .points import block_arrays, spin_axes_last
 from .scene import Scene, fixed_values
 from .variables import ATTRS, DECIDED_BY, N_COMPLEX_PAIRS, STABILITY, stability_from_pairs
 
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 REFERENCES = (
     "Yu. N. Kononov, On the motion of a system of coupled rigid bodies with cavities containing "
     "liquid (in Russian), Donetsk State University, received 22.11.1999: equations (22)-(34)"

@@ -32,6 +32,7 @@ def _cmd_atlas(args) -> None:
 
     if (args.scene is None) == (args.example is None):
         raise StabmapError("give a scene file or --example NAME (not both); see 'stabmap examples'")
+    refine = _refine_options(args)
     check_writable(args.output)
     if args.png:
         check_writable(args.png)
@@ -39,7 +40,12 @@ def _cmd_atlas(args) -> None:
     if args.workers is not None and args.workers < 1:
         raise StabmapError(f"--workers must be >= 1, got {args.workers}")
     t0 = time.perf_counter()
-    ds = compute(scene, workers=args.workers, progress=not args.quiet)
+    if refine is None:
+        ds = compute(scene, workers=args.workers, progress=not args.quiet)
+    else:
+        from .refine import compute_refined
+
+        ds = compute_refined(scene, workers=args.workers, progress=not args.quiet, **refine)
     write_atlas(ds, args.output)
     stats = _summary_line(ds)
     print(f"wrote {args.output}: {stats} in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
@@ -48,12 +54,33 @@ def _cmd_atlas(args) -> None:
         print(f"wrote {args.png}", file=sys.stderr)
 
 
+def _refine_options(args) -> dict | None:
+    """Keyword arguments of compute_refined (None: a dense atlas), checked before any work starts."""
+    from .refine import DEFAULT_MARGIN, check_coarse_stride, check_margin
+
+    if not args.refine:
+        given = [opt for opt, v in (("--coarse-stride", args.coarse_stride), ("--margin", args.margin)) if v is not None]
+        if given:
+            raise StabmapError(f"{given[0]} applies to adaptive atlases only; add --refine")
+        return None
+    margin = DEFAULT_MARGIN if args.margin is None else args.margin
+    return {"coarse_stride": check_coarse_stride(args.coarse_stride, "--coarse-stride"), "margin": check_margin(margin, "--margin")}
+
+
 def _summary_line(ds) -> str:
     from .query import summary
 
     s = summary(ds)
     exact = s["decided_by"]["exact_rational_arithmetic"]
-    return f"{s['points']} points, {100 * s['stable_fraction']:.1f} % stable, {exact} decided in exact arithmetic"
+    line = f"{s['points']} points, {100 * s['stable_fraction']:.1f} % stable, {exact} decided in exact arithmetic"
+    evaluated = ds.attrs.get("n_evaluated_points")
+    if evaluated is not None:
+        evaluated = int(evaluated)
+        line += (
+            f"; refined: {evaluated:,} polynomials evaluated instead of {s['points']:,} "
+            f"({s['points'] / max(1, evaluated):.1f}x fewer), the other points inferred from cell corners"
+        )
+    return line
 
 
 def _cmd_info(args) -> None:
@@ -90,7 +117,10 @@ def _cmd_query(args) -> None:
         note = " (outside the grid: nearest edge)" if k in label.outside else ""
         print(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g} {units}{note}")
     print(f"n_complex_pairs = {label.n_complex_pairs}")
-    print(f"stability = {label.stability} (decided by {label.decided_by.replace('_', ' ')})")
+    if label.decided_by == "inferred_from_cell_corners":
+        print(f"stability = {label.stability} (not computed: inferred from the agreeing corners of its grid cell; docs/refine.md)")
+    else:
+        print(f"stability = {label.stability} (decided by {label.decided_by.replace('_', ' ')})")
 
 
 def _cmd_plot(args) -> None:
@@ -120,6 +150,9 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("-o", "--output", required=True, help="netCDF file to write, e.g. atlas.nc")
     a.add_argument("--png", metavar="FILE", help="also draw the atlas to this PNG/PDF")
     a.add_argument("--workers", type=int, help="threads (default: all cores)")
+    a.add_argument("--refine", action="store_true", help="adaptive: a coarse lattice, refined only where labels change (docs/refine.md)")
+    a.add_argument("--coarse-stride", type=int, metavar="S", help="with --refine: grid steps between coarse nodes, a power of two (default: 64-127 cells per axis)")
+    a.add_argument("--margin", type=int, metavar="M", help="with --refine: cells split around every disagreeing cell (default 2)")
     a.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     a.set_defaults(func=_cmd_atlas)
 

@@ -13,6 +13,8 @@ from .points import PointArrays
 BY_STURM = 0
 BY_EXACT = 1
 BY_INCLUSION = 2
+# Not a decision: an adaptive atlas (stabmap.refine) filled the point from its grid cell's agreeing corners.
+BY_INFERRED = 3
 
 
 def decided_by_from_status(status: np.ndarray) -> np.ndarray:

@@ -25,12 +25,15 @@ ATTRS = {
     },
     DECIDED_BY: {
         "long_name": "arithmetic that decided n_complex_pairs at this point",
-        "flag_values": np.array([0, 1, 2], dtype=np.int8),
-        "flag_meanings": "interval_sturm_sequence exact_rational_arithmetic interval_root_inclusion",
+        "flag_values": np.array([0, 1, 2, 3], dtype=np.int8),
+        "flag_meanings": "interval_sturm_sequence exact_rational_arithmetic interval_root_inclusion "
+        "inferred_from_cell_corners",
         "comment": "interval_sturm_sequence: proved by the double-double interval Sturm sequence; "
         "interval_root_inclusion: proved by disjoint Gerschgorin inclusion disks around the roots; "
         "exact_rational_arithmetic: neither could decide and the point was recomputed exactly. "
-        "All three are proofs; docs/certification.md",
+        "These three are proofs; docs/certification.md. "
+        "inferred_from_cell_corners: not computed and not proved; an adaptive atlas (stabmap atlas --refine) "
+        "gave the point the value on which all corners of its grid cell agree; docs/refine.md",
     },
 }
 

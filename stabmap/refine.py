@@ -1,0 +1,396 @@
+"""Adaptive atlases: decide a coarse lattice of the grid, refine only where cell corners disagree.
+
+The result has the dense atlas's grid and values wherever the labels have no
+feature that hides inside a grid cell (docs/refine.md says exactly what that
+means).  Points that were filled from their cell's corners rather than computed
+carry ``decided_by = BY_INFERRED``: they are not proved.
+
+Algorithm, in index space of the final grid (any number of axes):
+
+1. Axis i starts at a power-of-two stride s_i; its nodes are the multiples of
+   the current stride plus its last index.  Consecutive nodes bound the cells,
+   so a cell is a box with 2^d corners.  Every cell starts active.
+2. At each level the corners of the active cells that are not yet computed are
+   decided (in chunks on a thread pool).  A cell whose corners disagree, or
+   one of whose corners turned out different from the value an earlier fill
+   had given it, is *split*, and so is every cell within ``margin`` cells of
+   it, whether active or filled before (a filled cell is re-opened).
+3. Active cells that are not split are filled with their corners' value.
+   Split cells' children, at half the stride, are the next level's active cells.
+4. At stride 1 every point of a cell is a corner; re-opened cells are decided
+   until no cell asks for another point.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import sys
+import time
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from .atlas import _dataset
+from .decide import BY_INFERRED, decide
+from .errors import StabmapError
+from .points import point_arrays, spin_axes_last
+from .scene import Scene
+
+DEFAULT_MARGIN = 2  # cells split around a disagreeing cell; docs/refine.md has the measurements behind 2
+COARSE_CELLS = 64  # default: the coarsest lattice has 64 to 127 cells (65 to 128 nodes) per long axis
+CHUNK_POINTS = 32768
+
+
+def default_coarse_stride(n: int) -> int:
+    """The largest power of two s with at least ``COARSE_CELLS`` cells of s steps along an axis of ``n`` points."""
+    cells = (n - 1) // COARSE_CELLS
+    return 1 << (cells.bit_length() - 1) if cells >= 1 else 1
+
+
+def check_coarse_stride(value, option: str = "coarse_stride") -> int | None:
+    """Validate a user's coarse stride (None: choose per axis); errors name ``option``."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise StabmapError(f"{option} must be a whole power of two such as 8 or 16, got {value!r}")
+    if value < 1 or value & (value - 1):
+        lower = 1 << (max(1, int(value)).bit_length() - 1)
+        raise StabmapError(
+            f"{option} must be a power of two (1, 2, 4, 8, 16, ...) so that halving it reaches every grid point; "
+            f"got {value}, use e.g. {lower} or {2 * lower}"
+        )
+    return int(value)
+
+
+def check_margin(value, option: str = "margin") -> int:
+    """Validate a safety margin in cells; errors name ``option``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        raise StabmapError(f"{option} must be a whole number of cells >= 0 (default 2; 0 and 1 are cheaper and miss more), got {value!r}")
+    return int(value)
+
+
+@dataclass(frozen=True)
+class _Level:
+    """Nodes and cells of one refinement level of a box of grid points (per axis: node indices in the box)."""
+
+    strides: tuple[int, ...]
+    nodes: tuple[np.ndarray, ...]
+    ncells: tuple[int, ...]
+
+    @classmethod
+    def build(cls, shape: tuple[int, ...], strides: tuple[int, ...]) -> _Level:
+        nodes = []
+        for n, t in zip(shape, strides):
+            idx = np.arange(0, n, t)
+            if idx[-1] != n - 1:
+                idx = np.append(idx, n - 1)
+            nodes.append(idx)
+        return cls(tuple(strides), tuple(nodes), tuple(max(1, idx.size - 1) for idx in nodes))
+
+    @property
+    def has_interior(self) -> bool:
+        """Whether some cell holds points that are not its corners (only then is there anything to fill)."""
+        return any(t > 1 for t in self.strides)
+
+    def corners(self) -> list[tuple[slice, ...]]:
+        """For each of the 2^d corners, the slice of the node lattice that gives it for every cell."""
+        per_axis = []
+        for idx, c in zip(self.nodes, self.ncells):
+            upper = slice(1, c + 1) if idx.size > 1 else slice(0, 1)  # a one-point axis: both corners coincide
+            per_axis.append((slice(0, c), upper))
+        return list(itertools.product(*per_axis))
+
+    def at_nodes(self, grid_array: np.ndarray) -> np.ndarray:
+        """The values of a grid array at the nodes (a view where every stride is 1)."""
+        for axis, (idx, t) in enumerate(zip(self.nodes, self.strides)):
+            if t > 1:
+                grid_array = np.take(grid_array, idx, axis=axis)
+        return grid_array
+
+    def on_grid(self, cell_array: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+        """A per-cell array spread over the grid points each cell owns (a point on a face goes to the upper cell)."""
+        for axis, (n, t, c) in enumerate(zip(shape, self.strides, self.ncells)):
+            cell_array = np.take(cell_array, np.minimum(np.arange(n) // t, c - 1), axis=axis)
+        return cell_array
+
+
+def _any_corner(level: _Level, node_mask: np.ndarray) -> np.ndarray:
+    """Cells with at least one corner in ``node_mask``."""
+    out = np.zeros(level.ncells, dtype=bool)
+    for sl in level.corners():
+        out |= node_mask[sl]
+    return out
+
+
+def _corner_range(level: _Level, node_values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Smallest and largest corner value of every cell."""
+    lo = hi = None
+    for sl in level.corners():
+        v = node_values[sl]
+        lo = v.copy() if lo is None else np.minimum(lo, v)
+        hi = v.copy() if hi is None else np.maximum(hi, v)
+    return lo, hi
+
+
+def _dilate(mask: np.ndarray, cells: int) -> np.ndarray:
+    """Grow ``mask`` by ``cells`` in every direction, diagonals included (a box is separable by axis)."""
+    for _ in range(cells):
+        for axis in range(mask.ndim):
+            grown = mask.copy()
+            lower = [slice(None)] * mask.ndim
+            upper = [slice(None)] * mask.ndim
+            lower[axis], upper[axis] = slice(None, -1), slice(1, None)
+            grown[tuple(upper)] |= mask[tuple(lower)]
+            grown[tuple(lower)] |= mask[tuple(upper)]
+            mask = grown
+    return mask
+
+
+def _children(split: np.ndarray, finer: _Level, halves: tuple[bool, ...]) -> np.ndarray:
+    """Active cells of the next level: every child of a split cell (child k of an axis that halves has parent k // 2)."""
+    for axis, (c, h) in enumerate(zip(finer.ncells, halves)):
+        if h:
+            split = np.take(split, np.arange(c) // 2, axis=axis)
+    return split
+
+
+class _Progress:
+    """One self-overwriting line on stderr, shown once a run has taken two seconds (like the dense progress bar)."""
+
+    def __init__(self, enabled: bool, total: int, minimum: float = 2.0, dt: float = 0.5):
+        self.enabled, self.total, self.minimum, self.dt = enabled, total, minimum, dt
+        self.t0 = time.perf_counter()
+        self.last = 0.0
+        self.shown = False
+
+    def update(self, stride: int, level_done: int, level_total: int, evaluated: int) -> None:
+        now = time.perf_counter() - self.t0
+        if not self.enabled or now < self.minimum or now - self.last < self.dt:
+            return
+        self.last, self.shown = now, True
+        pct = 100 * evaluated / max(1, self.total)
+        sys.stderr.write(
+            f"\r[refine] stride {stride:>4}: {level_done:,}/{level_total:,} points | "
+            f"evaluated {evaluated:,} = {pct:.1f} % of dense | {now:.0f} s   "
+        )
+        sys.stderr.flush()
+
+    def close(self) -> None:
+        if self.shown:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+class _Evaluator:
+    """Decides grid points on a thread pool and holds the state of the whole grid."""
+
+    def __init__(self, scene: Scene, pool: ThreadPoolExecutor, workers: int, chunk_points: int, progress: _Progress):
+        self.scene, self.pool, self.workers, self.chunk_points, self.progress = scene, pool, workers, chunk_points, progress
+        shape = scene.shape
+        self.nc = np.zeros(shape, dtype=np.int16)
+        self.by = np.full(shape, BY_INFERRED, dtype=np.int8)
+        self.computed = np.zeros(shape, dtype=bool)
+        self.filled = np.zeros(shape, dtype=bool)
+        self.evaluated = 0
+        self.order = spin_axes_last(scene)
+
+    def evaluate(self, points: tuple[np.ndarray, ...], stride: int) -> np.ndarray:
+        """Decide the grid points ``points`` (index arrays per axis); True where an earlier fill had it wrong."""
+        shape = self.scene.shape
+        flat = np.ravel_multi_index(points, shape)
+        # Spin axes vary fastest, as in the dense path: the kernels then reuse M and K between points.
+        key = np.ravel_multi_index(tuple(points[d] for d in self.order), tuple(shape[d] for d in self.order))
+        perm = np.argsort(key, kind="stable")
+        nc, by = np.empty(flat.size, np.int16), np.empty(flat.size, np.int8)
+        nc[perm], by[perm] = self._decide(flat[perm], stride)
+        nc_grid, by_grid = self.nc.reshape(-1), self.by.reshape(-1)
+        wrong = self.filled.reshape(-1)[flat] & (nc_grid[flat] != nc)
+        nc_grid[flat] = nc
+        by_grid[flat] = by
+        self.computed.reshape(-1)[flat] = True
+        self.evaluated += flat.size
+        return wrong
+
+    def evaluate_point(self) -> None:
+        """A scene without grid axes: its one point."""
+        nc, by = decide(point_arrays(self.scene, {}))
+        self.nc[()], self.by[()], self.computed[()] = nc[0], by[0], True
+        self.evaluated = 1
+
+    def _decide(self, flat: np.ndarray, stride: int) -> tuple[np.ndarray, np.ndarray]:
+        npts = flat.size
+        size = min(self.chunk_points, max(1024, -(-npts // (4 * self.workers))))
+        bounds = [(a, min(a + size, npts)) for a in range(0, npts, size)]
+        nc = np.empty(npts, dtype=np.int16)
+        by = np.empty(npts, dtype=np.int8)
+        futures = {self.pool.submit(self._chunk, flat[a:b]): (a, b) for a, b in bounds}
+        done_points = 0
+        try:
+            pending = set(futures)
+            while pending:
+                done, pending = wait(pending, timeout=self.progress.dt, return_when=FIRST_COMPLETED)
+                for f in done:
+                    a, b = futures[f]
+                    nc[a:b], by[a:b] = f.result()
+                    done_points += b - a
+                self.progress.update(stride, done_points, npts, self.evaluated + done_points)
+        except BaseException:
+            for f in futures:
+                f.cancel()
+            raise
+        return nc, by
+
+    def _chunk(self, flat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        idx = np.unravel_index(flat, self.scene.shape)
+        values = {axis.name: axis.array[i] for axis, i in zip(self.scene.grid, idx)}
+        return decide(point_arrays(self.scene, values))
+
+
+def _step(ev: _Evaluator, level: _Level, active: np.ndarray, margin: int, box: tuple[slice, ...]) -> np.ndarray:
+    """One level on a box of the grid: decide the active cells' new corners, fill the cells that agree.
+
+    Returns the cells to split: those whose corners disagree or include a point
+    an earlier fill got wrong, grown by ``margin`` cells.
+    """
+    computed, nc = ev.computed[box], ev.nc[box]
+    need = np.zeros(tuple(idx.size for idx in level.nodes), dtype=bool)
+    for sl in level.corners():
+        need[sl] |= active
+    need &= ~level.at_nodes(computed)
+    wrong = np.zeros(level.ncells, dtype=bool)
+    if need.any():
+        sel = np.nonzero(need)
+        points = tuple(idx[s] + b.start for idx, s, b in zip(level.nodes, sel, box))
+        bad = ev.evaluate(points, max(level.strides))
+        if bad.any():
+            wrong_nodes = np.zeros(need.shape, dtype=bool)
+            wrong_nodes[tuple(s[bad] for s in sel)] = True
+            wrong = _any_corner(level, wrong_nodes)
+    lo, hi = _corner_range(level, level.at_nodes(nc))
+    split = _dilate((active & (lo != hi)) | wrong, margin)
+    if level.has_interior:
+        mask = level.on_grid(active & ~split, nc.shape) & ~computed
+        nc[mask] = level.on_grid(lo, nc.shape)[mask]
+        ev.filled[box] |= mask
+    return split
+
+
+def _run_levels(ev: _Evaluator, strides: tuple[int, ...], margin: int) -> None:
+    """The refinement loop (module docstring, steps 1-3) from the coarse strides down to stride 1."""
+    shape = ev.scene.shape
+    whole = tuple(slice(0, n) for n in shape)
+    t = max(strides)
+    level = _Level.build(shape, tuple(min(t, s) for s in strides))
+    active = np.ones(level.ncells, dtype=bool)
+    while True:
+        split = _step(ev, level, active, margin, whole)
+        if t == 1:
+            return _reopen(ev, level, split, margin)
+        t //= 2
+        finer = _Level.build(shape, tuple(min(t, s) for s in strides))
+        active = _children(split, finer, tuple(t < s for s in strides))
+        level = finer
+
+
+def _reopen(ev: _Evaluator, level: _Level, split: np.ndarray, margin: int) -> None:
+    """Step 4: at stride 1, decide the points of re-opened cells until no cell asks for another.
+
+    Each round works on the bounding box of the cells still asking, so following
+    a boundary that the coarse levels missed costs little per step.
+    """
+    shape = ev.scene.shape
+    active = split & _any_corner(level, ~ev.computed)
+    while active.any():
+        cells, points = [], []
+        for axis, n in enumerate(shape):
+            hit = np.flatnonzero(np.any(active, axis=tuple(a for a in range(active.ndim) if a != axis)))
+            # margin + 1: a cell next to an active one can be wrong, and the margin grows from there.
+            c0, c1 = max(0, hit[0] - margin - 1), min(active.shape[axis], hit[-1] + 2 + margin)
+            cells.append(slice(c0, c1))
+            points.append(slice(c0, min(n, c1 + 1)))
+        cells, points = tuple(cells), tuple(points)
+        sub = _Level.build(tuple(p.stop - p.start for p in points), (1,) * len(shape))
+        again = _step(ev, sub, active[cells], margin, points)
+        active = np.zeros_like(active)
+        active[cells] = again & _any_corner(sub, ~ev.computed[points])
+
+
+def compute_refined(
+    scene: Scene,
+    *,
+    coarse_stride: int | None = None,
+    margin: int = DEFAULT_MARGIN,
+    workers: int | None = None,
+    progress: bool | None = None,
+    chunk_points: int | None = None,
+) -> xr.Dataset:
+    """Compute the atlas of ``scene`` adaptively: coarse lattice first, refined where labels change.
+
+    The Dataset has the same grid, variables and layout as ``compute_atlas``.
+    Computed points carry their proof in ``decided_by``; points filled from
+    their cell's corners carry ``decided_by = 3`` (inferred_from_cell_corners).
+    The result equals the dense atlas unless a feature (a region of other N_c)
+    lies inside a cell whose corners agree and comes within ``margin`` cells of
+    no disagreeing cell: see docs/refine.md.
+
+    Parameters
+    ----------
+    scene : Scene
+        Bodies, support and grid; a scene without grid is its one point, computed.
+    coarse_stride : int, optional
+        Grid steps between coarse nodes along every axis, a power of two. Default:
+        per axis, the largest power of two that leaves at least 64 coarse cells
+        (1 for axes of fewer than 129 points: no inference along them).
+    margin : int, optional
+        Cells around every disagreeing cell that are split too (default 2; 0 and
+        1 are cheaper and miss more of the features smaller than a cell).
+    workers : int, optional
+        Threads (default: all cores).
+    progress : bool, optional
+        Progress line on stderr for runs over two seconds (default: when stderr is a terminal).
+    chunk_points : int, optional
+        Points per chunk handed to a thread (default: about 32768, fewer for small levels).
+
+    Returns
+    -------
+    xarray.Dataset
+        As ``compute_atlas``, with attributes ``refine_coarse_stride`` (per axis),
+        ``refine_margin`` and ``n_evaluated_points`` (characteristic polynomials evaluated).
+    """
+    coarse_stride = check_coarse_stride(coarse_stride)
+    margin = check_margin(margin)
+    workers = workers or os.cpu_count() or 1
+    if workers < 1:
+        raise StabmapError(f"workers must be >= 1, got {workers}")
+    chunk_points = CHUNK_POINTS if chunk_points is None else int(chunk_points)
+    if chunk_points < 1:
+        raise StabmapError(f"chunk_points must be >= 1, got {chunk_points}")
+    if progress is None:
+        progress = sys.stderr.isatty()
+    shape = scene.shape
+    strides = tuple(coarse_stride or default_coarse_stride(n) for n in shape)
+    total = math.prod(shape)
+    t0 = time.perf_counter()
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        bar = _Progress(progress, total)
+        ev = _Evaluator(scene, pool, workers, chunk_points, bar)
+        try:
+            if shape:
+                _run_levels(ev, strides, margin)
+            else:
+                ev.evaluate_point()
+        finally:
+            bar.close()
+    ds = _dataset(scene, ev.nc, ev.by)
+    ds.attrs["history"] += (
+        f"; adaptive refinement (coarse stride {list(strides)}, margin {margin}): "
+        f"{ev.evaluated} of {total} points evaluated in {time.perf_counter() - t0:.1f} s"
+    )
+    ds.attrs["refine_coarse_stride"] = np.array(strides, dtype=np.int32)
+    ds.attrs["refine_margin"] = np.int32(margin)
+    ds.attrs["n_evaluated_points"] = np.int64(ev.evaluated)
+    return ds

@@ -1,0 +1,188 @@
+"""Adaptive atlases (stabmap.refine): equal to the dense atlas cell for cell, far fewer evaluations.
+
+Also pins down the documented assumption (docs/refine.md): a feature that hides
+inside a cell whose corners agree, more than ``margin`` cells from any
+disagreeing cell, is not seen, and the points it covers are flagged inferred.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import stabmap
+from stabmap.cli import main
+from stabmap.decide import BY_INFERRED
+from stabmap.scene import Axis
+
+ALL_EXAMPLES = stabmap.example_names()
+
+
+def regrid(scene, *nums: int):
+    """The scene with its grid axes resampled to ``nums`` points over the same ranges."""
+    axes = []
+    for a, num in zip(scene.grid, nums):
+        lo, hi = a.values[0], a.values[-1]
+        values = np.geomspace(lo, hi, num) if a.scale == "log" else np.linspace(lo, hi, num)
+        axes.append(Axis(a.name, tuple(float(v) for v in values), a.scale))
+    return dataclasses.replace(scene, grid=tuple(axes))
+
+
+def dense(scene):
+    return stabmap.compute_atlas(scene, workers=2, progress=False)
+
+
+def refined(scene, **kwargs):
+    return stabmap.compute_refined(scene, workers=2, progress=False, **kwargs)
+
+
+def check_against_dense(ref, den) -> np.ndarray:
+    """Refined equals dense cell for cell; computed points carry dense's proof, the rest flag 3. Returns mismatches."""
+    by_r, by_d = ref["decided_by"].values, den["decided_by"].values
+    computed = by_r != BY_INFERRED
+    assert (by_r[computed] == by_d[computed]).all()
+    assert int(ref.attrs["n_evaluated_points"]) == int(computed.sum())
+    assert ref["n_complex_pairs"].dims == den["n_complex_pairs"].dims
+    for name in ref.coords:
+        np.testing.assert_array_equal(ref[name].values, den[name].values)
+    mismatch = ref["n_complex_pairs"].values != den["n_complex_pairs"].values
+    assert not (mismatch & computed).any()  # only inferred points can differ
+    return mismatch
+
+
+@pytest.mark.parametrize("name", ALL_EXAMPLES)
+def test_equals_dense_on_every_example(name):
+    scene = regrid(stabmap.example(name), 129, 129)
+    den = dense(scene)
+    for stride in (None, 8):
+        ref = refined(scene, coarse_stride=stride)
+        assert not check_against_dense(ref, den).any()
+        assert (ref["stability"].values == den["stability"].values).all()
+        assert list(ref.attrs["refine_coarse_stride"]) == [stride or 2] * 2
+    assert int(ref.attrs["n_evaluated_points"]) < den["n_complex_pairs"].size / 2
+
+
+def test_much_fewer_evaluations_at_1024():
+    scene = regrid(stabmap.example("paper-n2-fixed"), 1024, 1024)
+    den, ref = dense(scene), refined(scene)
+    assert not check_against_dense(ref, den).any()
+    assert 20 * int(ref.attrs["n_evaluated_points"]) < den["n_complex_pairs"].size
+    assert set(np.unique(den["n_complex_pairs"])) == {0, 1, 2}  # three regions, two boundaries
+
+
+def test_cusp_missed_without_margin_found_with_it():
+    # paper-n1-fixed has a stable tongue that narrows to a cusp; at 300 x 300 and stride 4 its tip
+    # is thinner than a coarse cell, so corners that agree hide it unless the margin opens its cells.
+    scene = regrid(stabmap.example("paper-n1-fixed"), 300, 300)
+    den = dense(scene)
+    missed = check_against_dense(refined(scene, margin=0), den)
+    assert missed.sum() > 0
+    assert not check_against_dense(refined(scene, margin=1), den).any()
+
+
+ONE_TOP = """
+support = "fixed"
+omega = 20.0
+[[bodies]]
+m = 1.0
+A = 0.02
+C = 0.03
+c = 0.10
+"""
+# This top is stable for omega above about 11.44 rad/s, so 5.0 marks one unstable point.
+STABLE, UNSTABLE = 20.0, 5.0
+
+
+def one_axis_scene(unstable_at: list[int], num: int = 33):
+    values = [UNSTABLE if i in unstable_at else STABLE + i for i in range(num)]
+    grid = (Axis("omega", tuple(values), "values"),)
+    return dataclasses.replace(stabmap.loads_scene(ONE_TOP), grid=grid)
+
+
+def test_feature_smaller_than_a_cell_is_the_documented_blind_spot():
+    # Stride 8: cells [0,8] [8,16] [16,24] [24,32].  A real boundary in the last cell (28..32 unstable);
+    # one-point features at 4 (inside a cell of agreeing corners, far from it) and 20 (next to it).
+    scene = one_axis_scene([4, 20, 28, 29, 30, 31, 32])
+    den = dense(scene)
+    assert list(np.flatnonzero(den["n_complex_pairs"].values)) == [4, 20, 28, 29, 30, 31, 32]
+
+    ref = refined(scene, coarse_stride=8, margin=1)
+    missed = check_against_dense(ref, den)
+    assert list(np.flatnonzero(missed)) == [4]  # the margin opened the cell holding 20, nothing opened 4's
+    assert ref["decided_by"].values[4] == BY_INFERRED  # and the missed point does not claim a proof
+
+    assert list(np.flatnonzero(check_against_dense(refined(scene, coarse_stride=8, margin=0), den))) == [4, 20]
+    assert not check_against_dense(refined(scene, coarse_stride=4, margin=0), den).any()  # 4 and 20 are nodes
+
+
+@pytest.mark.parametrize("shape", [(), (1001,), (65, 33, 17), (129, 1, 2)])
+def test_any_number_of_axes(shape):
+    names = ("omega", "K_1", "m_2")
+    axes = tuple(
+        Axis(name, tuple(float(v) for v in np.linspace(lo, hi, num)))
+        for name, (lo, hi), num in zip(names, ((1.0, 150.0), (0.0, 40.0), (0.1, 5.0)), shape)
+    )
+    scene = dataclasses.replace(stabmap.example("paper-n2-fixed"), grid=axes)
+    den = dense(scene)
+    for stride in (None, 4):
+        ref = refined(scene, coarse_stride=stride)
+        assert ref["n_complex_pairs"].shape == shape
+        assert not check_against_dense(ref, den).any()
+
+
+def test_threads_and_chunks_do_not_change_the_result():
+    scene = regrid(stabmap.example("paper-n1-free"), 257, 257)
+    a = refined(scene, coarse_stride=16)
+    b = stabmap.compute_refined(scene, coarse_stride=16, workers=1, chunk_points=100, progress=False)
+    assert (a["n_complex_pairs"].values == b["n_complex_pairs"].values).all()
+    assert (a["decided_by"].values == b["decided_by"].values).all()
+
+
+@pytest.mark.parametrize(
+    "kwargs,message",
+    [
+        ({"coarse_stride": 12}, "coarse_stride must be a power of two"),
+        ({"coarse_stride": 0}, "coarse_stride must be a power of two"),
+        ({"coarse_stride": 8.0}, "coarse_stride must be a whole power of two"),
+        ({"margin": -1}, "margin must be a whole number of cells >= 0"),
+        ({"workers": -2}, "workers must be >= 1"),
+    ],
+)
+def test_bad_arguments(kwargs, message):
+    with pytest.raises(stabmap.StabmapError, match=message):
+        stabmap.compute_refined(stabmap.example("paper-n1-fixed"), **kwargs)
+
+
+def test_cli_refine_file_info_query(tmp_path, capsys):
+    out = tmp_path / "a.nc"
+    assert main(["atlas", "--example", "paper-n2-fixed", "-o", str(out), "--refine", "--coarse-stride", "8", "-q"]) == 0
+    err = capsys.readouterr().err
+    assert "polynomials evaluated instead of 60,000" in err and "x fewer" in err
+    ds = stabmap.open_atlas(out)
+    assert list(ds.attrs["refine_coarse_stride"]) == [8, 8] and int(ds.attrs["refine_margin"]) == 2
+    inferred = int((ds["decided_by"].values == BY_INFERRED).sum())
+    assert inferred + int(ds.attrs["n_evaluated_points"]) == 60000
+    assert "inferred_from_cell_corners" in ds["decided_by"].attrs["flag_meanings"].split()
+    assert stabmap.summary(ds)["decided_by"]["inferred_from_cell_corners"] == inferred
+    assert main(["info", str(out)]) == 0
+    assert f"inferred from cell corners {inferred}" in capsys.readouterr().out
+    assert main(["query", str(out), "omega=100", "K_1=20"]) == 0
+    assert "not computed: inferred from the agreeing corners" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "args,message",
+    [
+        (["--refine", "--coarse-stride", "12"], "--coarse-stride must be a power of two"),
+        (["--coarse-stride", "8"], "--coarse-stride applies to adaptive atlases only; add --refine"),
+        (["--margin", "2"], "--margin applies to adaptive atlases only; add --refine"),
+        (["--refine", "--margin", "-1"], "--margin must be a whole number of cells >= 0"),
+    ],
+)
+def test_cli_bad_refine_options(tmp_path, capsys, args, message):
+    out = tmp_path / "a.nc"
+    assert main(["atlas", "--example", "paper-n1-fixed", "-o", str(out), *args]) == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
