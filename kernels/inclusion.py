@@ -37,7 +37,8 @@ from .status import DECIDED_INCLUSION, UNDECIDED
 
 TINY = 2.0**-1000  # floor of a radius, so an underflowing bound never becomes zero
 MAX_ITER = 120
-POLISH_SWEEPS = 2
+POLISH_SWEEPS = 12  # at most; tight clusters (three identical cavities) need 6-8 sweeps
+STEP_TOL = 2.0**-50  # a step below this share of |z| means z has all the digits a float holds
 
 
 @kernel
@@ -122,8 +123,13 @@ def _aberth_step(z, d, i, p, dp):
 
 @kernel
 def _polish(X, d, z, sweeps):
-    """Aberth sweeps with p and p' in double-double: roots in tight clusters to full float precision."""
+    """Aberth sweeps with p and p' in double-double until no approximation moves by more than 2**-50 of itself.
+
+    The float iteration resolves a cluster of k roots only to about u**(1/k) of
+    their size; the double-double values let every sweep gain digits there.
+    """
     for _ in range(sweeps):
+        moved = False
         for i in range(d):
             p, _, dp = _value_dd(X, d, z[i].real, z[i].imag)
             if p == 0.0 or dp == 0.0:
@@ -131,6 +137,9 @@ def _polish(X, d, z, sweeps):
             step = _aberth_step(z, d, i, p, dp)
             if math.isfinite(step.real) and math.isfinite(step.imag):
                 z[i] -= step
+                moved = moved or abs(step) > STEP_TOL * abs(z[i])
+        if not moved:
+            return
 
 
 @kernel
@@ -148,7 +157,7 @@ def _aberth(a, d, z, done):
                 continue
             step = _aberth_step(z, d, i, p, dp)
             z[i] -= step
-            if abs(step) <= 2.0**-50 * abs(z[i]):
+            if abs(step) <= STEP_TOL * abs(z[i]):
                 done[i] = True
             else:
                 moving = True
