@@ -19,6 +19,7 @@ if getattr(_kernels, "STABMAP_KERNELS", None) != 1:
     )
 
 from .atlas import compute as compute_atlas  # noqa: E402
+from .critical import critical  # noqa: E402
 from .errors import StabmapError  # noqa: E402
 from .examples import example, example_names  # noqa: E402
 from .io import open_atlas, write_atlas  # noqa: E402
@@ -35,6 +36,7 @@ __all__ = [
     "StabmapError",
     "compute_atlas",
     "compute_refined",
+    "critical",
     "example",
     "example_names",
     "label_at",

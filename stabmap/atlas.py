@@ -88,24 +88,37 @@ def compute(scene: Scene, *, workers: int | None = None, progress: bool | None =
     return _dataset(scene, nc, decided_by)
 
 
-def _dataset(scene: Scene, nc: np.ndarray, decided_by: np.ndarray) -> xr.Dataset:
-    dims = tuple(a.name for a in scene.grid)
+def coordinates(scene: Scene, skip: tuple[str, ...] = ()) -> dict:
+    """The grid axes (except ``skip``) and every fixed parameter as CF coordinates with units."""
     coords = {}
     for axis in scene.grid:
+        if axis.name in skip:
+            continue
         name = parse_name(axis.name, scene.n, scene.support)
         coords[axis.name] = (axis.name, axis.array, {"units": name.units, "long_name": name.long_name, "scale": axis.scale})
     for key, value in fixed_values(scene).items():
         name = parse_name(key, scene.n, scene.support)
         coords[key] = ((), np.float64(value), {"units": name.units, "long_name": name.long_name})
+    return coords
+
+
+def _dataset(scene: Scene, nc: np.ndarray, decided_by: np.ndarray) -> xr.Dataset:
+    dims = tuple(a.name for a in scene.grid)
+    coords = coordinates(scene)
     data = {
         N_COMPLEX_PAIRS: (dims, nc, ATTRS[N_COMPLEX_PAIRS]),
         STABILITY: (dims, stability_from_pairs(nc), ATTRS[STABILITY]),
         DECIDED_BY: (dims, decided_by, ATTRS[DECIDED_BY]),
     }
+    return xr.Dataset(data, coords=coords, attrs=global_attrs(scene, "stabmap atlas"))
+
+
+def global_attrs(scene: Scene, kind: str) -> dict:
+    """CF global attributes of every file stabmap writes, with the scene that made it."""
     now = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
-    attrs = {
+    return {
         "Conventions": "CF-1.10",
-        "title": scene.title or "stabmap atlas",
+        "title": scene.title or kind,
         "source": f"stabmap {__version__}",
         "history": f"{now} computed by stabmap {__version__}",
         "references": REFERENCES,
@@ -115,4 +128,3 @@ def _dataset(scene: Scene, nc: np.ndarray, decided_by: np.ndarray) -> xr.Dataset
         "polynomial_degree_bound": scene.degree,
         "scene": scene.to_toml(),
     }
-    return xr.Dataset(data, coords=coords, attrs=attrs)

@@ -6,6 +6,8 @@ import argparse
 import sys
 import time
 
+import numpy as np
+
 from . import __version__
 from .errors import StabmapError
 
@@ -89,6 +91,11 @@ def _cmd_info(args) -> None:
     from .variables import N_COMPLEX_PAIRS
 
     ds = open_atlas(args.atlas)
+    if ds.attrs.get("stabmap_kind") == "critical values":
+        print(f"{args.atlas}: {ds.attrs.get('title', '')}: critical values along {ds.attrs['critical_along']}")
+        print(f"  {ds.attrs['comment']}")
+        _print_intervals(ds)
+        return
     s = summary(ds)
     a = ds.attrs
     print(f"{args.atlas}: {a.get('title', '')}")
@@ -111,6 +118,8 @@ def _cmd_query(args) -> None:
     from .query import label_at
 
     ds = open_atlas(args.atlas)
+    if ds.attrs.get("stabmap_kind") == "critical values":
+        raise StabmapError(f"{args.atlas} holds critical values, not an atlas; 'stabmap info {args.atlas}' lists its intervals")
     label = label_at(ds, **_pairs(args.point, "point"))
     for k, v in label.requested.items():
         units = ds[k].attrs.get("units", "")
@@ -128,8 +137,60 @@ def _cmd_plot(args) -> None:
     from .plot import plot_atlas
 
     ds = open_atlas(args.atlas)
-    plot_atlas(ds, args.output, x=args.x, y=args.y, sel=_pairs(args.sel, "--sel"))
+    if ds.attrs.get("stabmap_kind") == "critical values":
+        from .plot import plot_critical
+
+        plot_critical(ds, args.output, sel=_pairs(args.sel, "--sel"))
+    else:
+        plot_atlas(ds, args.output, x=args.x, y=args.y, sel=_pairs(args.sel, "--sel"))
     print(f"wrote {args.output}", file=sys.stderr)
+
+
+def _cmd_critical(args) -> None:
+    from .critical import critical
+    from .examples import example
+    from .io import check_writable, write_atlas
+    from .plot import plot_critical
+    from .scene import load
+
+    if (args.scene is None) == (args.example is None):
+        raise StabmapError("give a scene file or --example NAME (not both); see 'stabmap examples'")
+    if args.workers is not None and args.workers < 1:
+        raise StabmapError(f"--workers must be >= 1, got {args.workers}")
+    check_writable(args.output)
+    if args.png:
+        check_writable(args.png)
+    scene = load(args.scene) if args.scene else example(args.example)
+    t0 = time.perf_counter()
+    ds = critical(scene, args.along, rtol=args.rtol, workers=args.workers)
+    write_atlas(ds, args.output)
+    print(f"wrote {args.output} in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+    if not args.quiet:
+        _print_intervals(ds)
+    if args.png:
+        plot_critical(ds, args.png)
+        print(f"wrote {args.png}", file=sys.stderr)
+
+
+def _print_intervals(ds, limit: int = 8) -> None:
+    """Stable intervals for the first ``limit`` points of the other axes."""
+    along = ds.attrs["critical_along"]
+    names = [f"{along}_stable_{end}" for end in ("lower", "upper", "lower_outer", "upper_outer")]
+    dims = [d for d in ds[names[0]].dims if d != "interval"]
+    table = ds[names].stack(point=dims) if dims else ds[names].expand_dims(point=[0])
+    lo, hi, olo, ohi = (table[n].transpose("point", "interval").values for n in names)
+    units = ds[names[0]].attrs.get("units", "")
+    for p, label in enumerate(table["point"].values[:limit]):
+        where = ", ".join(f"{d} = {v:g}" for d, v in zip(dims, label)) if dims else "the scene"
+        parts = [
+            f"{lo[p, k]:.10g} ({'scan end' if np.isnan(olo[p, k]) else 'boundary'}) to "
+            f"{hi[p, k]:.10g} ({'scan end' if np.isnan(ohi[p, k]) else 'boundary'})"
+            for k in range(lo.shape[1])
+            if np.isfinite(lo[p, k])
+        ]
+        print(f"{where}: stable {along} [{units}] " + ("; ".join(parts) if parts else "nowhere in the scan"))
+    if lo.shape[0] > limit:
+        print(f"... and {lo.shape[0] - limit} more points in the file")
 
 
 def _cmd_examples(args) -> None:
@@ -172,6 +233,17 @@ def parser() -> argparse.ArgumentParser:
     pl.add_argument("--y", help="axis along y (default: the second axis)")
     pl.add_argument("--sel", nargs="*", default=[], metavar="NAME=VALUE", help="values of the other axes (nearest)")
     pl.set_defaults(func=_cmd_plot)
+
+    c = sub.add_parser("critical", help="stable intervals of one parameter (e.g. the critical spin rates), ends to 1e-10")
+    c.add_argument("scene", nargs="?", help="scene TOML file; its grid axis --along is the scan")
+    c.add_argument("--example", metavar="NAME", help="a bundled example scene (see 'stabmap examples')")
+    c.add_argument("--along", default="omega", help="the scanned grid axis (default: omega)")
+    c.add_argument("-o", "--output", required=True, help="netCDF file to write, e.g. critical.nc")
+    c.add_argument("--png", metavar="FILE", help="also draw the stable intervals to this PNG/PDF")
+    c.add_argument("--rtol", type=float, default=1e-10, help="relative width of the located ends (default 1e-10)")
+    c.add_argument("--workers", type=int, help="threads (default: all cores)")
+    c.add_argument("-q", "--quiet", action="store_true", help="no interval listing")
+    c.set_defaults(func=_cmd_critical)
 
     e = sub.add_parser("examples", help="list the bundled example scenes")
     e.set_defaults(func=_cmd_examples)

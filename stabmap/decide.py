@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 import kernels
@@ -33,3 +35,29 @@ def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
     if undecided.size:
         nc[undecided] = exact.decide_points(*points.kernel_args(), undecided)
     return nc, decided_by_from_status(status)
+
+
+def decide_values(scene, values: dict[str, np.ndarray], *, workers: int | None = None, chunk_points: int = 32768):
+    """``decide`` for points given by equal-length 1-D arrays of axis values, in chunks on a thread pool.
+
+    The kernels release the GIL, so threads run the chunks in parallel.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    from .points import point_arrays
+
+    npts = len(next(iter(values.values()))) if values else 1
+    workers = workers or os.cpu_count() or 1
+    size = max(1, min(chunk_points, -(-npts // workers)))
+    bounds = [(a, min(a + size, npts)) for a in range(0, npts, size)]
+
+    def run(bound):
+        a, b = bound
+        return decide(point_arrays(scene, {k: v[a:b] for k, v in values.items()}))
+
+    nc = np.empty(npts, dtype=np.int16)
+    by = np.empty(npts, dtype=np.int8)
+    with ThreadPoolExecutor(workers) as pool:
+        for (a, b), (n, d) in zip(bounds, pool.map(run, bounds)):
+            nc[a:b], by[a:b] = n, d
+    return nc, by

@@ -96,6 +96,13 @@ def plot_atlas(ds: xr.Dataset, path: str | Path, *, x: str | None = None, y: str
     if fixed:
         title += "\n" + ", ".join(f"{k} = {v:.4g} {ds[k].attrs.get('units', '')}".strip() for k, v in fixed.items())
     ax.set_title(title, fontsize=10)
+    return _save(fig, path)
+
+
+def _save(fig, path: Path) -> Path:
+    """Write the figure atomically (a temporary file renamed into place), then close it."""
+    import matplotlib.pyplot as plt
+
     tmp = path.with_name(f".{path.name}.tmp{path.suffix}")
     try:
         fig.savefig(tmp, dpi=150)
@@ -117,3 +124,58 @@ def _edges(centres: np.ndarray, scale: str | None) -> np.ndarray:
         return np.exp(np.concatenate([[2 * lc[0] - mid[0]], mid, [2 * lc[-1] - mid[-1]]]))
     mid = (centres[1:] + centres[:-1]) / 2
     return np.concatenate([[2 * centres[0] - mid[0]], mid, [2 * centres[-1] - mid[-1]]])
+
+
+def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | None = None) -> Path:
+    """Draw a critical-values Dataset: stable intervals of the scanned parameter (shaded) and their ends (curves)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    path = check_writable(path)
+    if path.suffix.lower() not in (".png", ".pdf"):
+        raise StabmapError(f"plot file {str(path)!r}: use a .png or .pdf name")
+    along = ds.attrs["critical_along"]
+    lower, upper = ds[f"{along}_stable_lower"], ds[f"{along}_stable_upper"]
+    dims = [d for d in lower.dims if d != "interval"]
+    for k in sel or {}:
+        if k not in dims:
+            raise StabmapError(f"--sel {k}: not an axis of this file; its axes are: {', '.join(dims) or '(none)'}")
+    chosen = dict(sel or {})
+    free = [d for d in dims if d not in chosen]
+    if len(free) > 1:
+        raise StabmapError(f"this file has {len(free)} other axes ({', '.join(free)}); fix all but one with --sel NAME=VALUE")
+    # Curves only where an end is a located boundary, not where the interval meets the end of the scan.
+    lower_b = lower.where(ds[f"{along}_stable_lower_outer"].notnull())
+    upper_b = upper.where(ds[f"{along}_stable_upper_outer"].notnull())
+    if chosen:
+        lower, upper, lower_b, upper_b = (v.sel(chosen, method="nearest") for v in (lower, upper, lower_b, upper_b))
+    fig, ax = plt.subplots(figsize=(7.5, 5.5), constrained_layout=True)
+    lo, hi = np.atleast_2d(np.asarray(lower)), np.atleast_2d(np.asarray(upper))
+    lo_b, hi_b = np.atleast_2d(np.asarray(lower_b)), np.atleast_2d(np.asarray(upper_b))
+    scan = ds.attrs["critical_scan_range"]
+    if free:
+        x = np.asarray(ds[free[0]])
+        for k in range(lo.shape[1]):
+            ok = np.isfinite(lo[:, k])
+            ax.fill_between(x, lo[:, k], hi[:, k], where=ok, color=_STABLE, alpha=0.6, linewidth=0, label="stable" if k == 0 else None)
+            ax.plot(x, lo_b[:, k], "k-", lw=1.0, label="boundary" if k == 0 else None)
+            ax.plot(x, hi_b[:, k], "k-", lw=1.0)
+        ax.set_xlabel(_axis_label(ds, free[0]))
+        if ds[free[0]].attrs.get("scale") == "log":
+            ax.set_xscale("log")
+    else:
+        for k in range(lo.shape[1]):
+            if np.isfinite(lo[0, k]):
+                ax.axhspan(lo[0, k], hi[0, k], color=_STABLE, alpha=0.6, label="stable" if k == 0 else None)
+        ax.set_xticks([])
+    ax.set_ylim(float(scan[0]), float(scan[-1]))
+    units = lower.attrs.get("units", "")
+    ax.set_ylabel(f"{along} [{units}]" if units else along)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    title = ds.attrs.get("title", "stabmap critical values") + f"\nstable {along} (white: unstable); ends to rtol {ds.attrs['critical_rtol']:g}"
+    if chosen:
+        title += "; " + ", ".join(f"{k} = {v:.4g}" for k, v in chosen.items())
+    ax.set_title(title, fontsize=10)
+    return _save(fig, path)
