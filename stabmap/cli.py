@@ -161,6 +161,13 @@ def _cmd_critical(args) -> None:
     if args.png:
         check_writable(args.png)
     scene = load(args.scene) if args.scene else example(args.example)
+    others = [a.name for a in scene.grid if a.name != args.along]
+    if args.png and len(others) > 1 and args.along in {a.name for a in scene.grid}:
+        # Fail before the work: a picture shows one other axis, the rest must be fixed with --sel.
+        raise StabmapError(
+            f"--png draws one other axis, but this scene has {len(others)} ({', '.join(others)}); drop --png and draw "
+            f"the file afterwards with 'stabmap plot {args.output} -o PNG --sel {others[-1]}=VALUE'"
+        )
     t0 = time.perf_counter()
     ds = critical(scene, args.along, rtol=args.rtol, workers=args.workers)
     write_atlas(ds, args.output)

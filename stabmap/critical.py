@@ -25,36 +25,28 @@ docs/critical.md.
 
 from __future__ import annotations
 
-import datetime as _dt
 import math
 import os
 import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
 
-from . import __version__
-from .atlas import FORMAT_VERSION, REFERENCES
 from .atlas import compute as compute_atlas
-from .decide import BY_EXACT, decide
+from .atlas import coordinates, global_attrs
+from .decide import BY_EXACT, decide_values
 from .errors import StabmapError
 from .parameters import parse_name
-from .points import point_arrays
-from .scene import Scene, fixed_values
-from .variables import N_COMPLEX_PAIRS
+from .scene import Scene
+from .variables import DECIDED_BY, N_COMPLEX_PAIRS
 
-KIND = "critical"  # global attribute stabmap_kind of every critical-values Dataset
+KIND = "critical values"  # global attribute stabmap_kind of every critical-values Dataset
 DEFAULT_RTOL = 1e-10
 MIN_RTOL = 1e-15  # a few ulps: bisection in float64 cannot go finer anyway
 ATOL_FACTOR = 1e-6  # default atol = ATOL_FACTOR * rtol * max |scan value|, for boundaries at or near 0
 MAX_ITERATIONS = 2200  # bisection of float64 reaches adjacent floats long before (about 2100 halvings worst case)
-CHUNK_POINTS = 8192
 PAD_NC = -2  # n_complex_pairs_below/above where a point has fewer boundaries than the boundary dimension
-
-# Values of the <along>_stable_lower_kind / _upper_kind flag variables.
-END_NONE, END_BOUNDARY, END_SCAN = -1, 0, 1
 
 ASSUMPTION = (
     "Changes of n_complex_pairs are searched for only between adjacent scan values whose n_complex_pairs differ. "
@@ -88,7 +80,7 @@ class _Brackets:
 
 @dataclass
 class _Counts:
-    """What the run cost, for the Dataset's attributes and the CLI's summary line."""
+    """What the run cost, for the Dataset's attributes and history."""
 
     scan_points: int = 0
     bisection_points: int = 0
@@ -105,18 +97,18 @@ def check_along(scene: Scene, along: str) -> int:
             f"--along {along}: not a grid axis of this scene; its grid axes are: {have}. "
             f"Add {along} = {{ start = ..., stop = ..., num = ... }} under [grid] to scan it"
         )
-    axis = scene.grid[names.index(along)]
-    if len(axis.values) < 2:
+    if len(scene.grid[names.index(along)].values) < 2:
         raise StabmapError(f"grid axis {along!r} has 1 value; critical values need a scan of at least 2 values (set num)")
     return names.index(along)
 
 
 def check_rtol(rtol) -> float:
     """Validate the relative tolerance of located ends."""
-    if isinstance(rtol, bool) or not isinstance(rtol, (int, float, np.floating)) or not math.isfinite(rtol):
-        raise StabmapError(f"rtol must be a number, got {rtol!r}")
-    if not MIN_RTOL <= rtol < 1:
-        raise StabmapError(f"rtol must be >= {MIN_RTOL:g} (float64 resolution) and < 1, got {rtol!r}; the default is {DEFAULT_RTOL:g}")
+    ok = not isinstance(rtol, bool) and isinstance(rtol, (int, float, np.floating)) and math.isfinite(rtol)
+    if not ok or not MIN_RTOL <= rtol < 1:
+        raise StabmapError(
+            f"rtol must be between {MIN_RTOL:g} (float64 resolution) and 1 (excluded), got {rtol!r}; the default is {DEFAULT_RTOL:g}"
+        )
     return float(rtol)
 
 
@@ -141,10 +133,10 @@ def critical(
         The scanned parameter, any grid axis name (default ``"omega"``).
     rtol : float
         Located ends satisfy hi - lo <= max(rtol * max(|lo|, |hi|), atol)
-        (default 1e-10; at least 1e-15).
+        (default 1e-10; between 1e-15 and 1).
     atol : float, optional
-        Absolute floor of the bracket width, which only matters for a boundary
-        at or very near 0, where a relative width cannot be reached. Default:
+        Absolute floor of the bracket width. It only matters for a boundary at
+        or very near 0, where a relative width cannot be reached. Default:
         1e-6 * rtol * max |scan value|.
     workers : int, optional
         Threads (default: all cores).
@@ -154,8 +146,8 @@ def critical(
     Returns
     -------
     xarray.Dataset
-        Dimensions: the other grid axes, ``interval`` and ``boundary``. The
-        layout is in docs/critical.md; ``stabmap_kind = "critical"``.
+        Dimensions: the other grid axes, ``interval`` and ``boundary``;
+        ``stabmap_kind = "critical values"``. Layout: docs/critical.md.
     """
     index = check_along(scene, along)
     rtol = check_rtol(rtol)
@@ -171,11 +163,10 @@ def critical(
     counts = _Counts()
     t0 = time.perf_counter()
     nc = _scan(scene, index, workers, progress, counts)
-    brackets = _initial_brackets(nc, scan)
-    with ThreadPoolExecutor(max_workers=workers) as pool:
-        brackets = _bisect(scene, along, others, brackets, rtol, atol, pool, workers, counts)
-    ds = _dataset(scene, along, others, scan, nc, brackets, rtol, atol, counts)
-    ds.attrs["history"] += f" in {time.perf_counter() - t0:.1f} s"
+    brackets = _bisect(scene, along, others, _initial_brackets(nc, scan), rtol, atol, workers, counts)
+    ds = _dataset(scene, along, others, scan, nc, brackets)
+    ds.attrs.update(_attrs(along, scan, rtol, atol, counts))
+    ds.attrs["history"] += _history(along, counts, time.perf_counter() - t0)
     return ds
 
 
@@ -186,7 +177,7 @@ def _scan(scene: Scene, index: int, workers: int, progress: bool | None, counts:
     if scene.grid[index].values[0] > scene.grid[index].values[-1]:
         nc = nc[..., ::-1]
     counts.scan_points = nc.size
-    counts.exact += int((atlas["decided_by"].values == BY_EXACT).sum())
+    counts.exact += int((atlas[DECIDED_BY].values == BY_EXACT).sum())
     return np.ascontiguousarray(nc)
 
 
@@ -200,13 +191,13 @@ def _initial_brackets(nc: np.ndarray, scan: np.ndarray) -> _Brackets:
 def _converged(b: _Brackets, rtol: float, atol: float) -> np.ndarray:
     width = b.hi - b.lo
     mid = b.lo + 0.5 * width
-    # No float strictly inside: the bracket is two adjacent doubles and cannot shrink.
+    # No double strictly inside: lo and hi are neighbours and the bracket cannot shrink.
     no_room = (mid <= b.lo) | (mid >= b.hi)
     return (width <= np.maximum(rtol * np.maximum(np.abs(b.lo), np.abs(b.hi)), atol)) | no_room
 
 
-def _bisect(scene, along, others, brackets: _Brackets, rtol, atol, pool, workers, counts: _Counts) -> _Brackets:
-    """Halve every bracket until converged; returns all final brackets."""
+def _bisect(scene, along, others, brackets: _Brackets, rtol, atol, workers, counts: _Counts) -> _Brackets:
+    """Halve every bracket until converged (one batched decision per step); returns all final brackets."""
     shape = tuple(len(a.values) for a in others)
     done = []
     active = brackets
@@ -220,16 +211,18 @@ def _bisect(scene, along, others, brackets: _Brackets, rtol, atol, pool, workers
         idx = np.unravel_index(active.owner, shape) if shape else ()
         values = {a.name: a.array[i] for a, i in zip(others, idx)}
         values[along] = mid
-        nc_mid = _decide_parallel(scene, values, mid.size, pool, workers, counts)
+        nc_mid, by = decide_values(scene, values, workers=workers)
+        counts.bisection_points += mid.size
+        counts.exact += int((by == BY_EXACT).sum())
         counts.iterations += 1
         active = _halve(active, mid, nc_mid)
-    else:  # pragma: no cover - float64 bisection always reaches adjacent doubles first
+    else:  # pragma: no cover - float64 bisection always reaches neighbouring doubles first
         raise RuntimeError("bisection did not converge")
     return _Brackets.concat(done)
 
 
 def _halve(b: _Brackets, mid: np.ndarray, nc_mid: np.ndarray) -> _Brackets:
-    """Keep the half (or both halves) whose ends still differ."""
+    """Keep the half whose ends differ; keep both when the midpoint differs from both ends (two changes)."""
     left = nc_mid != b.nc_lo  # a change in (lo, mid]
     right = nc_mid != b.nc_hi  # a change in (mid, hi]
     lower = _Brackets(b.owner[left], b.lo[left], mid[left], b.nc_lo[left], nc_mid[left])
@@ -237,32 +230,15 @@ def _halve(b: _Brackets, mid: np.ndarray, nc_mid: np.ndarray) -> _Brackets:
     return _Brackets.concat([lower, upper])
 
 
-def _decide_parallel(scene, values: dict, npts: int, pool, workers: int, counts: _Counts) -> np.ndarray:
-    """N_c of the points ``values`` (1-d arrays), decided in chunks on the thread pool."""
-    size = max(512, min(CHUNK_POINTS, -(-npts // (2 * workers))))
-    starts = range(0, npts, size)
-    futures = [pool.submit(decide, point_arrays(scene, {k: v[a : a + size] for k, v in values.items()})) for a in starts]
-    nc = np.empty(npts, dtype=np.int16)
-    for a, f in zip(starts, futures):
-        part, by = f.result()
-        nc[a : a + size] = part
-        counts.exact += int((by == BY_EXACT).sum())
-    counts.bisection_points += npts
-    return nc
-
-
 @dataclass
 class _Table:
-    """Per-point results padded along the interval and boundary dimensions."""
+    """Per-point results, padded along the interval and boundary dimensions (NaN, or PAD_NC for counts)."""
 
     n_intervals: np.ndarray
     lower: np.ndarray
     upper: np.ndarray
     lower_outer: np.ndarray
     upper_outer: np.ndarray
-    lower_kind: np.ndarray
-    upper_kind: np.ndarray
-    n_boundaries: np.ndarray
     b_lower: np.ndarray
     b_upper: np.ndarray
     nc_below: np.ndarray
@@ -274,109 +250,96 @@ def _table(nc: np.ndarray, scan: np.ndarray, b: _Brackets) -> _Table:
     flat = nc.reshape(-1, scan.size)
     npoints = flat.shape[0]
     b = b.take(np.lexsort((b.lo, b.owner)))
-    n_bound = np.bincount(b.owner, minlength=npoints).astype(np.int16)
-    starts = np.concatenate([[0], np.cumsum(n_bound)])
-    # Pieces between brackets carry one N_c each (the scan start's, then each bracket's upper end's).
-    pieces = [_pieces(flat[p, 0], scan, b.take(slice(starts[p], starts[p + 1]))) for p in range(npoints)]
-    n_int = np.array([len(p) for p in pieces], dtype=np.int16)
-    ni, nb = max(1, int(n_int.max(initial=0))), max(1, int(n_bound.max(initial=0)))
-    t = _Table(
-        n_int, *(np.full((npoints, ni), np.nan) for _ in range(4)), *(np.full((npoints, ni), END_NONE, np.int8) for _ in range(2)),
-        n_bound, *(np.full((npoints, nb), np.nan) for _ in range(2)), *(np.full((npoints, nb), PAD_NC, np.int16) for _ in range(2)),
-    )
-    for p, intervals in enumerate(pieces):
-        for i, row in enumerate(intervals):
-            t.lower[p, i], t.upper[p, i], t.lower_outer[p, i], t.upper_outer[p, i], t.lower_kind[p, i], t.upper_kind[p, i] = row
+    starts = np.concatenate([[0], np.cumsum(np.bincount(b.owner, minlength=npoints))])
+    intervals = [_stable_intervals(flat[p, 0], scan, b.take(slice(starts[p], starts[p + 1]))) for p in range(npoints)]
+    n_int = np.array([len(i) for i in intervals], dtype=np.int16)
+    ni = max(1, int(n_int.max(initial=0)))
+    nb = max(1, int(np.diff(starts).max(initial=0)))
+    ends = np.full((4, npoints, ni), np.nan)
+    for p, rows in enumerate(intervals):
+        for i, row in enumerate(rows):
+            ends[:, p, i] = row
     slot = np.arange(len(b)) - starts[b.owner]
-    t.b_lower[b.owner, slot], t.b_upper[b.owner, slot] = b.lo, b.hi
-    t.nc_below[b.owner, slot], t.nc_above[b.owner, slot] = b.nc_lo, b.nc_hi
-    return t
+    bounds = np.full((2, npoints, nb), np.nan)
+    counts = np.full((2, npoints, nb), PAD_NC, dtype=np.int16)
+    bounds[0, b.owner, slot], bounds[1, b.owner, slot] = b.lo, b.hi
+    counts[0, b.owner, slot], counts[1, b.owner, slot] = b.nc_lo, b.nc_hi
+    return _Table(n_int, *ends, *bounds, *counts)
 
 
-def _pieces(nc_start: int, scan: np.ndarray, b: _Brackets) -> list[tuple]:
-    """Stable intervals of one point: (inner lower, inner upper, outer lower, outer upper, lower kind, upper kind)."""
+def _stable_intervals(nc_start: int, scan: np.ndarray, b: _Brackets) -> list[tuple[float, float, float, float]]:
+    """(lower, upper, lower_outer, upper_outer) of each stable interval of one point; NaN outer: scan end.
+
+    The sorted brackets and the scan steps between them partition the scan
+    range, so the N_c between bracket i-1 and bracket i is bracket i's lower-end N_c.
+    """
     k = len(b)
-    if k and not np.array_equal(b.nc_hi[:-1], b.nc_lo[1:]):  # pragma: no cover - the brackets partition the scan
+    if k and not np.array_equal(b.nc_hi[:-1], b.nc_lo[1:]):  # pragma: no cover - guaranteed by construction
         raise AssertionError("brackets do not chain")
     out = []
     for i in range(k + 1):
-        value = nc_start if i == 0 else b.nc_hi[i - 1]
-        if value != 0:
+        if (nc_start if i == 0 else b.nc_hi[i - 1]) != 0:
             continue
-        lower = (scan[0], np.nan, END_SCAN) if i == 0 else (b.hi[i - 1], b.lo[i - 1], END_BOUNDARY)
-        upper = (scan[-1], np.nan, END_SCAN) if i == k else (b.lo[i], b.hi[i], END_BOUNDARY)
-        out.append((lower[0], upper[0], lower[1], upper[1], lower[2], upper[2]))
+        lower, lower_outer = (scan[0], np.nan) if i == 0 else (b.hi[i - 1], b.lo[i - 1])
+        upper, upper_outer = (scan[-1], np.nan) if i == k else (b.lo[i], b.hi[i])
+        out.append((lower, upper, lower_outer, upper_outer))
     return out
 
 
-def _dataset(scene, along, others, scan, nc, brackets, rtol, atol, counts: _Counts) -> xr.Dataset:
+def _dataset(scene, along, others, scan, nc, brackets) -> xr.Dataset:
     info = parse_name(along, scene.n, scene.support)
     dims = tuple(a.name for a in others)
     shape = tuple(len(a.values) for a in others)
     t = _table(nc, scan, brackets)
     iv, bd = dims + ("interval",), dims + ("boundary",)
 
-    def pad(a):
+    def grid(a):
         return a.reshape(shape + a.shape[1:])
 
     def along_attrs(long_name, comment):
         return {"long_name": f"{long_name} ({info.long_name})", "units": info.units, "comment": comment}
 
-    ends = {"flag_values": np.array([END_NONE, END_BOUNDARY, END_SCAN], np.int8), "flag_meanings": "no_interval located_boundary scan_range_end"}
+    def count_attrs(long_name):
+        return {"long_name": long_name, "units": "1", "comment": f"-1: p vanishes identically; {PAD_NC}: fill (no boundary)"}
+
     data = {
-        "n_stable_intervals": (dims, pad(t.n_intervals), {"long_name": "number of stable intervals in the scan range", "units": "1"}),
-        f"{along}_stable_lower": (iv, pad(t.lower), along_attrs("lower end of a stable interval, proved stable", "inner bound: stable at this value and up to the upper end (assuming no feature narrower than the scan spacing); NaN pads")),
-        f"{along}_stable_upper": (iv, pad(t.upper), along_attrs("upper end of a stable interval, proved stable", "inner bound; NaN pads")),
-        f"{along}_stable_lower_outer": (iv, pad(t.lower_outer), along_attrs("value just below the stable interval with N_c proved nonzero", "outer bound: the boundary lies in (lower_outer, lower]; NaN where the interval starts at the scan range end")),
-        f"{along}_stable_upper_outer": (iv, pad(t.upper_outer), along_attrs("value just above the stable interval with N_c proved nonzero", "outer bound: the boundary lies in [upper, upper_outer); NaN where the interval ends at the scan range end")),
-        f"{along}_stable_lower_kind": (iv, pad(t.lower_kind), {"long_name": "what bounds the stable interval from below", **ends}),
-        f"{along}_stable_upper_kind": (iv, pad(t.upper_kind), {"long_name": "what bounds the stable interval from above", **ends}),
-        "n_boundaries": (dims, pad(t.n_boundaries), {"long_name": "number of located changes of n_complex_pairs in the scan range", "units": "1"}),
-        f"{along}_boundary_lower": (bd, pad(t.b_lower), along_attrs("lower end of the bracket of a change of n_complex_pairs", "n_complex_pairs_below holds here (proved); NaN pads")),
-        f"{along}_boundary_upper": (bd, pad(t.b_upper), along_attrs("upper end of the bracket of a change of n_complex_pairs", "n_complex_pairs_above holds here (proved); a change lies in (lower, upper]; NaN pads")),
-        "n_complex_pairs_below": (bd, pad(t.nc_below), {"long_name": "n_complex_pairs at the lower end of the bracket", "units": "1", "comment": f"-1: p identically zero; {PAD_NC}: padding (no boundary)"}),
-        "n_complex_pairs_above": (bd, pad(t.nc_above), {"long_name": "n_complex_pairs at the upper end of the bracket", "units": "1", "comment": f"-1: p identically zero; {PAD_NC}: padding (no boundary)"}),
+        "n_stable_intervals": (dims, grid(t.n_intervals), {"long_name": "number of stable intervals in the scan range", "units": "1"}),
+        f"{along}_stable_lower": (iv, grid(t.lower), along_attrs("lower end of a stable interval", "proved stable; NaN pads")),
+        f"{along}_stable_upper": (iv, grid(t.upper), along_attrs("upper end of a stable interval", "proved stable; NaN pads")),
+        f"{along}_stable_lower_outer": (iv, grid(t.lower_outer), along_attrs(
+            "value just below a stable interval", "proved unstable; the boundary lies in (lower_outer, lower]; "
+            "NaN where the interval starts at the scan range end (it may continue below)")),
+        f"{along}_stable_upper_outer": (iv, grid(t.upper_outer), along_attrs(
+            "value just above a stable interval", "proved unstable; the boundary lies in [upper, upper_outer); "
+            "NaN where the interval ends at the scan range end (it may continue above)")),
+        "boundary_lower": (bd, grid(t.b_lower), along_attrs("lower end of the bracket of a change of n_complex_pairs", "n_complex_pairs_below holds here, proved; NaN pads")),
+        "boundary_upper": (bd, grid(t.b_upper), along_attrs("upper end of the bracket of a change of n_complex_pairs", "n_complex_pairs_above holds here, proved; a change lies in (lower, upper]; NaN pads")),
+        "n_complex_pairs_below": (bd, grid(t.nc_below), count_attrs("n_complex_pairs at boundary_lower")),
+        "n_complex_pairs_above": (bd, grid(t.nc_above), count_attrs("n_complex_pairs at boundary_upper")),
     }
-    return xr.Dataset(data, coords=_coords(scene, others), attrs=_attrs(scene, along, scan, rtol, atol, counts))
+    attrs = global_attrs(scene, "stabmap critical values")
+    return xr.Dataset(data, coords=coordinates(scene, skip=(along,)), attrs=attrs)
 
 
-def _coords(scene: Scene, others) -> dict:
-    coords = {}
-    for axis in others:
-        name = parse_name(axis.name, scene.n, scene.support)
-        coords[axis.name] = (axis.name, axis.array, {"units": name.units, "long_name": name.long_name, "scale": axis.scale})
-    for key, value in fixed_values(scene).items():
-        name = parse_name(key, scene.n, scene.support)
-        coords[key] = ((), np.float64(value), {"units": name.units, "long_name": name.long_name})
-    return coords
-
-
-def _attrs(scene, along, scan, rtol, atol, counts: _Counts) -> dict:
-    now = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
+def _attrs(along, scan, rtol, atol, counts: _Counts) -> dict:
     return {
-        "Conventions": "CF-1.10",
-        "title": scene.title or "stabmap critical values",
-        "source": f"stabmap {__version__}",
-        "history": f"{now} critical values of {along} computed by stabmap {__version__}: {counts.scan_points} scan points, "
-        f"{counts.bisection_points} bisection points in {counts.iterations} steps",
-        "references": REFERENCES,
-        "stabmap_format_version": FORMAT_VERSION,
         "stabmap_kind": KIND,
-        "support": scene.support,
-        "n_bodies": scene.n,
-        "polynomial_degree_bound": scene.degree,
-        "along": along,
-        "along_units": parse_name(along, scene.n, scene.support).units,
-        "rtol": rtol,
-        "atol": atol,
-        "tolerance": "every bracket has hi - lo <= max(rtol * max(|lo|, |hi|), atol), or hi and lo are adjacent doubles",
-        "scan_size": np.int64(scan.size),
-        "scan_min": float(scan[0]),
-        "scan_max": float(scan[-1]),
-        "scan_max_spacing": float(np.diff(scan).max()),
-        "assumption": ASSUMPTION,
-        "n_scan_points": np.int64(counts.scan_points),
-        "n_bisection_points": np.int64(counts.bisection_points),
-        "n_decided_exactly": np.int64(counts.exact),
-        "scene": scene.to_toml(),
+        "critical_along": along,
+        "critical_rtol": rtol,
+        "critical_atol": atol,
+        "critical_scan_points": np.int64(scan.size),
+        "critical_scan_range": np.array([scan[0], scan[-1]]),
+        "critical_scan_max_step": float(np.diff(scan).max()),
+        "critical_evaluated_points": np.int64(counts.scan_points + counts.bisection_points),
+        "critical_bisection_steps": np.int64(counts.iterations),
+        "critical_decided_exactly": np.int64(counts.exact),
+        "comment": "Ends are located until hi - lo <= max(rtol * max(|lo|, |hi|), atol), or lo and hi are neighbouring "
+        "doubles. " + ASSUMPTION,
     }
+
+
+def _history(along, counts: _Counts, seconds: float) -> str:
+    return (
+        f"; critical values of {along}: {counts.scan_points} scan points and {counts.bisection_points} "
+        f"bisection points ({counts.iterations} steps) in {seconds:.1f} s"
+    )

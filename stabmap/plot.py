@@ -156,12 +156,18 @@ def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | N
     lo_b, hi_b = np.atleast_2d(np.asarray(lower_b)), np.atleast_2d(np.asarray(upper_b))
     scan = ds.attrs["critical_scan_range"]
     if free:
+        from matplotlib.collections import PolyCollection
+
         x = np.asarray(ds[free[0]])
-        for k in range(lo.shape[1]):
-            ok = np.isfinite(lo[:, k])
-            ax.fill_between(x, lo[:, k], hi[:, k], where=ok, color=_STABLE, alpha=0.6, linewidth=0, label="stable" if k == 0 else None)
-            ax.plot(x, lo_b[:, k], "k-", lw=1.0, label="boundary" if k == 0 else None)
-            ax.plot(x, hi_b[:, k], "k-", lw=1.0)
+        edges = _edges(x, ds[free[0]].attrs.get("scale"))
+        # One box per point and interval, and the ends as dots: joining neighbouring points would draw boundaries
+        # (and shade regions) that were never computed wherever the number of intervals changes between points.
+        i, k = np.nonzero(np.isfinite(lo))
+        boxes = [[(edges[a], lo[a, b]), (edges[a + 1], lo[a, b]), (edges[a + 1], hi[a, b]), (edges[a], hi[a, b])] for a, b in zip(i, k)]
+        ax.add_collection(PolyCollection(boxes, facecolors=_STABLE, edgecolors="none", alpha=0.6, label="stable"))
+        xs = np.broadcast_to(x[:, None], lo.shape).ravel()
+        ax.plot(np.concatenate([xs, xs]), np.concatenate([lo_b.ravel(), hi_b.ravel()]), "k.", ms=2.5, label="boundary")
+        ax.set_xlim(edges[0], edges[-1])
         ax.set_xlabel(_axis_label(ds, free[0]))
         if ds[free[0]].attrs.get("scale") == "log":
             ax.set_xscale("log")

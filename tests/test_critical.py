@@ -141,3 +141,103 @@ def test_plot_with_two_other_axes_asks_for_sel(tmp_path):
         plot_critical(ds, tmp_path / "x.png")
     plot_critical(ds, tmp_path / "x.png", sel={"m_1": 2.0})
     assert (tmp_path / "x.png").exists()
+
+
+def test_boundary_at_exactly_zero_uses_the_absolute_floor(tmp_path):
+    # At omega = 0 a top is stable iff c <= 0 (p = (A + m c^2) lam^2 + m c g), so the boundary is c = 0 exactly, where
+    # no relative width can be reached. Also: a decreasing scan, an axis other than omega, no other axis, its plot.
+    scene = from_dict({
+        "support": "fixed", "g": 9.81, "omega": 0.0, "bodies": [dict(TOP, c=0.1)],
+        "grid": {"c_1": {"start": 0.2, "stop": -0.2, "num": 40}},
+    })
+    ds = critical(scene, "c_1", rtol=1e-10)
+    atol = 1e-6 * 1e-10 * 0.2
+    assert ds.attrs["critical_atol"] == pytest.approx(atol) and ds["c_1_stable_lower"].dims == ("interval",)
+    assert int(ds["n_stable_intervals"]) == 1
+    assert ds["c_1_stable_lower"].item() == -0.2 and np.isnan(ds["c_1_stable_lower_outer"].item())
+    upper, outer = ds["c_1_stable_upper"].item(), ds["c_1_stable_upper_outer"].item()
+    assert upper <= 0.0 < outer and outer - upper <= atol
+    from stabmap.plot import plot_critical
+
+    assert plot_critical(ds, tmp_path / "line.png").read_bytes()[:4] == b"\x89PNG"
+
+
+# Dyadic parameters: the floats are the rationals, so the discriminant below has small integer coefficients.
+_DYADIC = {
+    "support": "fixed", "g": 9.75,
+    "bodies": [
+        {"m": 1.0, "A": 0.0234375, "C": 0.03125, "c": 0.125, "s": 0.25, "fluid": {"E": [0.0009765625], "kappa": [1.3125]}},
+        {"m": 0.5, "A": 0.009765625, "C": 0.015625, "c": 0.0625, "fluid": {"E": [0.00048828125], "kappa": [3.0]}},
+    ],
+}
+
+
+def _bivariate(joints: list[float]):
+    """p(lam, w) of the dyadic pair at spin rate w: total degree <= 6 in (lam, w) (MODEL.md), so 7 nodes fix it."""
+    import sympy
+
+    w = sympy.Symbol("w")
+
+    def at(omega):
+        point = dict(_DYADIC, joints=joints, omega=omega)
+        return ref.char_poly(**reference_args(point)).as_expr()
+
+    nodes = [sympy.Integer(k) for k in range(1, 9)]  # one more than needed
+    P = sympy.Poly(sympy.expand(sympy.interpolate([(x, at(x)) for x in nodes], w)), ref.lam)
+    assert sympy.expand(P.as_expr().subs(w, sympy.Rational(37, 3)) - at(Fraction(37, 3))) == 0
+    return P, w, at
+
+
+def test_boundaries_are_the_real_roots_of_discriminant_times_leading_coefficient():
+    # N_c can change only where p has a multiple root (discriminant 0) or loses degree (leading coefficient 0).
+    # Each located bracket must hold such a root, and each such root at which N_c changes must lie in a bracket.
+    import sympy
+
+    system = dict(_DYADIC, joints=[0.0])
+    system["grid"] = {"omega": {"start": -150.0, "stop": 150.0, "num": 601}, "K_1": {"values": [0.0, 2.0]}}
+    ds = critical(from_dict(system), "omega", rtol=1e-10)
+    for j, K in enumerate(ds["K_1"].values):
+        P, w, at = _bivariate([float(K)])
+        D = (sympy.Poly(sympy.discriminant(P, ref.lam), w) * sympy.Poly(P.LC(), w)).sqf_part()
+        lo, hi = ds["boundary_lower"][j].values, ds["boundary_upper"][j].values
+        lo, hi = lo[np.isfinite(lo)], hi[np.isfinite(hi)]
+        assert lo.size >= 6
+        for a, b in zip(lo, hi):
+            assert D.count_roots(sympy.Rational(a), sympy.Rational(b)) >= 1
+        changes = 0
+        for (a, b), _ in D.intervals(eps=Fraction(1, 10**12), inf=-150, sup=150):
+            if a == b:  # a rational root: look just beside it
+                a, b = a - Fraction(1, 10**9), b + Fraction(1, 10**9)
+            if ref.count_complex_pairs(at(a)) != ref.count_complex_pairs(at(b)):
+                changes += 1
+                assert np.any((lo <= float(b)) & (hi >= float(a))), (float(a), float(b))
+        assert changes == lo.size
+
+
+def test_a_coarser_scan_finds_a_subset_of_the_same_boundaries():
+    # The documented assumption: a stable window narrower than a scan step can be missed, but whatever a coarse
+    # scan reports is one of the fine scan's boundaries (same brackets to rtol), with the same N_c on each side.
+    found = {}
+    for num in (13, 601):
+        system = dict(_DYADIC, joints=[2.0])
+        system["grid"] = {"omega": {"start": -150.0, "stop": 150.0, "num": num}}
+        ds = critical(from_dict(system), "omega")
+        keep = np.isfinite(ds["boundary_lower"].values)
+        found[num] = [(ds[v].values[keep]) for v in ("boundary_lower", "boundary_upper", "n_complex_pairs_below", "n_complex_pairs_above")]
+    fine_lo, fine_hi, fine_below, fine_above = found[601]
+    assert fine_lo.size == 6  # includes a stable window about 1 rad/s wide near omega = 24
+    assert found[13][0].size < fine_lo.size
+    for lo, hi, below, above in zip(*found[13]):
+        k = np.flatnonzero((fine_lo <= hi) & (fine_hi >= lo))
+        assert k.size == 1 and (fine_below[k[0]], fine_above[k[0]]) == (below, above)
+
+
+def test_cli_png_with_two_other_axes_fails_before_the_work(tmp_path, capsys):
+    scene = tmp_path / "three.toml"
+    scene.write_text(from_dict({
+        "support": "fixed", "g": 9.81, "bodies": [dict(TOP, c=0.1)],
+        "grid": {"c_1": {"values": [0.1, 0.2]}, "omega": {"start": 0.5, "stop": 60.0, "num": 10}, "m_1": {"values": [1.0, 2.0]}},
+    }).to_toml())
+    out = tmp_path / "c.nc"
+    assert main(["critical", str(scene), "-o", str(out), "--png", str(tmp_path / "c.png")]) == 2
+    assert "--sel m_1=VALUE" in capsys.readouterr().err and not out.exists()
