@@ -33,7 +33,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import kernels  # noqa: E402
-from bench_kernel import random_points  # noqa: E402
+from bench_kernel import companion_pairs, random_points, timed  # noqa: E402
 from stabmap import exact  # noqa: E402
 from stabmap.atlas import compute  # noqa: E402
 from stabmap.decide import BY_EXACT, BY_INCLUSION, BY_STURM, decided_by_from_status  # noqa: E402
@@ -172,22 +172,7 @@ def numpy_roots(coeffs, tol):
     return out
 
 
-def companion_eigvals(coeffs, tol):
-    d = coeffs.shape[1] - 1
-    comp = np.zeros((len(coeffs), d, d))
-    comp[:, 1:, :-1] = np.eye(d - 1)
-    comp[:, :, -1] = -coeffs[:, :d] / coeffs[:, d : d + 1]
-    z = np.linalg.eigvals(comp)
-    return (np.abs(z.imag) > tol * np.maximum(np.abs(z), 1e-300)).sum(axis=1) // 2
-
-
 # --- the table ----------------------------------------------------------------------------------
-
-
-def _timed(f, *args):
-    t0 = time.perf_counter()
-    out = f(*args)
-    return out, time.perf_counter() - t0
 
 
 def score(name: str, pts_list, rows: list) -> None:
@@ -199,11 +184,11 @@ def score(name: str, pts_list, rows: list) -> None:
         c = np.zeros((npts, degree + 1, 3))
         kernels.charpoly_block(*pts.kernel_args(), c)
         coeffs.append(c[..., 0] + c[..., 1])
-        lab, t = _timed(_exact_labels, pts)
+        lab, t = timed(_exact_labels, pts)
         truth.append(lab)
         t_exact += t
         nc, st = np.empty(npts, np.int16), np.empty(npts, np.int8)
-        _, t = _timed(kernels.count_block, *pts.kernel_args(), nc, st)
+        _, t = timed(kernels.count_block, *pts.kernel_args(), nc, st)
         t_kernel += t
         und = np.flatnonzero(st == kernels.UNDECIDED)
         t0 = time.perf_counter()
@@ -222,8 +207,8 @@ def score(name: str, pts_list, rows: list) -> None:
     times = dict.fromkeys(parts, 0.0)
     for c in coeffs:
         for key, f, tol in (("fs0", float_sturm, 0.0), ("fs10", float_sturm, 1e-10),
-                            ("nr10", numpy_roots, 1e-10), ("nr6", numpy_roots, 1e-6), ("ce", companion_eigvals, 1e-8)):
-            out, t = _timed(f, c, tol)
+                            ("nr10", numpy_roots, 1e-10), ("nr6", numpy_roots, 1e-6), ("ce", companion_pairs, 1e-8)):
+            out, t = timed(f, c, tol)
             parts[key].append(out)
             times[key] += t
     fs0, fs10, nr10, nr6, ce = (np.concatenate(parts[k]) for k in ("fs0", "fs10", "nr10", "nr6", "ce"))

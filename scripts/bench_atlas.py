@@ -13,28 +13,18 @@
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import os
 import platform
 import subprocess
 import sys
 import tempfile
 import time
-
-import numpy as np
+from pathlib import Path
 
 import stabmap
-from stabmap.scene import Axis
 
-
-def regrid(scene, num: int):
-    """The scene with every grid axis resampled to ``num`` points over the same range."""
-    axes = []
-    for a in scene.grid:
-        lo, hi = a.values[0], a.values[-1]
-        values = np.geomspace(lo, hi, num) if a.scale == "log" else np.linspace(lo, hi, num)
-        axes.append(Axis(a.name, tuple(float(v) for v in values), a.scale))
-    return dataclasses.replace(scene, grid=tuple(axes))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_refine import regrid  # noqa: E402
 
 
 def cold_start(cache_dir: str | None, workdir: str) -> float:

@@ -64,7 +64,8 @@ def count_threads(pts: PointArrays, threads: int):
     return nc, st
 
 
-def _timed(f, *args):
+def timed(f, *args):
+    """(f(*args), seconds it took)."""
     t0 = time.perf_counter()
     out = f(*args)
     return out, time.perf_counter() - t0
@@ -99,20 +100,20 @@ def run(n: int, modes: int, rng, quick: bool) -> dict:
     pts = random_points(rng, npts, n, modes)
     threads = os.cpu_count() or 1
     count_threads(_subset(pts, slice(0, 2 * threads)), threads)  # compile outside the timed calls
-    (nc, st), t1 = _timed(count_threads, pts, 1)
-    _, tn = _timed(count_threads, pts, threads)
+    (nc, st), t1 = timed(count_threads, pts, 1)
+    _, tn = timed(count_threads, pts, threads)
     undecided = np.flatnonzero(st == kernels.UNDECIDED)
     sample = undecided[:EXACT_SAMPLE]
     t_exact = 0.0
     if sample.size:
-        _, t_exact = _timed(exact.decide_points, *pts.kernel_args(), sample)
+        _, t_exact = timed(exact.decide_points, *pts.kernel_args(), sample)
         t_exact /= sample.size
     coeffs = np.zeros((npts, degree + 1, 3))
     kernels.charpoly_block(*pts.kernel_args(), coeffs)
     c = coeffs[..., 0] + coeffs[..., 1]
     m = min(npts, 2000)
-    nc_np, t_np = _timed(roots_pairs, c[:m], 1e-7)
-    nc_eig, t_eig = _timed(companion_pairs, c[:m], 1e-7)
+    nc_np, t_np = timed(roots_pairs, c[:m], 1e-7)
+    nc_eig, t_eig = timed(companion_pairs, c[:m], 1e-7)
     decided = st[:m] != kernels.UNDECIDED
     certified_us = 1e6 * t1 / npts + 1e6 * t_exact * undecided.size / npts
     return {

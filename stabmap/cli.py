@@ -25,22 +25,30 @@ def _pairs(items: list[str], what: str) -> dict[str, float]:
     return out
 
 
-def _cmd_atlas(args) -> None:
-    from .atlas import compute
+def _scene_for_run(args):
+    """The scene of an ``atlas`` or ``critical`` run, after every check that can fail before the work."""
     from .examples import example
-    from .io import check_writable, write_atlas
-    from .plot import plot_atlas
+    from .io import check_writable
     from .scene import load
 
     if (args.scene is None) == (args.example is None):
         raise StabmapError("give a scene file or --example NAME (not both); see 'stabmap examples'")
-    refine = _refine_options(args)
     check_writable(args.output)
     if args.png:
         check_writable(args.png)
     scene = load(args.scene) if args.scene else example(args.example)
     if args.workers is not None and args.workers < 1:
         raise StabmapError(f"--workers must be >= 1, got {args.workers}")
+    return scene
+
+
+def _cmd_atlas(args) -> None:
+    from .atlas import compute
+    from .io import write_atlas
+    from .plot import plot_atlas
+
+    refine = _refine_options(args)
+    scene = _scene_for_run(args)
     t0 = time.perf_counter()
     if refine is None:
         ds = compute(scene, workers=args.workers, progress=not args.quiet)
@@ -148,19 +156,10 @@ def _cmd_plot(args) -> None:
 
 def _cmd_critical(args) -> None:
     from .critical import critical
-    from .examples import example
-    from .io import check_writable, write_atlas
+    from .io import write_atlas
     from .plot import plot_critical
-    from .scene import load
 
-    if (args.scene is None) == (args.example is None):
-        raise StabmapError("give a scene file or --example NAME (not both); see 'stabmap examples'")
-    if args.workers is not None and args.workers < 1:
-        raise StabmapError(f"--workers must be >= 1, got {args.workers}")
-    check_writable(args.output)
-    if args.png:
-        check_writable(args.png)
-    scene = load(args.scene) if args.scene else example(args.example)
+    scene = _scene_for_run(args)
     others = [a.name for a in scene.grid if a.name != args.along]
     if args.png and len(others) > 1 and args.along in {a.name for a in scene.grid}:
         # Fail before the work: a picture shows one other axis, the rest must be fixed with --sel.

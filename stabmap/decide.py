@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import os
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
 import kernels
 
 from . import exact
-from .points import PointArrays
+from .points import PointArrays, point_arrays
 
 # Values of the ``decided_by`` flag variable.
 BY_STURM = 0
@@ -42,10 +43,6 @@ def decide_values(scene, values: dict[str, np.ndarray], *, workers: int | None =
 
     The kernels release the GIL, so threads run the chunks in parallel.
     """
-    from concurrent.futures import ThreadPoolExecutor
-
-    from .points import point_arrays
-
     npts = len(next(iter(values.values()))) if values else 1
     workers = workers or os.cpu_count() or 1
     size = max(1, min(chunk_points, -(-npts // workers)))
