@@ -18,6 +18,7 @@ if getattr(_kernels, "STABMAP_KERNELS", None) != 1:
         "(an unrelated PyPI package has the same name); uninstall it: pip uninstall kernels"
     )
 
+from . import cavity  # noqa: E402
 from .atlas import compute as compute_atlas  # noqa: E402
 from .critical import critical  # noqa: E402
 from .errors import StabmapError  # noqa: E402
@@ -34,6 +35,7 @@ __all__ = [
     "Body",
     "Scene",
     "StabmapError",
+    "cavity",
     "compute_atlas",
     "compute_refined",
     "critical",

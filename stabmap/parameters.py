@@ -33,17 +33,26 @@ BODY = {
 BODY_COLUMNS = ("m", "A", "C", "c", "s", "omega")  # column order of the kernels' body array
 JOINT = ParameterInfo("K", "N m rad-1", "stiffness of joint {k}", 0.0, False)
 BASE = ParameterInfo("K", "N m rad-1", "stiffness of the base joint", 0.0, False)
+CAVITY = {
+    "radius": ParameterInfo("a", "m", "radius (equatorial semi-axis) of the cavity of body {k}", 0.0, True),
+    "half_height": ParameterInfo("c", "m", "half height (polar semi-axis) of the cavity of body {k}", 0.0, True),
+    "density": ParameterInfo("rho", "kg m-3", "density of the liquid in the cavity of body {k}", 0.0, True),
+    "centre": ParameterInfo("z", "m", "height of the cavity centre above the lower joint of body {k}", None, False),
+    "E": ParameterInfo("E", "kg m2", "inertia coefficient of a liquid mode", 0.0, True),
+    "kappa": ParameterInfo("kappa", "1", "frequency parameter of a liquid mode", None, False),
+}
+SCANNABLE_CAVITY = ("radius", "half_height", "density")
 GLOBAL = {
     "omega": ParameterInfo("omega", "rad s-1", "common spin rate", None, False),
     "g": ParameterInfo("g", "m s-2", "gravitational acceleration", None, False),
 }
 
-_NAME = re.compile(r"^(m|A|C|c|s|omega|K)_(\d+)$")
+_NAME = re.compile(r"^(m|A|C|c|s|omega|K|radius|half_height|density)_(\d+)$")
 
 
 @dataclass(frozen=True)
 class Name:
-    """A parsed parameter name: kind is 'global', 'body' or 'joint'; index is 1-based (K: 0 = base)."""
+    """A parsed parameter name: kind is 'global', 'body', 'cavity' or 'joint'; index is 1-based (K: 0 = base)."""
 
     name: str
     kind: str
@@ -56,6 +65,8 @@ class Name:
             return GLOBAL[self.symbol]
         if self.kind == "joint":
             return BASE if self.index == 0 else JOINT
+        if self.kind == "cavity":
+            return CAVITY[self.symbol]
         return BODY[self.symbol]
 
     @property
@@ -77,7 +88,8 @@ def parse_name(name: str, n_bodies: int, support: str) -> Name:
     if not match:
         raise StabmapError(
             f"unknown parameter name {name!r}; scannable names are omega, g, "
-            "m_k A_k C_k c_k s_k omega_k (body k = 1..n) and K_k (joint k, K_0 the base)"
+            "m_k A_k C_k c_k s_k omega_k (body k = 1..n), radius_k half_height_k density_k (the cavity "
+            "of body k) and K_k (joint k, K_0 the base)"
         )
     symbol, index = match.group(1), int(match.group(2))
     if symbol == "K":
@@ -88,7 +100,7 @@ def parse_name(name: str, n_bodies: int, support: str) -> Name:
         return Name(name, "joint", symbol, index)
     if not 1 <= index <= n_bodies:
         raise StabmapError(f"{name!r}: bodies are numbered 1..{n_bodies}")
-    return Name(name, "body", symbol, index)
+    return Name(name, "cavity" if symbol in CAVITY else "body", symbol, index)
 
 
 def check_value(where: str, value, info: ParameterInfo) -> float:

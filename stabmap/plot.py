@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -92,7 +93,7 @@ def plot_atlas(ds: xr.Dataset, path: str | Path, *, x: str | None = None, y: str
         for v in present
     ]
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, title="N_c")
-    title = ds.attrs.get("title", "stabmap atlas")
+    title = textwrap.fill(ds.attrs.get("title", "stabmap atlas"), 70)
     if fixed:
         title += "\n" + ", ".join(f"{k} = {v:.4g} {ds[k].attrs.get('units', '')}".strip() for k, v in fixed.items())
     ax.set_title(title, fontsize=10)
@@ -180,7 +181,7 @@ def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | N
     units = lower.attrs.get("units", "")
     ax.set_ylabel(f"{along} [{units}]" if units else along)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    title = ds.attrs.get("title", "stabmap critical values") + f"\nstable {along} (white: unstable); ends to rtol {ds.attrs['critical_rtol']:g}"
+    title = textwrap.fill(ds.attrs.get("title", "stabmap critical values"), 70) + f"\nstable {along} (white: unstable); ends to rtol {ds.attrs['critical_rtol']:g}"
     if chosen:
         title += "; " + ", ".join(f"{k} = {v:.4g}" for k, v in chosen.items())
     ax.set_title(title, fontsize=10)

@@ -6,7 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .parameters import BODY_COLUMNS, parse_name
+from . import liquid
+from .parameters import BODY_COLUMNS, SCANNABLE_CAVITY, parse_name
 from .scene import Scene
 
 
@@ -65,14 +66,29 @@ def point_arrays(scene: Scene, values: dict[str, np.ndarray]) -> PointArrays:
                     body[..., k, 5] = value
         elif name.kind == "joint":
             joint[..., name.index] = value
-        else:
+        elif name.kind == "body":
             body[..., name.index - 1, BODY_COLUMNS.index(name.symbol)] = value
+    E = np.broadcast_to(E0, shape + E0.shape)
+    kappa = np.broadcast_to(kappa0, shape + kappa0.shape)
+    if any(b.cavity is not None for b in scene.bodies):
+        E, kappa = E.copy(), kappa.copy()
+        for k, b in enumerate(scene.bodies):
+            if b.cavity is None:
+                continue
+            sizes = {}
+            if b.cavity.geometric:
+                sizes = {key: np.broadcast_to(arrays.get(f"{key}_{k + 1}", getattr(b.cavity, key)), shape) for key in SCANNABLE_CAVITY}
+            # Modes after the explicit fluid modes; apply() also updates the body's columns in place.
+            Ek, kappak = liquid.apply(b.cavity, body[..., k, :], sizes)
+            first = len(b.E)
+            E[..., k, first : first + Ek.shape[-1]] = Ek
+            kappa[..., k, first : first + Ek.shape[-1]] = kappak
     return PointArrays(
         body=body.reshape(npts, scene.n, 6),
         joint=joint.reshape(npts, scene.n),
         g=g.reshape(npts),
-        E=np.ascontiguousarray(np.broadcast_to(E0, (npts,) + E0.shape)),
-        kappa=np.ascontiguousarray(np.broadcast_to(kappa0, (npts,) + kappa0.shape)),
+        E=np.ascontiguousarray(E.reshape((npts,) + E0.shape)),
+        kappa=np.ascontiguousarray(kappa.reshape((npts,) + kappa0.shape)),
         nmodes=scene.nmodes,
         free=scene.free,
     )

@@ -12,13 +12,15 @@ from pathlib import Path
 
 import numpy as np
 
+from . import liquid
 from .errors import StabmapError
-from .parameters import BASE, BODY, GLOBAL, JOINT, ParameterInfo, check_value, parse_name
+from .liquid import Cavity
+from .parameters import BASE, BODY, GLOBAL, JOINT, SCANNABLE_CAVITY, ParameterInfo, check_value, parse_name
 
 SUPPORTS = ("fixed", "free")
 DEFAULT_G = 9.81
 _TOP_KEYS = {"title", "support", "g", "omega", "joints", "K_0", "bodies", "grid"}
-_BODY_KEYS = {"m", "A", "C", "c", "s", "omega", "fluid"}
+_BODY_KEYS = {"m", "A", "C", "c", "s", "omega", "fluid", "cavity"}
 _FLUID_KEYS = {"E", "kappa"}
 _AXIS_KEYS = {"start", "stop", "num", "scale", "values"}
 _KAPPA = ParameterInfo("kappa", "1", "", None, False)
@@ -37,6 +39,7 @@ class Body:
     omega: float | None = None  # None: the scene's common omega
     E: tuple[float, ...] = ()  # retained liquid modes [kg m^2]
     kappa: tuple[float, ...] = ()  # their frequency parameters [1]; lambda_l = 2 omega / kappa_l
+    cavity: Cavity | None = None  # modes from geometry or a table, after the explicit ones
 
 
 @dataclass(frozen=True)
@@ -75,7 +78,7 @@ class Scene:
 
     @property
     def nmodes(self) -> np.ndarray:
-        return np.array([len(b.E) for b in self.bodies], dtype=np.int64)
+        return np.array([len(b.E) + liquid.n_modes(b.cavity) for b in self.bodies], dtype=np.int64)
 
     @property
     def degree(self) -> int:
@@ -106,6 +109,8 @@ class Scene:
                 out.append(f"omega = {b.omega!r}")
             if b.E:
                 out.append(f"fluid = {{ E = {_toml_list(b.E)}, kappa = {_toml_list(b.kappa)} }}")
+            if b.cavity is not None:
+                out.append(b.cavity.to_toml())
         if self.grid:
             out += ["", "[grid]"]
             for a in self.grid:
@@ -130,19 +135,19 @@ def load(path: str | Path) -> Scene:
         raise StabmapError(f"scene file {str(path)!r} does not exist") from None
     except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
         raise StabmapError(f"cannot read scene file {str(path)!r}: {exc}") from None
-    return loads(text, source=str(path))
+    return loads(text, source=str(path), base_dir=path.parent)
 
 
-def loads(text: str, source: str = "<scene>") -> Scene:
-    """Parse and validate scene TOML text."""
+def loads(text: str, source: str = "<scene>", base_dir: str | Path | None = None) -> Scene:
+    """Parse and validate scene TOML text; relative file names in it are taken from ``base_dir``."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise StabmapError(f"{source}: TOML syntax error: {exc}") from None
-    return from_dict(data)
+    return from_dict(data, base_dir)
 
 
-def from_dict(data: dict) -> Scene:
+def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
     """Validate a scene given as a dict with the TOML layout."""
     _no_unknown(data, _TOP_KEYS, "scene")
     support = data.get("support", "fixed")
@@ -152,7 +157,8 @@ def from_dict(data: dict) -> Scene:
     if not isinstance(raw_bodies, list) or not raw_bodies:
         raise StabmapError("bodies is missing: add at least one [[bodies]] table (body 1 at the bottom)")
     n = len(raw_bodies)
-    bodies = tuple(_body(raw, k + 1, n) for k, raw in enumerate(raw_bodies))
+    base_dir = None if base_dir is None else Path(base_dir)
+    bodies = tuple(_body(raw, k + 1, n, base_dir) for k, raw in enumerate(raw_bodies))
     title = data.get("title", "")
     if not isinstance(title, str):
         raise StabmapError(f"title must be a string, got {title!r}")
@@ -178,6 +184,7 @@ def from_dict(data: dict) -> Scene:
     grid = _grid(data.get("grid", {}), n, support)
     scene = Scene(bodies=bodies, support=support, omega=omega, g=g, joints=joints, K_0=K_0, title=title, grid=grid)
     _check_omega(scene)
+    _check_cavities(scene)
     return scene
 
 
@@ -189,9 +196,12 @@ def _no_unknown(table: dict, allowed: set, where: str) -> None:
         raise StabmapError(f"{where}: unknown key {unknown[0]!r}; allowed keys are {', '.join(sorted(allowed))}")
 
 
-def _body(raw: dict, k: int, n: int) -> Body:
+def _body(raw: dict, k: int, n: int, base_dir: Path | None) -> Body:
     where = f"bodies[{k}]"
     _no_unknown(raw, _BODY_KEYS, where)
+    cavity = liquid.parse(raw["cavity"], f"{where}.cavity", base_dir) if "cavity" in raw else None
+    # A dry shell may be massless when the engine adds the liquid (Kelvin's spinning shell).
+    dry = cavity is not None and not cavity.liquid_in_body
     values = {}
     for key in ("m", "A", "C", "c", "s"):
         if key not in raw:
@@ -199,7 +209,10 @@ def _body(raw: dict, k: int, n: int) -> Body:
                 values[key] = 0.0  # the top body has no upper joint
                 continue
             raise StabmapError(f"{where}.{key} is missing ({BODY[key].long_name.format(k=k)} [{BODY[key].units}])")
-        values[key] = check_value(f"{where}.{key}", raw[key], BODY[key])
+        info = BODY[key]
+        if dry and key in ("m", "A"):
+            info = ParameterInfo(info.symbol, info.units, info.long_name, 0.0, False)
+        values[key] = check_value(f"{where}.{key}", raw[key], info)
     omega = raw.get("omega")
     if omega is not None:
         omega = check_value(f"{where}.omega", omega, BODY["omega"])
@@ -218,7 +231,7 @@ def _body(raw: dict, k: int, n: int) -> Body:
         for i, v in enumerate(kappa):
             if v == 0.0:
                 raise StabmapError(f"{where}.fluid.kappa[{i + 1}] must be nonzero (lambda = 2 omega / kappa)")
-    return Body(omega=omega, E=E, kappa=kappa, **values)
+    return Body(omega=omega, E=E, kappa=kappa, cavity=cavity, **values)
 
 
 def _grid(raw: dict, n: int, support: str) -> tuple[Axis, ...]:
@@ -276,6 +289,26 @@ def _check_omega(scene: Scene) -> None:
         raise StabmapError(f"omega is missing: set the common rate omega, bodies[{k}].omega, or scan omega in [grid]")
 
 
+def _check_cavities(scene: Scene) -> None:
+    axes = {a.name: a.array for a in scene.grid}
+    for k, b in enumerate(scene.bodies, start=1):
+        cav = b.cavity
+        for key in SCANNABLE_CAVITY:
+            if f"{key}_{k}" in axes and (cav is None or not cav.geometric):
+                raise StabmapError(
+                    f"grid axis '{key}_{k}': body {k} has no spheroid or cylinder cavity to size; "
+                    f'add bodies[{k}].cavity = {{ shape = "cylinder", ... }} or remove the axis'
+                )
+        if cav is None:
+            continue
+        extremes = {}
+        for key in ("m", "A", "C") + (SCANNABLE_CAVITY if cav.geometric else ()):
+            fixed = getattr(b, key) if key in BODY else getattr(cav, key)
+            values = axes.get(f"{key}_{k}", np.array([fixed]))
+            extremes[key] = (float(values.min()), float(values.max()))
+        liquid.check_body(cav, f"bodies[{k}]", extremes)
+
+
 def fixed_values(scene: Scene) -> dict[str, float]:
     """Every scalar parameter of the scene that is not a grid axis, by its scannable name."""
     names = {a.name for a in scene.grid}
@@ -289,6 +322,9 @@ def fixed_values(scene: Scene) -> dict[str, float]:
             out[f"{key}_{k}"] = getattr(b, key)
         if b.omega is not None:
             out[f"omega_{k}"] = b.omega
+        if b.cavity is not None and b.cavity.geometric:
+            for key in SCANNABLE_CAVITY:
+                out[f"{key}_{k}"] = getattr(b.cavity, key)
     if not scene.free:
         out["K_0"] = scene.K_0
     for j, K in enumerate(scene.joint_stiffness(), start=1):

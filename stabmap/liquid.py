@@ -1,0 +1,257 @@
+"""The liquid a body carries: its cavity as a scene declares it, and its modes at every grid point.
+
+A scene's body may carry ``cavity = {shape = ..., ...}`` beside or instead of
+explicit ``fluid`` modes. Geometric cavities (spheroid, cylinder) give their
+modes from ``stabmap.cavity``; their radius, half_height and density may be
+grid axes (``radius_k``, ``half_height_k``, ``density_k``). A table gives the
+modes directly. ``apply`` turns the cavity into the kernels' per-point E, kappa
+and body columns.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import cavity
+from .errors import StabmapError
+from .parameters import CAVITY, check_value
+
+_KEYS = {
+    "spheroid": {"shape", "radius", "half_height", "density", "modes", "tail", "liquid_in_body", "centre"},
+    "cylinder": {"shape", "radius", "half_height", "density", "modes", "tail", "liquid_in_body", "centre"},
+    "table": {"shape", "E", "kappa", "lambda_over_omega", "file", "inertia", "deficit"},
+}
+_CACHE_LIMIT = 200_000
+_scaled: dict[tuple[str, int, float], tuple[np.ndarray, np.ndarray, float]] = {}
+
+
+@dataclass(frozen=True)
+class Cavity:
+    """A liquid-filled cavity of one body; lengths [m], density [kg m^-3], inertias [kg m^2]."""
+
+    shape: str  # "spheroid" | "cylinder" | "table"
+    radius: float = 0.0  # equatorial semi-axis (spheroid) or radius (cylinder)
+    half_height: float = 0.0  # polar semi-axis (spheroid) or half the height (cylinder)
+    density: float = 0.0
+    modes: int = 0  # modes kept (largest E first)
+    tail: bool = True  # lump the remaining modes into A (geometric shapes; a table with deficit)
+    liquid_in_body: bool = True  # m, A, C of the body already include the frozen liquid
+    centre: float = 0.0  # cavity centre above the lower joint O_k (liquid_in_body = false)
+    E: tuple[float, ...] = ()  # table
+    kappa: tuple[float, ...] = ()  # table
+    inertia: float | None = None  # table: the frozen liquid's transverse inertia, bounds sum(E)
+    deficit: float | None = None  # table: J_rigid - J_Zh; with it the tail is deficit - sum(E)
+
+    @property
+    def geometric(self) -> bool:
+        return self.shape != "table"
+
+    def to_toml(self) -> str:
+        if not self.geometric:
+            items = [("shape", '"table"'), ("E", _list(self.E)), ("kappa", _list(self.kappa))]
+            items += [(k, repr(v)) for k in ("inertia", "deficit") if (v := getattr(self, k)) is not None]
+        else:
+            items = [("shape", f'"{self.shape}"')] + [(k, repr(getattr(self, k))) for k in ("radius", "half_height", "density", "modes")]
+            items += [("tail", _bool(self.tail)), ("liquid_in_body", _bool(self.liquid_in_body))]
+            if not self.liquid_in_body:
+                items.append(("centre", repr(self.centre)))
+        return "cavity = { " + ", ".join(f"{k} = {v}" for k, v in items) + " }"
+
+
+def _list(xs) -> str:
+    return "[" + ", ".join(repr(float(x)) for x in xs) + "]"
+
+
+def _bool(b: bool) -> str:
+    return "true" if b else "false"
+
+
+def parse(raw, where: str, base_dir: Path | None) -> Cavity:
+    """Validate a body's ``cavity`` table; ``where`` names it in errors (e.g. ``bodies[2].cavity``)."""
+    if not isinstance(raw, dict):
+        raise StabmapError(f"{where} must be a table such as {{ shape = \"cylinder\", radius = 0.05, half_height = 0.1, density = 1000 }}")
+    shape = raw.get("shape")
+    if shape not in _KEYS:
+        raise StabmapError(f'{where}.shape must be "spheroid", "cylinder" or "table", got {shape!r}')
+    unknown = sorted(set(raw) - _KEYS[shape])
+    if unknown:
+        raise StabmapError(f"{where}: unknown key {unknown[0]!r} for shape {shape!r}; allowed keys are {', '.join(sorted(_KEYS[shape]))}")
+    if shape == "table":
+        return _table(raw, where, base_dir)
+    sizes = {}
+    for key in ("radius", "half_height", "density"):
+        if key not in raw:
+            raise StabmapError(f"{where}.{key} is missing [{CAVITY[key].units}]; a {shape} needs radius, half_height and density")
+        sizes[key] = check_value(f"{where}.{key}", raw[key], CAVITY[key])
+    try:
+        modes = cavity.check_shape(shape, raw.get("modes"))
+    except StabmapError as exc:
+        raise StabmapError(f"{where}.{exc}") from None
+    flags = {}
+    for key in ("tail", "liquid_in_body"):
+        flags[key] = raw.get(key, True)
+        if not isinstance(flags[key], bool):
+            raise StabmapError(f"{where}.{key} must be true or false, got {flags[key]!r}")
+    if "centre" in raw and flags["liquid_in_body"]:
+        raise StabmapError(f"{where}.centre is used only with liquid_in_body = false (the body's m, A, C, c already place the liquid); remove it")
+    centre = check_value(f"{where}.centre", raw.get("centre", 0.0), CAVITY["centre"])
+    return Cavity(shape=shape, modes=modes, centre=centre, **sizes, **flags)
+
+
+def _table(raw: dict, where: str, base_dir: Path | None) -> Cavity:
+    if "file" in raw:
+        if {"E", "kappa", "lambda_over_omega"} & set(raw):
+            raise StabmapError(f"{where}: give the modes either in file or as E and kappa, not both")
+        columns = _read_table(raw["file"], f"{where}.file", base_dir)
+    else:
+        columns = {k: raw[k] for k in ("E", "kappa", "lambda_over_omega") if k in raw}
+    if "kappa" in columns and "lambda_over_omega" in columns:
+        raise StabmapError(f"{where}: give kappa or lambda_over_omega (= 2 / kappa), not both")
+    if "E" not in columns or not ({"kappa", "lambda_over_omega"} & set(columns)):
+        raise StabmapError(f"{where}: a table needs E and kappa (or lambda_over_omega), one value per mode")
+    freq_key = "kappa" if "kappa" in columns else "lambda_over_omega"
+    E, freq = columns["E"], columns[freq_key]
+    if not isinstance(E, list) or not isinstance(freq, list) or not E:
+        raise StabmapError(f"{where}: E and {freq_key} must be non-empty lists of numbers")
+    if len(E) != len(freq):
+        raise StabmapError(f"{where}: E has {len(E)} values but {freq_key} has {len(freq)}; give one per mode")
+    E = tuple(check_value(f"{where}.E[{i + 1}]", v, CAVITY["E"]) for i, v in enumerate(E))
+    freq = [check_value(f"{where}.{freq_key}[{i + 1}]", v, CAVITY["kappa"]) for i, v in enumerate(freq)]
+    if freq_key == "lambda_over_omega":
+        bad = [i for i, v in enumerate(freq) if v == 0.0 or abs(v) >= 2.0]
+        if bad:
+            raise StabmapError(f"{where}.lambda_over_omega[{bad[0] + 1}] = {freq[bad[0]]}: a cavity mode has 0 < |lambda/omega| < 2")
+        freq = [2.0 / v for v in freq]
+    bad = [i for i, v in enumerate(freq) if abs(v) <= 1.0]
+    if bad:
+        raise StabmapError(f"{where}.kappa[{bad[0] + 1}] = {freq[bad[0]]}: a cavity mode has |kappa| > 1")
+    extra = {k: check_value(f"{where}.{k}", raw[k], CAVITY["E"]) for k in ("inertia", "deficit") if k in raw}
+    total = math.fsum(E)
+    if "inertia" in extra and total > extra["inertia"]:
+        raise StabmapError(f"{where}: sum(E) = {total:g} exceeds the frozen liquid's transverse inertia {extra['inertia']:g}; the modes cannot hold more than the liquid")
+    if "deficit" in extra and total > extra["deficit"]:
+        raise StabmapError(f"{where}: sum(E) = {total:g} exceeds deficit = {extra['deficit']:g} (the sum over all modes); check both")
+    return Cavity(shape="table", E=E, kappa=tuple(freq), tail="deficit" in extra, **extra)
+
+
+def _read_table(name, where: str, base_dir: Path | None) -> dict:
+    """Columns of a CSV (header row naming E and kappa or lambda_over_omega) or TOML file."""
+    if not isinstance(name, str):
+        raise StabmapError(f"{where} must be a path string, got {name!r}")
+    path = Path(name)
+    if not path.is_absolute() and base_dir is not None:
+        path = base_dir / path
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise StabmapError(f"{where}: cannot read {str(path)!r}: {exc.strerror or exc}") from None
+    if path.suffix.lower() == ".toml":
+        try:
+            return tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise StabmapError(f"{where}: TOML syntax error in {str(path)!r}: {exc}") from None
+    rows = list(csv.reader(line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")))
+    if not rows:
+        raise StabmapError(f"{where}: {str(path)!r} is empty; give a header row (E,kappa) and one row per mode")
+    header = [h.strip() for h in rows[0]]
+    columns: dict[str, list] = {h: [] for h in header}
+    for number, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise StabmapError(f"{where}: {str(path)!r} row {number} has {len(row)} fields; the header has {len(header)}")
+        for h, cell in zip(header, row):
+            try:
+                columns[h].append(float(cell))
+            except ValueError:
+                raise StabmapError(f"{where}: {str(path)!r} row {number}, column {h}: {cell.strip()!r} is not a number") from None
+    return columns
+
+
+def n_modes(c: Cavity | None) -> int:
+    if c is None:
+        return 0
+    return c.modes if c.geometric else len(c.E)
+
+
+def check_body(c: Cavity, where: str, extremes: dict[str, tuple[float, float]]) -> None:
+    """A body whose m, A, C include the liquid must hold at least the frozen liquid at every grid point.
+
+    The grid is an outer product and the liquid's mass and inertias grow with each
+    of radius, half_height and density, so the worst point pairs each body value's
+    smallest grid value with every cavity size's largest.
+    """
+    if not c.liquid_in_body:
+        return
+    if not c.geometric:
+        total = math.fsum(c.E)
+        if total > extremes["A"][0]:
+            raise StabmapError(f"{where}: sum(E) = {total:g} exceeds A = {extremes['A'][0]:g}, which includes the frozen liquid; the modes cannot hold more than the liquid")
+        return
+    big = {k: extremes[k][1] for k in ("radius", "half_height", "density")}
+    m_f = float(cavity.frozen_mass(c.shape, **big))
+    J_f, Jz_f = (float(v) for v in cavity.frozen_inertia(c.shape, **big))
+    for key, need in (("m", m_f), ("A", J_f), ("C", Jz_f)):
+        if extremes[key][0] < need:
+            raise StabmapError(
+                f"{where}: {key} = {extremes[key][0]:g} is less than the frozen liquid's {need:g} "
+                f"(at radius {big['radius']:g}, half_height {big['half_height']:g}, density {big['density']:g}); "
+                f"{key} must include the liquid, or set liquid_in_body = false to have it added"
+            )
+
+
+def scaled(shape: str, q: np.ndarray, n: int):
+    """(E / (density radius^5), kappa, tail / (density radius^5)) at aspect ratios q, memoised per value."""
+    q = np.asarray(q, dtype=np.float64)
+    unique, inverse = np.unique(q, return_inverse=True)
+    # Atlas chunks run on threads: read each entry once and never rely on it staying cached.
+    found = {float(v): _scaled.get((shape, n, float(v))) for v in unique}
+    missing = np.array([v for v, row in found.items() if row is None])
+    if len(missing):
+        e, kappa = cavity.scaled_modes(shape, missing, n)
+        deficit = cavity.scaled_deficit(shape, missing)
+        if len(_scaled) + len(missing) > _CACHE_LIMIT:
+            _scaled.clear()
+        for i, v in enumerate(missing.tolist()):
+            found[v] = _scaled[(shape, n, v)] = (e[i], kappa[i], float(deficit[i] - math.fsum(e[i])))
+    rows = [found[float(v)] for v in unique]
+    e = np.stack([r[0] for r in rows])[inverse]
+    kappa = np.stack([r[1] for r in rows])[inverse]
+    tail = np.array([r[2] for r in rows])[inverse]
+    return e.reshape(q.shape + (n,)), kappa.reshape(q.shape + (n,)), tail.reshape(q.shape)
+
+
+def apply(c: Cavity, body: np.ndarray, sizes: dict[str, np.ndarray]):
+    """Modes of the cavity at every point: returns (E, kappa), each (..., L), and updates ``body``.
+
+    ``body`` is the (..., 6) array of one body's columns m, A, C, c, s, omega at
+    the points; ``sizes`` holds radius, half_height and density broadcast to the
+    points. The tail is subtracted from A; a liquid not in the body is added to
+    m, A, C and moves c.
+    """
+    if not c.geometric:
+        E = np.broadcast_to(np.array(c.E), body.shape[:-1] + (len(c.E),))
+        kappa = np.broadcast_to(np.array(c.kappa), E.shape)
+        if c.tail:
+            body[..., 1] -= c.deficit - math.fsum(c.E)
+        return E, kappa
+    a, h, rho = sizes["radius"], sizes["half_height"], sizes["density"]
+    e, kappa, tail = scaled(c.shape, h / a, c.modes)
+    unit = rho * a**5
+    if not c.liquid_in_body:
+        m_f = cavity.frozen_mass(c.shape, a, h, rho)
+        J_f, Jz_f = cavity.frozen_inertia(c.shape, a, h, rho)
+        m, A, C, cm = (body[..., i].copy() for i in range(4))
+        total = m + m_f
+        new_c = (m * cm + m_f * c.centre) / total
+        body[..., 0] = total
+        body[..., 1] = A + m * (cm - new_c) ** 2 + J_f + m_f * (c.centre - new_c) ** 2
+        body[..., 2] = C + Jz_f
+        body[..., 3] = new_c
+    if c.tail:
+        body[..., 1] -= unit * tail
+    return unit[..., None] * e, kappa
