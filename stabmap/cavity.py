@@ -18,7 +18,7 @@ from scipy.optimize import elementwise
 from .errors import StabmapError
 
 SHAPES = ("spheroid", "cylinder")
-DEFAULT_MODES = 4  # cylinder modes kept; chosen from scripts/bench_truncation.py (BENCHMARKS.md)
+DEFAULT_MODES = 8  # cylinder modes kept with the tail: 1e-4 on the critical spin (scripts/bench_truncation.py, BENCHMARKS.md)
 MAX_MODES = 64
 
 

@@ -48,3 +48,13 @@ def test_bench_conditioning_quick(capsys):
         exact, blur15, blur13 = r["shares"]
         assert 0 <= blur13 <= blur15 <= exact <= 1  # wider enclosures can only decide fewer points
     assert "| n | modes | degree |" in capsys.readouterr().out
+
+
+def test_bench_truncation_quick(capsys):
+    out = runpy.run_path(str(SCRIPTS / "bench_truncation.py"))["main"](["--quick"])
+    rows = {(r["N"], r["tail"]): r for r in out["rows"]}
+    assert set(rows) == {(N, t) for N in (1, 2, 4, 8) for t in (True, False)}
+    assert rows[(8, True)]["max_err"] == 0.0  # the reference against itself
+    # More modes never make the lumped-tail answer worse here, and 4 modes are within 1 % everywhere.
+    assert rows[(4, True)]["max_err"] <= rows[(1, True)]["max_err"] and rows[(4, True)]["off_1pct"] == 0
+    assert "| scene | N | tail |" in capsys.readouterr().out
