@@ -42,6 +42,7 @@ CAVITY = {
     "kappa": ParameterInfo("kappa", "1", "frequency parameter of a liquid mode", None, False),
 }
 SCANNABLE_CAVITY = ("radius", "half_height", "density")
+EVERY_BODY = ("m", "A", "C", "c", "s")  # grid axes that set one parameter of every body at once (identical bodies)
 GLOBAL = {
     "omega": ParameterInfo("omega", "rad s-1", "common spin rate", None, False),
     "g": ParameterInfo("g", "m s-2", "gravitational acceleration", None, False),
@@ -52,7 +53,11 @@ _NAME = re.compile(r"^(m|A|C|c|s|omega|K|radius|half_height|density)_(\d+)$")
 
 @dataclass(frozen=True)
 class Name:
-    """A parsed parameter name: kind is 'global', 'body', 'cavity' or 'joint'; index is 1-based (K: 0 = base)."""
+    """A parsed parameter name: kind is 'global', 'body', 'cavity', 'joint', 'every_body' or 'every_joint'.
+
+    index is 1-based (K: 0 = base); 0 for the common axes of every body (``m``, ``A``, ``C``, ``c``, ``s``)
+    and of every joint between bodies (``K``, which leaves the base joint K_0 alone).
+    """
 
     name: str
     kind: str
@@ -63,8 +68,8 @@ class Name:
     def info(self) -> ParameterInfo:
         if self.kind == "global":
             return GLOBAL[self.symbol]
-        if self.kind == "joint":
-            return BASE if self.index == 0 else JOINT
+        if self.kind in ("joint", "every_joint"):
+            return BASE if self.kind == "joint" and self.index == 0 else JOINT
         if self.kind == "cavity":
             return CAVITY[self.symbol]
         return BODY[self.symbol]
@@ -75,6 +80,10 @@ class Name:
 
     @property
     def long_name(self) -> str:
+        if self.kind == "every_body":
+            return self.info.long_name.replace("body {k}", "every body")
+        if self.kind == "every_joint":
+            return "stiffness of every joint between bodies (K_1..K_n-1)"
         return self.info.long_name.format(k=self.index)
 
 
@@ -84,12 +93,18 @@ def parse_name(name: str, n_bodies: int, support: str) -> Name:
         if name == "g" and support == "free":
             raise StabmapError("grid axis 'g' has no effect with support = \"free\" (gravity exerts no torque about the centre of mass); remove it")
         return Name(name, "global", name, 0)
+    if name in EVERY_BODY:
+        return Name(name, "every_body", name, 0)
+    if name == "K":
+        if n_bodies < 2:
+            raise StabmapError("grid axis 'K' (every joint) needs two or more bodies; a single body has no joint between bodies")
+        return Name(name, "every_joint", name, 0)
     match = _NAME.match(name)
     if not match:
         raise StabmapError(
             f"unknown parameter name {name!r}; scannable names are omega, g, "
             "m_k A_k C_k c_k s_k omega_k (body k = 1..n), radius_k half_height_k density_k (the cavity "
-            "of body k) and K_k (joint k, K_0 the base)"
+            "of body k), K_k (joint k, K_0 the base), and m A C c s K for every body or joint at once"
         )
     symbol, index = match.group(1), int(match.group(2))
     if symbol == "K":

@@ -54,16 +54,21 @@ def point_arrays(scene: Scene, values: dict[str, np.ndarray]) -> PointArrays:
     joint = np.broadcast_to(joint0, shape + joint0.shape).copy()
     g = np.full(shape, g0)
     own_omega = [b.omega is not None for b in scene.bodies]
-    # A common-omega axis first, so that an omega_k axis for the same body wins.
-    for key in sorted(arrays, key=lambda key: key != "omega"):
-        value = arrays[key]
-        name = parse_name(key, scene.n, scene.support)
+    names = {key: parse_name(key, scene.n, scene.support) for key in arrays}
+    # Axes common to every body or joint first, so that an axis of one body or joint (omega_2, C_2, K_1) wins there.
+    common = {"omega", "every_body", "every_joint"}
+    for key in sorted(arrays, key=lambda key: key not in common and names[key].kind not in common):
+        value, name = arrays[key], names[key]
         if name.kind == "global" and name.symbol == "g":
             g[...] = value
         elif name.kind == "global":
             for k in range(scene.n):
                 if not own_omega[k]:
                     body[..., k, 5] = value
+        elif name.kind == "every_body":
+            body[..., BODY_COLUMNS.index(name.symbol)] = value[..., None]
+        elif name.kind == "every_joint":
+            joint[..., 1:] = value[..., None]
         elif name.kind == "joint":
             joint[..., name.index] = value
         elif name.kind == "body":

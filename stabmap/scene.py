@@ -15,7 +15,7 @@ import numpy as np
 from . import liquid
 from .errors import StabmapError
 from .liquid import Cavity
-from .parameters import BASE, BODY, GLOBAL, JOINT, SCANNABLE_CAVITY, ParameterInfo, check_value, parse_name
+from .parameters import BASE, BODY, EVERY_BODY, GLOBAL, JOINT, SCANNABLE_CAVITY, ParameterInfo, check_value, parse_name
 
 SUPPORTS = ("fixed", "free")
 DEFAULT_G = 9.81
@@ -304,7 +304,7 @@ def _check_cavities(scene: Scene) -> None:
         extremes = {}
         for key in ("m", "A", "C") + (SCANNABLE_CAVITY if cav.geometric else ()):
             fixed = getattr(b, key) if key in BODY else getattr(cav, key)
-            values = axes.get(f"{key}_{k}", np.array([fixed]))
+            values = axes.get(f"{key}_{k}", axes.get(key, np.array([fixed])) if key in EVERY_BODY else np.array([fixed]))
             extremes[key] = (float(values.min()), float(values.max()))
         liquid.check_body(cav, f"bodies[{k}]", extremes)
 
@@ -318,8 +318,9 @@ def fixed_values(scene: Scene) -> dict[str, float]:
     if not scene.free and "g" not in names:
         out["g"] = scene.g
     for k, b in enumerate(scene.bodies, start=1):
-        for key in ("m", "A", "C", "c", "s"):
-            out[f"{key}_{k}"] = getattr(b, key)
+        for key in EVERY_BODY:
+            if key not in names:
+                out[f"{key}_{k}"] = getattr(b, key)
         if b.omega is not None:
             out[f"omega_{k}"] = b.omega
         if b.cavity is not None and b.cavity.geometric:
@@ -327,8 +328,9 @@ def fixed_values(scene: Scene) -> dict[str, float]:
                 out[f"{key}_{k}"] = getattr(b.cavity, key)
     if not scene.free:
         out["K_0"] = scene.K_0
-    for j, K in enumerate(scene.joint_stiffness(), start=1):
-        out[f"K_{j}"] = K
+    if "K" not in names:
+        for j, K in enumerate(scene.joint_stiffness(), start=1):
+            out[f"K_{j}"] = K
     return {k: v for k, v in out.items() if k not in names}
 
 
