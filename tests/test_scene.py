@@ -109,3 +109,38 @@ def test_omega_must_come_from_somewhere():
     text = GOOD.replace("omega = 50.0\n", "").replace("omega = { start = 1.0, stop = 200.0, num = 5 }\n", "")
     with pytest.raises(StabmapError, match="omega is missing"):
         loads_scene(text)
+
+
+def _three_bodies(grid: str) -> str:
+    body = "[[bodies]]\nm = 1.0\nA = 0.02\nC = 0.03\nc = 0.10\ns = 0.25\n"
+    return f'support = "fixed"\nomega = 40.0\njoints = [5.0, 6.0]\nK_0 = 7.0\n' + body * 3 + "[grid]\n" + grid
+
+
+def test_axes_for_every_body_and_every_joint():
+    from stabmap.points import point_arrays
+
+    scene = loads_scene(_three_bodies("C = { values = [0.01, 0.05] }\nK = { values = [0.0, 9.0] }\nA_2 = { values = [0.5] }\n"))
+    pa = point_arrays(scene, {"C": [0.05], "K": [9.0], "A_2": [0.5], "C_3": [0.07]})
+    assert pa.body[0, :, 2].tolist() == [0.05, 0.05, 0.07]  # C_3 wins over the common C on body 3
+    assert pa.body[0, :, 1].tolist() == [0.02, 0.5, 0.02]
+    assert pa.joint[0].tolist() == [7.0, 9.0, 9.0]  # K sets K_1 and K_2, never the base K_0
+    ds = stabmap.compute_atlas(scene, progress=False)
+    assert ds["C"].attrs["long_name"] == "axial moment of inertia of every body"
+    assert "every joint" in ds["K"].attrs["long_name"]
+    assert not {"C_1", "C_2", "C_3", "K_1", "K_2"} & set(ds.coords)  # no stale fixed values beside the axis
+    assert float(ds["K_0"]) == 7.0 and float(ds["A_1"]) == 0.02
+
+
+def test_common_axis_equals_setting_every_body():
+    scene = loads_scene(_three_bodies("m = { values = [0.5, 2.0] }\nomega = { values = [5.0, 50.0] }\n"))
+    ds = stabmap.compute_atlas(scene, progress=False)
+    assert (ds["n_complex_pairs"].sel(m=0.5) != ds["n_complex_pairs"].sel(m=2.0)).any()  # the axis matters here
+    for m in (0.5, 2.0):
+        one = loads_scene(_three_bodies("omega = { values = [5.0, 50.0] }\n").replace("m = 1.0", f"m = {m}"))
+        expected = stabmap.compute_atlas(one, progress=False)["n_complex_pairs"]
+        assert (ds["n_complex_pairs"].sel(m=m).values == expected.values).all()
+
+
+def test_every_joint_axis_needs_joints():
+    with pytest.raises(StabmapError, match="grid axis 'K' \\(every joint\\) needs two or more bodies"):
+        loads_scene('support = "fixed"\nomega = 1.0\n[[bodies]]\nm = 1.0\nA = 0.02\nC = 0.03\nc = 0.1\n[grid]\nK = { values = [1.0] }\n')
