@@ -16,7 +16,8 @@ Each case is a bundled scene (``stabmap atlas --example NAME``) with two grid ax
    boundaries are the real roots of the discriminant, as a polynomial in the ``along`` parameter,
    at which the closed-form count changes. They are drawn over the map (dense dotted curve), and
    ``--check`` requires the engine's boundaries and the closed form's to pair up one to one with
-   the same N_c on either side and to agree to RTOL relative.
+   the same N_c on either side and to agree to RTOL relative, and every point of the map to have
+   the closed form's N_c (exact rational arithmetic).
 4. Every case, closed form or not, is checked against the paper's printed determinant
    ((22), (29)-(32), (28); ``stabmap.paper.paper_polynomial``) in exact rational arithmetic: the N_c
    of every atlas point on the checked rows, and of both ends of every located boundary.
@@ -112,6 +113,12 @@ def closed_form_pairs_at(scene, case: Case, values: dict[str, np.ndarray]) -> np
     return np.array([paper.closed_form_pairs(paper.factors(ch, case.closed_form)) for ch in _chains(scene, values)])
 
 
+def grid_values(ds) -> dict[str, np.ndarray]:
+    """The atlas' axis values, shaped to broadcast over its grid (C order of ``n_complex_pairs``)."""
+    dims = list(ds["n_complex_pairs"].dims)
+    return {d: ds[d].values.reshape([-1 if i == j else 1 for j in range(len(dims))]) for i, d in enumerate(dims)}
+
+
 def paper_pairs_at(scene, values: dict[str, np.ndarray]) -> np.ndarray:
     """N_c of the paper's printed determinant, exactly, at every point (C order)."""
     return np.array([paper.complex_pairs(paper.paper_polynomial(ch)) for ch in _chains(scene, values)])
@@ -139,6 +146,16 @@ def check_case(case: Case, *, quick: bool, rows: int, out: Path | None) -> dict:
     row_scene = dataclasses.replace(scene, grid=tuple(a if a.name != other else Axis(other, tuple(float(v) for v in picks), "values") for a in scene.grid))
     crit = critical(row_scene, case.along, progress=False)
     problems, matched, worst = [], 0, 0.0
+    if case.closed_form is not None:
+        # The whole map against the closed form, point by point, in exact arithmetic.
+        expected = closed_form_pairs_at(scene, case, grid_values(ds)).reshape(ds["n_complex_pairs"].shape)
+        wrong = np.argwhere(expected != ds["n_complex_pairs"].values)
+        dims = ds["n_complex_pairs"].dims
+        for idx in wrong[:5]:
+            at = ", ".join(f"{d} = {ds[d].values[i]:.10g}" for d, i in zip(dims, idx))
+            problems.append(f"{case.name}: {at}: engine N_c = {ds['n_complex_pairs'].values[tuple(idx)]}, closed form {expected[tuple(idx)]}")
+        if len(wrong) > 5:
+            problems.append(f"{case.name}: {len(wrong)} points of the map disagree with the closed form in all")
     scan = next(a.array for a in scene.grid if a.name == case.along)
     for row in picks:
         found = engine_boundaries(crit, other, row)
@@ -174,6 +191,7 @@ def check_case(case: Case, *, quick: bool, rows: int, out: Path | None) -> dict:
         "case": case, "points": int(ds["n_complex_pairs"].size), "atlas_s": t_atlas, "rows": len(picks),
         "boundaries": sum(len(engine_boundaries(crit, other, r)) for r in picks), "matched": matched,
         "worst_rel": worst, "problems": problems,
+        "map_agree": None if case.closed_form is None else int(ds["n_complex_pairs"].size - len(wrong)),
     }
 
 
@@ -226,7 +244,7 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--check", action="store_true", help="exit 1 if any boundary or label disagrees with the paper")
     p.add_argument("--quick", action="store_true", help="coarse grids (60 x 40) and 3 rows per case")
     p.add_argument("--case", action="append", choices=[c.name for c in CASES], help="only this case (repeatable)")
-    p.add_argument("--rows", type=int, help="rows of the second axis checked per case (default 7, quick 3)")
+    p.add_argument("--rows", type=int, help="rows of the second axis checked per case (default 15, quick 3)")
     p.add_argument("--out", type=Path, default=Path("paper-cases"), help="directory for the figures (default paper-cases/)")
     p.add_argument("--no-figures", action="store_true", help="check only")
     p.add_argument("--golden", type=Path, metavar="DIR", help="write the golden atlases to DIR and stop")
@@ -238,7 +256,7 @@ def main(argv: list[str] | None = None) -> dict:
     out = None if args.no_figures else args.out
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
-    rows = args.rows or (3 if args.quick else 7)
+    rows = args.rows or (3 if args.quick else 15)
     if rows < 1:
         p.error("--rows must be >= 1")
     cases = [c for c in CASES if not args.case or c.name in args.case]
@@ -248,12 +266,13 @@ def main(argv: list[str] | None = None) -> dict:
     print(f"# boundaries located to 1e-10 relative by stabmap.critical; closed form must agree to {RTOL:g}; every label on")
     print("# the checked rows and both ends of every boundary are compared with the paper's determinant in exact arithmetic")
     print()
-    print("| case | paper | points | rows | boundaries located | closed form: matched, worst rel. diff | disagreements |")
-    print("|---|---|---|---|---|---|---|")
+    print("| case | paper | points | map points = closed form | rows | boundaries located | closed form: matched, worst rel. diff | disagreements |")
+    print("|---|---|---|---|---|---|---|---|")
     for r in results:
         c = r["case"]
         cf = f"{r['matched']}, {r['worst_rel']:.1e}" if c.closed_form else "none exists"
-        print(f"| {c.name} | {c.equation} | {r['points']} | {r['rows']} | {r['boundaries']} | {cf} | {len(r['problems'])} |")
+        agree = "-" if r["map_agree"] is None else f"{r['map_agree']}"
+        print(f"| {c.name} | {c.equation} | {r['points']} | {agree} | {r['rows']} | {r['boundaries']} | {cf} | {len(r['problems'])} |")
     problems = [msg for r in results for msg in r["problems"]]
     for msg in problems:
         print(f"DISAGREES: {msg}")

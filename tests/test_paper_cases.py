@@ -171,8 +171,7 @@ def test_golden_atlas_recomputes_cell_for_cell(path):
 def test_golden_atlas_matches_the_paper_exactly(path):
     golden = xr.load_dataset(path)
     scene, case = loads(golden.attrs["scene"]), CASES[path.stem]
-    dims = list(golden["n_complex_pairs"].dims)
-    values = {d: golden[d].values.reshape([-1 if i == j else 1 for j in range(len(dims))]) for i, d in enumerate(dims)}
+    values = SCRIPT["grid_values"](golden)
     if case.closed_form is not None:
         expected = SCRIPT["closed_form_pairs_at"](scene, case, values)
     else:
