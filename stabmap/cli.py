@@ -202,8 +202,10 @@ def _print_intervals(ds, limit: int = 8) -> None:
 def _cmd_examples(args) -> None:
     from .examples import example, example_names
 
-    for name in example_names():
-        print(f"{name:<18} {example(name).title}")
+    names = example_names()
+    width = max(map(len, names))
+    for name in names:
+        print(f"{name:<{width}}  {example(name).title}")
 
 
 def parser() -> argparse.ArgumentParser:
