@@ -18,13 +18,14 @@ if getattr(_kernels, "STABMAP_KERNELS", None) != 1:
         "(an unrelated PyPI package has the same name); uninstall it: pip uninstall kernels"
     )
 
+from . import accessor  # noqa: E402,F401  (registers the ds.stabmap accessor)
 from . import cavity  # noqa: E402
 from .atlas import compute as compute_atlas  # noqa: E402
 from .critical import critical  # noqa: E402
 from .errors import StabmapError  # noqa: E402
 from .examples import example, example_names  # noqa: E402
 from .io import open_atlas, write_atlas  # noqa: E402
-from .query import label_at, summary  # noqa: E402
+from .query import StableFraction, boundaries, label_at, smallest_stable, stable_fraction, summary  # noqa: E402
 from .refine import compute_refined  # noqa: E402
 from .scene import Axis, Body, Scene  # noqa: E402
 from .scene import load as load_scene  # noqa: E402
@@ -34,7 +35,9 @@ __all__ = [
     "Axis",
     "Body",
     "Scene",
+    "StableFraction",
     "StabmapError",
+    "boundaries",
     "cavity",
     "compute_atlas",
     "compute_refined",
@@ -45,6 +48,8 @@ __all__ = [
     "load_scene",
     "loads_scene",
     "open_atlas",
+    "smallest_stable",
+    "stable_fraction",
     "summary",
     "write_atlas",
 ]

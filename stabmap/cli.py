@@ -123,21 +123,65 @@ def _cmd_info(args) -> None:
 
 def _cmd_query(args) -> None:
     from .io import open_atlas
-    from .query import label_at
+    from .query import boundaries, label_at, render, smallest_stable, stable_fraction
 
     ds = open_atlas(args.atlas)
     if ds.attrs.get("stabmap_kind") == "critical values":
         raise StabmapError(f"{args.atlas} holds critical values, not an atlas; 'stabmap info {args.atlas}' lists its intervals")
-    label = label_at(ds, **_pairs(args.point, "point"))
-    for k, v in label.requested.items():
-        units = ds[k].attrs.get("units", "")
-        note = " (outside the grid: nearest edge)" if k in label.outside else ""
-        print(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g} {units}{note}")
-    print(f"n_complex_pairs = {label.n_complex_pairs}")
-    if label.decided_by == "inferred_from_cell_corners":
-        print(f"stability = {label.stability} (not computed: inferred from the agreeing corners of its grid cell; docs/refine.md)")
+    fmt = "csv" if args.csv else "json" if args.json else "text"
+    if args.limit < 0:
+        raise StabmapError(f"--limit must be >= 0 (0 shows every row), got {args.limit}")
+    over, after_over = (None, []) if args.over is None else _query_axis(args.over, "--over", None)
+    if over is not None and args.smallest_stable is None:
+        raise StabmapError("--over applies to --smallest-stable only, e.g. --smallest-stable omega --over K_1")
+    if args.boundaries is not None:
+        along, extra = _query_axis(args.boundaries, "--boundaries", None)
+        result = boundaries(ds, along, **_query_selection(args.point + extra))
+    elif args.smallest_stable is not None:
+        along, extra = _query_axis(args.smallest_stable, "--smallest-stable", "omega")
+        result = smallest_stable(ds, along, over, **_query_selection(args.point + extra + after_over))
+    elif args.fraction is not None:
+        result = stable_fraction(ds, **_query_selection(args.point + args.fraction))
     else:
-        print(f"stability = {label.stability} (decided by {label.decided_by.replace('_', ' ')})")
+        if not args.point:
+            axes = " ".join(f"{d}=VALUE" for d in ds["n_complex_pairs"].dims)
+            raise StabmapError(
+                f"give the point: {axes} (nearest grid point), or ask --fraction, --boundaries AXIS or "
+                "--smallest-stable [AXIS]; see 'stabmap query --help'"
+            )
+        result = label_at(ds, **_query_selection(args.point))
+    print(render(result, fmt, limit=args.limit, atlas=ds))
+
+
+def _query_axis(items: list[str], option: str, default: str | None) -> tuple[str, list[str]]:
+    """The axis named first after ``option`` (or ``default``), and the NAME=VALUE items after it."""
+    if items and "=" not in items[0]:
+        return items[0], items[1:]
+    if default is None:
+        raise StabmapError(f"{option}: name the axis to search along first, e.g. {option} omega K_1=3")
+    return default, items
+
+
+def _query_selection(items: list[str]) -> dict:
+    """NAME=VALUE (nearest grid value) and NAME=LO:HI (a range; LO: and :HI open) as stabmap.query selections."""
+    out = {}
+    for item in items:
+        key, sep, value = (part.strip() for part in item.partition("="))
+        if not sep or not key:
+            raise StabmapError(f"{item!r}: write NAME=VALUE (nearest grid value) or NAME=LO:HI (a range), e.g. omega=42.5 or K_1=0:10")
+        if key in out:
+            raise StabmapError(f"{key} is given twice; give each axis once")
+        ends = value.split(":")
+        if len(ends) > 2:
+            raise StabmapError(f"{item!r}: a range is NAME=LO:HI, e.g. {key}=0:10")
+        try:
+            numbers = [float(e) if e.strip() else None for e in ends]
+        except ValueError:
+            raise StabmapError(f"{item!r}: {value!r} is not a number or a range LO:HI; write e.g. {key}=42.5 or {key}=0:10") from None
+        if len(numbers) == 1 and numbers[0] is None:
+            raise StabmapError(f"{item!r}: no value; write e.g. {key}=42.5 or {key}=0:10")
+        out[key] = numbers[0] if len(numbers) == 1 else tuple(numbers)
+    return out
 
 
 def _cmd_plot(args) -> None:
@@ -229,9 +273,44 @@ def parser() -> argparse.ArgumentParser:
     i.add_argument("atlas")
     i.set_defaults(func=_cmd_info)
 
-    q = sub.add_parser("query", help="the label at a point (nearest grid point)")
-    q.add_argument("atlas")
-    q.add_argument("point", nargs="*", metavar="NAME=VALUE")
+    q = sub.add_parser(
+        "query",
+        help="ask a saved atlas: the label at a point, the stable fraction, boundaries, the smallest stable value",
+        description="Answers about the grid points of a saved atlas (docs/query.md).\n"
+        "NAME=VALUE selects the grid value of NAME nearest to VALUE (the value used is printed);\n"
+        "NAME=LO:HI keeps the grid values in [LO, HI] (LO: and :HI are open-ended); axes not named are kept whole.\n"
+        "Without a question (--fraction, --boundaries, --smallest-stable): the label at one point, a value per axis.",
+        epilog="examples:\n"
+        "  stabmap query a.nc omega=42.5 K_1=3                      label at the nearest grid point\n"
+        "  stabmap query a.nc --fraction K_1=3                      stable fraction over every omega at K_1 ~ 3\n"
+        "  stabmap query a.nc --fraction omega=20:60                stable fraction of a range, every K_1\n"
+        "  stabmap query a.nc --boundaries omega K_1=0:10           where N_c changes along omega (grid brackets)\n"
+        "  stabmap query a.nc --smallest-stable omega --over K_1    smallest stable omega for each K_1\n"
+        "  stabmap query a.nc --smallest-stable omega=0: --csv      ... of positive spin rates only, as CSV\n"
+        "NAME=VALUE items go after the atlas or after the question (argparse reads none after --csv or --limit N).\n"
+        "Boundaries are known to grid resolution only; 'stabmap critical' locates them to 1e-10 (docs/critical.md).",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    q.add_argument("atlas", help="an atlas file (stabmap atlas)")
+    q.add_argument("point", nargs="*", metavar="NAME=VALUE", help="the point (no question), or the slice a question is asked of")
+    ask = q.add_mutually_exclusive_group()
+    ask.add_argument("--fraction", nargs="*", metavar="NAME=VALUE", help="the stable fraction of the slice; axes not named are counted whole")
+    ask.add_argument(
+        "--boundaries", nargs="+", metavar=("AXIS", "NAME=VALUE"),
+        help="every change of N_c along AXIS, for every point of the other axes (or the slice): the two grid values around it, N_c on each side",
+    )
+    ask.add_argument(
+        "--smallest-stable", nargs="*", metavar=("AXIS", "NAME=VALUE"),
+        help="the smallest stable grid value of AXIS (default omega) and the unstable one just below it, for every point of the other axes",
+    )
+    q.add_argument(
+        "--over", nargs="+", metavar=("NAME", "NAME=VALUE"),
+        help="with --smallest-stable: the one axis that labels the answer (fix the others with NAME=VALUE)",
+    )
+    out = q.add_mutually_exclusive_group()
+    out.add_argument("--csv", action="store_true", help="print CSV (every row) instead of text")
+    out.add_argument("--json", action="store_true", help="print JSON (every row) instead of text")
+    q.add_argument("--limit", type=int, default=40, metavar="N", help="rows of a text table (default 40; 0: all)")
     q.set_defaults(func=_cmd_query)
 
     pl = sub.add_parser("plot", help="draw a 2-D stability map")

@@ -1,7 +1,34 @@
-"""Questions asked of a saved atlas: the label at a point, what the file holds."""
+"""Questions asked of a saved atlas (docs/query.md).
+
+- :func:`label_at`: the label at the grid point nearest to a point.
+- :func:`stable_fraction`: the fraction of stable grid points in a slice.
+- :func:`boundaries`: where N_c changes along one axis, bracketed by neighbouring grid values.
+- :func:`smallest_stable`: the smallest stable grid value of one axis, for each value of another.
+- :func:`summary`: counts that describe a whole atlas.
+
+**Selections.** The keyword arguments of ``stable_fraction``, ``boundaries`` and
+``smallest_stable`` select a slice, one keyword per grid axis:
+
+- a number fixes the axis at its *nearest grid value* (the results say which value was used);
+- a pair ``(lo, hi)`` or ``slice(lo, hi)`` keeps the grid values ``lo <= v <= hi`` (either end may be
+  ``None``: unbounded; the two ends may come in either order);
+- an axis not named is kept whole.
+
+**What the answers are.** Every answer is about grid points, never about values between them. A boundary is
+known only to lie between two neighbouring grid values with different N_c; ``stabmap critical`` (stabmap.critical)
+locates such ends to 1e-10 with proof (docs/critical.md). In an adaptive atlas (``stabmap atlas --refine``) some
+points were not computed but inferred from their grid cell's corners (``decided_by`` = inferred_from_cell_corners);
+every answer counts or flags them.
+
+The ``render`` function turns any answer into the text, CSV or JSON that ``stabmap query`` prints.
+"""
 
 from __future__ import annotations
 
+import csv
+import io
+import json
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -9,6 +36,11 @@ import xarray as xr
 
 from .errors import StabmapError
 from .variables import ATTRS, DECIDED_BY, N_COMPLEX_PAIRS, STABILITY, flag_meaning
+
+_BY = dict(zip(ATTRS[DECIDED_BY]["flag_meanings"].split(), (int(v) for v in ATTRS[DECIDED_BY]["flag_values"])))
+INFERRED = _BY["inferred_from_cell_corners"]  # decided_by of points an adaptive atlas did not compute
+PAD_NC = -2  # N_c where there is no grid value (no unstable value below the first stable one), as in critical files
+CRITICAL_HINT = "'stabmap critical SCENE --along {along}' locates the ends to 1e-10 (docs/critical.md)"
 
 
 @dataclass(frozen=True)
@@ -22,17 +54,207 @@ class Label:
     decided_by: str
     outside: tuple[str, ...]  # axes on which the request lies outside the grid
 
+    @property
+    def inferred(self) -> bool:
+        """True when the point was not computed (adaptive atlas: inferred from its grid cell's corners)."""
+        return self.decided_by == "inferred_from_cell_corners"
+
+
+@dataclass(frozen=True)
+class AxisSelection:
+    """How one grid axis entered a query: the request and the grid values actually used."""
+
+    name: str
+    units: str
+    requested: float | tuple[float | None, float | None] | None  # a number, a range (lo, hi), or None: whole axis
+    values: tuple[float, ...]  # the grid values used, in grid order
+    outside: bool = False  # a number outside the grid's range: the nearest end was used
+
+    @property
+    def fixed(self) -> bool:
+        """True when a number fixed the axis at one grid value."""
+        return self.requested is not None and not isinstance(self.requested, tuple)
+
+    @property
+    def bounds(self) -> tuple[float, float]:
+        """The smallest and largest grid value used."""
+        return min(self.values), max(self.values)
+
+    def describe(self) -> str:
+        """One line of text, e.g. ``K_1 = 3 -> nearest grid value 3.0150754 N m rad-1``."""
+        units = f" {self.units}" if self.units else ""
+        if self.fixed:
+            note = " (outside the grid: nearest end)" if self.outside else ""
+            return f"{self.name} = {self.requested:g} -> nearest grid value {self.values[0]:.8g}{units}{note}"
+        lo, hi = self.bounds
+        n = len(self.values)
+        span = f"{n} grid value{'s' if n != 1 else ''}, {lo:.8g} .. {hi:.8g}{units}"
+        if self.requested is None:
+            return f"{self.name}: all {span}"
+        a, b = self.requested
+        return f"{self.name} in [{'-inf' if a is None else f'{a:g}'}, {'inf' if b is None else f'{b:g}'}]: {span}"
+
+
+@dataclass(frozen=True)
+class StableFraction:
+    """The stable fraction of a slice of an atlas, with what was counted and where."""
+
+    fraction: float  # stable / points
+    stable: int  # N_c = 0
+    points: int  # grid points in the slice
+    unstable: int  # N_c > 0
+    degenerate: int  # N_c = -1 (p identically zero)
+    inferred: int  # points not computed (decided_by = inferred_from_cell_corners), stable or not
+    inferred_stable: int  # of those, how many carry the label stable
+    axes: dict[str, AxisSelection]  # every grid axis of the atlas, in order
+
+    @property
+    def selected(self) -> dict[str, float | tuple[float, float]]:
+        """The grid coordinates used: one value for a fixed axis, (smallest, largest) grid value otherwise."""
+        return {k: a.values[0] if a.fixed else a.bounds for k, a in self.axes.items()}
+
+    @property
+    def computed_fraction(self) -> float:
+        """The stable fraction among the computed (not inferred) points only; NaN if none was computed."""
+        computed = self.points - self.inferred
+        return (self.stable - self.inferred_stable) / computed if computed else float("nan")
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# selection
+
+
+def _check_atlas(ds: xr.Dataset) -> list[str]:
+    """The grid axes of an atlas; a clear error for a critical-values Dataset or anything else."""
+    if ds.attrs.get("stabmap_kind") == "critical values":
+        raise StabmapError(
+            "this Dataset holds critical values (stabmap critical), not an atlas; its intervals are in "
+            f"{ds.attrs.get('critical_along', 'omega')}_stable_lower/upper ('stabmap info FILE' lists them)"
+        )
+    if N_COMPLEX_PAIRS not in ds or DECIDED_BY not in ds:
+        raise StabmapError("this Dataset is not a stabmap atlas (no n_complex_pairs/decided_by); open one with stabmap.open_atlas")
+    return list(ds[N_COMPLEX_PAIRS].dims)
+
+
+def _not_an_axis(ds: xr.Dataset, name: str, dims: list[str], role: str = "") -> StabmapError:
+    axes = ", ".join(dims) or "(none)"
+    role = f"{role} " if role else ""
+    if name in ds.coords and ds[name].ndim == 0:
+        units = ds[name].attrs.get("units", "")
+        return StabmapError(f"{role}{name!r} is fixed at {float(ds[name]):g} {units} in this atlas, not a grid axis; its axes are: {axes}")
+    return StabmapError(f"{role}{name!r} is not an axis of this atlas; its axes are: {axes}")
+
+
+def _number(name: str, value) -> float:
+    try:
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, str, np.integer, np.floating)):
+            raise ValueError
+        value = float(value)
+    except ValueError:
+        raise StabmapError(f"{name}={value!r}: give a number (the nearest grid value is used) or a range (lo, hi)") from None
+    if math.isnan(value):
+        raise StabmapError(f"{name}=nan: give a number (the nearest grid value is used) or a range (lo, hi)")
+    return value
+
+
+def _request(name: str, value) -> float | tuple[float | None, float | None]:
+    """A number, or a range (lo, hi) with lo <= hi (None: unbounded), from a user's value."""
+    if isinstance(value, slice):
+        if value.step is not None:
+            raise StabmapError(f"{name}={value!r}: a range has no step; write {name}=({value.start}, {value.stop})")
+        ends = (value.start, value.stop)
+    elif isinstance(value, (tuple, list)):
+        if len(value) != 2:
+            raise StabmapError(f"{name}={value!r}: a range is a pair (lo, hi), e.g. {name}=(1.0, 2.5)")
+        ends = tuple(value)
+    else:
+        return _number(name, value)
+    lo, hi = (None if v is None else _number(name, v) for v in ends)
+    if lo is not None and hi is not None and lo > hi:
+        lo, hi = hi, lo
+    return lo, hi
+
+
+def select(ds: xr.Dataset, sel: dict, *, along: str | None = None) -> tuple[xr.Dataset, dict[str, AxisSelection]]:
+    """The slice of ``ds`` that ``sel`` asks for, and how every grid axis was selected.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        An atlas.
+    sel : dict
+        ``{axis: number | (lo, hi) | slice(lo, hi)}`` (module docstring). A number removes the axis (it stays
+        as a scalar coordinate holding the grid value used); a range keeps the grid values inside it.
+    along : str, optional
+        An axis that must stay an axis (boundaries, smallest_stable): a number for it is an error.
+    """
+    dims = _check_atlas(ds)
+    index, axes = {}, {}
+    for name, value in sel.items():
+        if name not in dims:
+            raise _not_an_axis(ds, name, dims)
+        requested = _request(name, value)
+        grid = np.asarray(ds[name].values, dtype=np.float64)
+        units = str(ds[name].attrs.get("units", ""))
+        if isinstance(requested, tuple):
+            lo, hi = requested
+            keep = np.ones(grid.size, dtype=bool)
+            if lo is not None:
+                keep &= grid >= lo
+            if hi is not None:
+                keep &= grid <= hi
+            if not keep.any():
+                raise StabmapError(
+                    f"{name} in [{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}] holds no grid "
+                    f"value; the {grid.size} grid values of {name} run from {grid.min():.8g} to {grid.max():.8g} {units}".rstrip()
+                )
+            index[name] = np.flatnonzero(keep)
+            axes[name] = AxisSelection(name, units, requested, tuple(float(v) for v in grid[keep]))
+        else:
+            if name == along:
+                raise StabmapError(
+                    f"{name}={requested:g} would fix {name}, the axis searched along; give a range instead, "
+                    f"e.g. {name}=({grid.min():g}, {grid.max():g}), or leave {name} out"
+                )
+            i = int(ds.indexes[name].get_indexer([requested], method="nearest")[0])
+            index[name] = i
+            outside = not grid.min() <= requested <= grid.max()
+            axes[name] = AxisSelection(name, units, requested, (float(grid[i]),), outside)
+    for d in dims:
+        if d not in axes:
+            axes[d] = AxisSelection(d, str(ds[d].attrs.get("units", "")), None, tuple(float(v) for v in ds[d].values))
+    return (ds.isel(index) if index else ds), {d: axes[d] for d in dims}
+
+
+def _fixed_names(axes: dict[str, AxisSelection]) -> str:
+    """The axes a number fixed, space-separated (a netCDF-safe string attribute)."""
+    return " ".join(a.name for a in axes.values() if a.fixed)
+
+
+def _selection_text(axes: dict[str, AxisSelection]) -> str:
+    """The fixed and ranged axes, one description each, joined by '; ' (a netCDF-safe string attribute)."""
+    return "; ".join(a.describe() for a in axes.values() if a.requested is not None)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# the questions
+
 
 def label_at(ds: xr.Dataset, **point: float) -> Label:
     """Label of the grid point nearest to ``point`` (one value per grid axis)."""
-    dims = list(ds[N_COMPLEX_PAIRS].dims)
+    dims = _check_atlas(ds)
     unknown = [k for k in point if k not in dims]
     if unknown:
         raise StabmapError(f"{unknown[0]!r} is not an axis of this atlas; its axes are: {', '.join(dims) or '(none)'}")
+    for k, v in point.items():
+        if isinstance(v, (tuple, list, slice)):
+            raise StabmapError(f"{k}={v!r}: the label is asked at one point; a range belongs to stable_fraction, boundaries or smallest_stable "
+                "(stabmap query --fraction, --boundaries AXIS, --smallest-stable)")
     missing = [d for d in dims if d not in point]
     if missing:
         raise StabmapError(f"give a value for every axis; missing: {', '.join(missing)} (e.g. {missing[0]}={float(ds[missing[0]][0]):g})")
-    sel = ds.sel({k: float(v) for k, v in point.items()}, method="nearest") if dims else ds
+    point = {k: _number(k, v) for k, v in point.items()}
+    sel = ds.sel(point, method="nearest") if dims else ds
     outside = tuple(
         d for d in dims if not float(ds[d].min()) <= float(point[d]) <= float(ds[d].max())
     )
@@ -44,6 +266,256 @@ def label_at(ds: xr.Dataset, **point: float) -> Label:
         decided_by=flag_meaning(DECIDED_BY, int(sel[DECIDED_BY])),
         outside=outside,
     )
+
+
+def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
+    """The fraction of stable grid points (N_c = 0) in a slice of an atlas.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        An atlas.
+    **sel
+        ``axis=number`` fixes the axis at its nearest grid value, ``axis=(lo, hi)`` keeps a range of it; the
+        fraction is taken over every grid point of what remains (module docstring).
+
+    Returns
+    -------
+    StableFraction
+        ``fraction`` with the counts behind it (stable, unstable, degenerate, points), how many points were
+        inferred rather than computed, and ``axes``/``selected``: the grid values actually used.
+
+    Examples
+    --------
+    >>> stable_fraction(ds, K_1=3)                  # over every omega, at the K_1 grid value nearest to 3
+    >>> stable_fraction(ds, omega=(20, 60))         # 20 <= omega <= 60, every K_1
+    """
+    sub, axes = select(ds, sel)
+    nc = np.asarray(sub[N_COMPLEX_PAIRS].values).ravel()
+    inferred = np.asarray(sub[DECIDED_BY].values).ravel() == INFERRED
+    stable = nc == 0
+    return StableFraction(
+        fraction=float(stable.mean()),
+        stable=int(stable.sum()),
+        points=int(nc.size),
+        unstable=int((nc > 0).sum()),
+        degenerate=int((nc < 0).sum()),
+        inferred=int(inferred.sum()),
+        inferred_stable=int((inferred & stable).sum()),
+        axes=axes,
+    )
+
+
+def _along(ds: xr.Dataset, along, dims: list[str], role: str) -> str:
+    if not isinstance(along, str) or along not in dims:
+        raise _not_an_axis(ds, str(along), dims, role)
+    return along
+
+
+def _lines(sub: xr.Dataset, along: str) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray]:
+    """Other axes, the ascending grid of ``along``, and N_c and the inferred flag as (other axes..., along)."""
+    sub = sub.sortby(along)
+    others = [d for d in sub[N_COMPLEX_PAIRS].dims if d != along]
+    nc = sub[N_COMPLEX_PAIRS].transpose(*others, along).values
+    inferred = sub[DECIDED_BY].transpose(*others, along).values == INFERRED
+    return others, np.asarray(sub[along].values, dtype=np.float64), nc, inferred
+
+
+def _coord(sub: xr.Dataset, name: str, dim: str, values) -> tuple:
+    return (dim, np.asarray(values), dict(sub[name].attrs))
+
+
+def _fixed_coords(sub: xr.Dataset, axes: dict[str, AxisSelection]) -> dict:
+    """The grid axes a number fixed, as scalar coordinates holding the grid value used.
+
+    The scene's fixed parameters (the atlas's other scalar coordinates) are left out, so that ``.to_dataframe()``
+    of an answer has one column per thing that varies or was chosen; they stay in the atlas.
+    """
+    return {k: sub[k].variable for k, a in axes.items() if a.fixed}
+
+
+def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
+    """Every change of N_c along one axis, bracketed by the two neighbouring grid values.
+
+    For every line along ``along`` (one per grid point of the other axes, or of the slice ``sel`` selects), each
+    pair of neighbouring grid values with different N_c is one boundary. The change lies somewhere between the
+    two values, not at either: ``stabmap critical`` locates it to 1e-10 (docs/critical.md). Changes hidden
+    between two grid values with equal N_c (a thin band) are not seen.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        An atlas.
+    along : str
+        The grid axis to search along (e.g. ``"omega"``).
+    **sel
+        Selection of the other axes (number: nearest grid value; (lo, hi): a range); ``along`` itself may only
+        take a range, which limits the search.
+
+    Returns
+    -------
+    xarray.Dataset
+        A tidy table, one entry per boundary along the dimension ``boundary`` (``.to_dataframe()`` gives a
+        pandas table). Coordinates: the other axes' grid values of each boundary's line; axes fixed by
+        ``sel`` are scalar coordinates (the scene's fixed parameters stay in the atlas). Variables: ``boundary_lower``/``boundary_upper`` (the bracketing grid
+        values, lower < upper, in the units of ``along``), ``n_complex_pairs_below``/``n_complex_pairs_above``
+        (N_c at them), ``inferred_below``/``inferred_above`` (True where that side was not computed but
+        inferred from cell corners). Attributes: ``along``, ``n_lines``, ``n_lines_with_boundary``,
+        ``selection`` and ``comment``.
+
+    Examples
+    --------
+    >>> b = boundaries(ds, "omega", K_1=(0, 10))
+    >>> b.to_dataframe()                                            # one row per boundary
+    >>> b.where(b.n_complex_pairs_above == 0, drop=True)            # only the changes to stable
+    """
+    dims = _check_atlas(ds)
+    along = _along(ds, along, dims, "boundaries along")
+    sub, axes = select(ds, sel, along=along)
+    others, x, nc, inferred = _lines(sub, along)
+    shape = nc.shape[:-1]
+    nc2, inf2 = nc.reshape(-1, x.size), inferred.reshape(-1, x.size)
+    line, k = np.nonzero(nc2[:, 1:] != nc2[:, :-1])
+    position = np.unravel_index(line, shape) if others else ()
+    units = str(ds[along].attrs.get("units", ""))
+
+    def var(values, long_name, **attrs):
+        return ("boundary", values, {"long_name": long_name, **attrs})
+
+    coords = {d: _coord(sub, d, "boundary", sub[d].values[p]) for d, p in zip(others, position)}
+    coords.update(_fixed_coords(sub, axes))
+    out = xr.Dataset(
+        {
+            "boundary_lower": var(x[k], f"{along} at the grid value below the change of n_complex_pairs", units=units),
+            "boundary_upper": var(x[k + 1], f"{along} at the grid value above the change of n_complex_pairs", units=units),
+            "n_complex_pairs_below": var(nc2[line, k].astype(np.int16), "n_complex_pairs at boundary_lower", units="1"),
+            "n_complex_pairs_above": var(nc2[line, k + 1].astype(np.int16), "n_complex_pairs at boundary_upper", units="1"),
+            "inferred_below": var(inf2[line, k], "boundary_lower was not computed (inferred from its grid cell's corners)"),
+            "inferred_above": var(inf2[line, k + 1], "boundary_upper was not computed (inferred from its grid cell's corners)"),
+        },
+        coords=coords,
+    )
+    n_lines = int(np.prod(shape)) if others else 1
+    out.attrs = {
+        "title": ds.attrs.get("title", ""),
+        "stabmap_query": "boundaries",
+        "along": along,
+        "along_units": units,
+        "n_lines": n_lines,
+        "n_lines_with_boundary": int(np.unique(line).size),
+        "along_grid_values": int(x.size),
+        "selection": _selection_text(axes),
+        "fixed_axes": _fixed_names(axes),
+        "comment": (
+            f"Each change of n_complex_pairs lies somewhere between boundary_lower and boundary_upper, two "
+            f"neighbouring grid values of {along}; it is not located more finely. Changes hidden between two grid "
+            f"values with equal n_complex_pairs are not seen. {CRITICAL_HINT.format(along=along)}."
+        ),
+    }
+    return out
+
+
+def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = None, **sel) -> xr.Dataset:
+    """The smallest grid value of ``along`` at which the rotation is stable, for each value of ``over``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        An atlas.
+    along : str
+        The axis searched, from its smallest grid value up (default ``"omega"``: the smallest stable spin rate).
+    over : str, optional
+        The axis that labels the answer. Every other axis must then be fixed by a number in ``sel``. Without
+        ``over``, the answer has every axis that ``sel`` leaves (one value per grid point of them).
+    **sel
+        Selection (number: nearest grid value; (lo, hi): a range). A range of ``along`` limits the search,
+        e.g. ``omega=(0, None)`` for the smallest stable *positive* spin rate.
+
+    Returns
+    -------
+    xarray.Dataset
+        Labelled by ``over`` (or the remaining axes); axes fixed by ``sel`` are scalar coordinates. Variables:
+
+        - ``smallest_stable``: the smallest stable grid value of ``along``; NaN where no grid value is stable;
+        - ``unstable_below``: the grid value just below it, not stable; NaN where ``smallest_stable`` is the
+          first grid value searched (stable from the start of the scan: the true threshold may lie lower) or
+          where nothing is stable. [unstable_below, smallest_stable] brackets the threshold;
+        - ``n_complex_pairs_below``: N_c at ``unstable_below`` (-2 where there is none);
+        - ``stable_to_scan_end``: True where every grid value from ``smallest_stable`` to the end of the searched
+          range is stable (False: an unstable band follows further up);
+        - ``inferred``/``inferred_below``: True where that point was not computed but inferred from cell corners.
+
+    Examples
+    --------
+    >>> s = smallest_stable(ds, "omega", over="K_1")
+    >>> s.smallest_stable.plot()                    # the smallest stable spin rate against K_1
+    """
+    dims = _check_atlas(ds)
+    along = _along(ds, along, dims, "smallest_stable along")
+    sub, axes = select(ds, sel, along=along)
+    others, x, nc, inferred = _lines(sub, along)
+    if over is not None:
+        if over == along:
+            raise StabmapError(f"over={over!r} is the axis searched along; choose another axis for over, e.g. {next((d for d in dims if d != along), 'K_1')}")
+        over = _along(ds, over, dims, "over")
+        if axes[over].fixed:
+            raise StabmapError(f"over={over!r} is also fixed by {over}={axes[over].requested:g}; give {over} a range (lo, hi) or leave it out")
+        extra = [d for d in others if d != over]
+        if extra:
+            example = ", ".join(f"{d}={float(ds[d][0]):g}" for d in extra)
+            raise StabmapError(
+                f"smallest_stable over {over!r}: fix the other axes as well ({example}, or any grid value), "
+                "or leave out over to get one answer per point of every remaining axis"
+            )
+    stable = nc == 0
+    has = stable.any(axis=-1)
+    first = np.argmax(stable, axis=-1)
+    below = np.maximum(first - 1, 0)
+    has_below = has & (first > 0)
+
+    def at(a, i):
+        return np.take_along_axis(a, i[..., None], axis=-1)[..., 0]
+
+    # stable from each grid value to the end of the scan
+    tail = np.flip(np.logical_and.accumulate(np.flip(stable, axis=-1), axis=-1), axis=-1)
+    units = str(ds[along].attrs.get("units", ""))
+
+    def var(values, long_name, **attrs):
+        return (others, values, {"long_name": long_name, **attrs})
+
+    coords = {d: _coord(sub, d, d, sub[d].values) for d in others}
+    coords.update(_fixed_coords(sub, axes))
+    out = xr.Dataset(
+        {
+            "smallest_stable": var(np.where(has, x[first], np.nan), f"smallest stable {along}", units=units),
+            "unstable_below": var(np.where(has_below, x[below], np.nan), f"unstable {along} just below the smallest stable one", units=units),
+            "n_complex_pairs_below": var(
+                np.where(has_below, at(nc, below), PAD_NC).astype(np.int16), "n_complex_pairs at unstable_below", units="1",
+                comment=f"{PAD_NC} where there is no unstable_below",
+            ),
+            "stable_to_scan_end": var(has & at(tail, first), f"stable at every grid value of {along} from smallest_stable to the end of the searched range"),
+            "inferred": var(has & at(inferred, first), "smallest_stable was not computed (inferred from its grid cell's corners)"),
+            "inferred_below": var(has_below & at(inferred, below), "unstable_below was not computed (inferred from its grid cell's corners)"),
+        },
+        coords=coords,
+    )
+    out.attrs = {
+        "title": ds.attrs.get("title", ""),
+        "stabmap_query": "smallest_stable",
+        "along": along,
+        "along_units": units,
+        "along_range": [float(x.min()), float(x.max())],
+        "along_grid_values": int(x.size),
+        "selection": _selection_text(axes),
+        "fixed_axes": _fixed_names(axes),
+        "comment": (
+            f"smallest_stable is a grid value of {along} proved (or, where inferred is true, inferred) stable, and "
+            f"unstable_below the grid value just below it; the threshold lies between them and is not located more "
+            f"finely. Stability below unstable_below is not implied, nor above smallest_stable unless "
+            f"stable_to_scan_end. {CRITICAL_HINT.format(along=along)}."
+        ),
+    }
+    return out
 
 
 def summary(ds: xr.Dataset) -> dict:
@@ -59,3 +531,241 @@ def summary(ds: xr.Dataset) -> dict:
         "n_complex_pairs": {int(v): int(c) for v, c in zip(values, counts)},
         "decided_by": {flag_meaning(DECIDED_BY, v): int((by == v).sum()) for v in ATTRS[DECIDED_BY]["flag_values"]},
     }
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# text, CSV and JSON (stabmap query)
+
+FORMATS = ("text", "csv", "json")
+
+
+def render(result, fmt: str = "text", *, limit: int = 40, atlas: xr.Dataset | None = None) -> str:
+    """The text, CSV or JSON of an answer (a Label, a StableFraction, or a boundaries/smallest_stable Dataset).
+
+    ``limit`` caps the rows of a text table (0: all); CSV and JSON are always complete. ``atlas`` supplies the
+    units of a Label's axes.
+    """
+    if fmt not in FORMATS:
+        raise StabmapError(f"format {fmt!r}: choose one of {', '.join(FORMATS)}")
+    if isinstance(result, Label):
+        return {"text": _label_text, "csv": _label_csv, "json": _label_json}[fmt](result, atlas)
+    if isinstance(result, StableFraction):
+        return {"text": _fraction_text, "csv": _fraction_csv, "json": _fraction_json}[fmt](result)
+    kind = result.attrs.get("stabmap_query") if isinstance(result, xr.Dataset) else None
+    if kind not in ("boundaries", "smallest_stable"):
+        raise StabmapError(f"cannot render {type(result).__name__}: not an answer of stabmap.query")
+    frame = _frame(result)
+    if fmt == "csv":
+        buf = io.StringIO()
+        frame.to_csv(buf, index=False, lineterminator="\n")
+        return buf.getvalue().rstrip("\n")
+    if fmt == "json":
+        head = {k: result.attrs[k] for k in ("stabmap_query", "along", "along_units", "selection", "comment")}
+        head["fixed"] = {k: float(result[k]) for k in _fixed_axes(result)}
+        head["rows"] = frame.to_dict(orient="records")
+        return _json(head)
+    return (_boundaries_text if kind == "boundaries" else _smallest_text)(result, frame, limit)
+
+
+def _units(ds: xr.Dataset | None, name: str) -> str:
+    return str(ds[name].attrs.get("units", "")) if ds is not None and name in ds.coords else ""
+
+
+def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
+    lines = []
+    for k, v in label.requested.items():
+        note = " (outside the grid: nearest edge)" if k in label.outside else ""
+        lines.append(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g} {_units(atlas, k)}".rstrip() + note)
+    lines.append(f"n_complex_pairs = {label.n_complex_pairs}")
+    if label.inferred:
+        lines.append(f"stability = {label.stability} (not computed: inferred from the agreeing corners of its grid cell; docs/refine.md)")
+    else:
+        lines.append(f"stability = {label.stability} (decided by {label.decided_by.replace('_', ' ')})")
+    return "\n".join(lines)
+
+
+def _label_record(label: Label) -> dict:
+    return {**label.grid_point, "n_complex_pairs": label.n_complex_pairs, "stability": label.stability, "decided_by": label.decided_by}
+
+
+def _label_csv(label: Label, atlas) -> str:
+    return _csv([_label_record(label)])
+
+
+def _label_json(label: Label, atlas) -> str:
+    return _json({
+        "stabmap_query": "label_at", "requested": label.requested, "grid_point": label.grid_point,
+        "outside": list(label.outside), "n_complex_pairs": label.n_complex_pairs, "stability": label.stability,
+        "decided_by": label.decided_by, "inferred": label.inferred,
+    })
+
+
+def _fraction_text(f: StableFraction) -> str:
+    lines = [
+        f"stable fraction {f.fraction:.6g}: {f.stable} of {f.points} grid points stable ({100 * f.fraction:.2f} %), "
+        f"{f.unstable} unstable" + (f", {f.degenerate} degenerate" if f.degenerate else "")
+    ]
+    lines += [f"  {a.describe()}" for a in f.axes.values()]
+    if f.inferred:
+        lines.append(
+            f"  inferred: {f.inferred} of these points were not computed but inferred from their grid cell's corners "
+            f"({f.inferred_stable} of them stable); among the computed points the stable fraction is {f.computed_fraction:.6g}"
+        )
+    else:
+        lines.append("  inferred: 0 (every point was computed)")
+    return "\n".join(lines)
+
+
+def _fraction_record(f: StableFraction) -> dict:
+    row = {k: getattr(f, k) for k in ("fraction", "stable", "points", "unstable", "degenerate", "inferred", "inferred_stable")}
+    for name, a in f.axes.items():
+        row[f"{name}_lo"], row[f"{name}_hi"] = a.bounds
+        row[f"{name}_n"] = len(a.values)
+    return row
+
+
+def _fraction_csv(f: StableFraction) -> str:
+    return _csv([_fraction_record(f)])
+
+
+def _fraction_json(f: StableFraction) -> str:
+    out = {"stabmap_query": "stable_fraction", **{k: v for k, v in _fraction_record(f).items() if not k.startswith(tuple(f.axes))}}
+    out["axes"] = {
+        name: {"units": a.units, "requested": list(a.requested) if isinstance(a.requested, tuple) else a.requested,
+               "grid_lo": a.bounds[0], "grid_hi": a.bounds[1], "grid_values": len(a.values), "outside": a.outside}
+        for name, a in f.axes.items()
+    }
+    return _json(out)
+
+
+def _fixed_axes(result: xr.Dataset) -> list[str]:
+    """The atlas axes that a number in the selection fixed (scalar coordinates of the answer)."""
+    return result.attrs.get("fixed_axes", "").split()
+
+
+def _frame(result: xr.Dataset):
+    """A pandas table of a boundaries/smallest_stable answer: varying axes, fixed axes, then the variables."""
+    scalars = [k for k in result.coords if result[k].ndim == 0]
+    fixed = _fixed_axes(result)
+    table = result.drop_vars(scalars)
+    if not table.sizes:  # smallest_stable of a one-axis atlas: one row
+        frame = table.expand_dims("row").to_dataframe().reset_index(drop=True)
+    elif result.attrs["stabmap_query"] == "boundaries":
+        frame = table.to_dataframe().reset_index(drop=True)
+    else:
+        frame = table.to_dataframe().reset_index()
+    for i, k in enumerate(fixed):
+        frame.insert(i, k, float(result[k]))
+    axes = fixed + [c for c in frame.columns if c in result.coords and c not in fixed]
+    return frame[axes + [c for c in frame.columns if c not in axes]]
+
+
+def _g(v) -> str:
+    if isinstance(v, (bool, np.bool_)):
+        return "yes" if v else "no"
+    if isinstance(v, (float, np.floating)):
+        return "-" if np.isnan(v) else f"{v:.8g}"
+    return str(v)
+
+
+def _table(header: list[str], rows: list[list[str]]) -> list[str]:
+    widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(header)]
+    return ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in [header, *rows]]
+
+
+def _head(result: xr.Dataset) -> list[str]:
+    lines = [f"  {item}" for item in result.attrs["selection"].split("; ") if item]
+    return lines
+
+
+def _more(n: int, limit: int) -> list[str]:
+    return [f"... and {n - limit} more rows (--limit 0 shows all; --csv or --json for every row)"] if limit and n > limit else []
+
+
+def _boundaries_text(b: xr.Dataset, frame, limit: int) -> str:
+    along, units = b.attrs["along"], b.attrs["along_units"]
+    u = f" [{units}]" if units else ""
+    n, lines_total = b.sizes["boundary"], b.attrs["n_lines"]
+    lines = [
+        f"boundaries along {along}{u}: {n} change{'s' if n != 1 else ''} of N_c on {b.attrs['n_lines_with_boundary']} "
+        f"of {lines_total} line{'s' if lines_total != 1 else ''}, each between two neighbouring grid values"
+    ]
+    lines += _head(b)
+    others = [c for c in frame.columns if c in b.coords and b[c].ndim == 1]
+    header = [f"{d} [{b[d].attrs['units']}]" if b[d].attrs.get("units") else d for d in others]
+    header += [f"{along} lower", f"{along} upper", "N_c below", "N_c above"]
+    rows = []
+    shown = frame if not limit else frame.iloc[:limit]
+    star = False
+    for r in shown.to_dict(orient="records"):
+        nb = f"{r['n_complex_pairs_below']}" + ("*" if r["inferred_below"] else "")
+        na = f"{r['n_complex_pairs_above']}" + ("*" if r["inferred_above"] else "")
+        star |= bool(r["inferred_below"] or r["inferred_above"])
+        rows.append([_g(r[d]) for d in others] + [_g(r["boundary_lower"]), _g(r["boundary_upper"]), nb, na])
+    if rows:
+        lines += _table(header, rows)
+    else:
+        lines.append(f"N_c does not change between neighbouring grid values of {along} anywhere in this selection")
+    lines += _more(len(frame), limit)
+    if star:
+        lines.append("* not computed: inferred from the agreeing corners of its grid cell (docs/refine.md)")
+    lines.append(f"Each change lies between the two grid values, not at either; {CRITICAL_HINT.format(along=along)}.")
+    return "\n".join(lines)
+
+
+def _smallest_text(s: xr.Dataset, frame, limit: int) -> str:
+    along, units = s.attrs["along"], s.attrs["along_units"]
+    u = f" [{units}]" if units else ""
+    lo, hi = s.attrs["along_range"]
+    lines = [f"smallest stable {along}{u}, searched upward over {s.attrs['along_grid_values']} grid values {lo:.8g} .. {hi:.8g}"]
+    lines += _head(s)
+    others = [d for d in s["smallest_stable"].dims]
+    header = [f"{d} [{s[d].attrs['units']}]" if s[d].attrs.get("units") else d for d in others]
+    header += [f"smallest stable {along}", "unstable below", "N_c below", "stable to end"]
+    rows = []
+    shown = frame if not limit else frame.iloc[:limit]
+    star = False
+    for r in shown.to_dict(orient="records"):
+        if np.isnan(r["smallest_stable"]):
+            first, below, ncb = "none", "-", "-"
+        else:
+            first = _g(r["smallest_stable"]) + ("*" if r["inferred"] else "")
+            below = _g(r["unstable_below"]) if not np.isnan(r["unstable_below"]) else "(scan start)"
+            ncb = f"{r['n_complex_pairs_below']}" + ("*" if r["inferred_below"] else "") if r["n_complex_pairs_below"] != PAD_NC else "-"
+        star |= bool(r["inferred"] or r["inferred_below"])
+        rows.append([_g(r[d]) for d in others] + [first, below, ncb, _g(r["stable_to_scan_end"]) if first != "none" else "-"])
+    lines += _table(header, rows)
+    lines += _more(len(frame), limit)
+    if star:
+        lines.append("* not computed: inferred from the agreeing corners of its grid cell (docs/refine.md)")
+    lines.append(
+        f"The threshold lies between 'unstable below' and the smallest stable grid value; "
+        f"'(scan start)': stable from the first grid value searched. {CRITICAL_HINT.format(along=along)}."
+    )
+    return "\n".join(lines)
+
+
+def _plain(v):
+    if isinstance(v, dict):
+        return {str(k): _plain(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_plain(x) for x in v]
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return None if math.isnan(v) else float(v)
+    return v
+
+
+def _json(obj) -> str:
+    return json.dumps(_plain(obj), indent=1)
+
+
+def _csv(rows: list[dict]) -> str:
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return buf.getvalue().rstrip("\n")
