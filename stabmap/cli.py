@@ -123,7 +123,8 @@ def _cmd_info(args) -> None:
 
 def _cmd_query(args) -> None:
     from .io import open_atlas
-    from .query import boundaries, label_at, render, smallest_stable, stable_fraction
+    from .query import boundaries, label_at, smallest_stable, stable_fraction
+    from .report import render
 
     ds = open_atlas(args.atlas)
     if ds.attrs.get("stabmap_kind") == "critical values":

@@ -19,7 +19,8 @@ import xarray as xr
 
 import stabmap
 from stabmap.cli import main
-from stabmap.query import INFERRED, render
+from stabmap.query import INFERRED
+from stabmap.report import render
 from stabmap.scene import from_dict
 
 M, A, C, G = 1.0, 0.02, 0.03, 9.81

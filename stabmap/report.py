@@ -1,0 +1,248 @@
+"""Answers of stabmap.query as the text, CSV or JSON that ``stabmap query`` prints."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+
+import numpy as np
+import xarray as xr
+
+from .errors import StabmapError
+from .query import CRITICAL_HINT, PAD_NC, Label, StableFraction
+
+FORMATS = ("text", "csv", "json")
+
+
+def render(result, fmt: str = "text", *, limit: int = 40, atlas: xr.Dataset | None = None) -> str:
+    """The text, CSV or JSON of an answer (a Label, a StableFraction, or a boundaries/smallest_stable Dataset).
+
+    ``limit`` caps the rows of a text table (0: all); CSV and JSON are always complete. ``atlas`` supplies the
+    units of a Label's axes.
+    """
+    if fmt not in FORMATS:
+        raise StabmapError(f"format {fmt!r}: choose one of {', '.join(FORMATS)}")
+    if isinstance(result, Label):
+        return {"text": _label_text, "csv": _label_csv, "json": _label_json}[fmt](result, atlas)
+    if isinstance(result, StableFraction):
+        return {"text": _fraction_text, "csv": _fraction_csv, "json": _fraction_json}[fmt](result)
+    kind = result.attrs.get("stabmap_query") if isinstance(result, xr.Dataset) else None
+    if kind not in ("boundaries", "smallest_stable"):
+        raise StabmapError(f"cannot render {type(result).__name__}: not an answer of stabmap.query")
+    frame = _frame(result)
+    if fmt == "csv":
+        buf = io.StringIO()
+        frame.to_csv(buf, index=False, lineterminator="\n")
+        return buf.getvalue().rstrip("\n")
+    if fmt == "json":
+        head = {k: result.attrs[k] for k in ("stabmap_query", "along", "along_units", "selection", "comment")}
+        head["fixed"] = {k: float(result[k]) for k in _fixed_axes(result)}
+        head["rows"] = frame.to_dict(orient="records")
+        return _json(head)
+    return (_boundaries_text if kind == "boundaries" else _smallest_text)(result, frame, limit)
+
+
+def _units(ds: xr.Dataset | None, name: str) -> str:
+    return str(ds[name].attrs.get("units", "")) if ds is not None and name in ds.coords else ""
+
+
+def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
+    lines = []
+    for k, v in label.requested.items():
+        note = " (outside the grid: nearest edge)" if k in label.outside else ""
+        lines.append(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g} {_units(atlas, k)}".rstrip() + note)
+    lines.append(f"n_complex_pairs = {label.n_complex_pairs}")
+    if label.inferred:
+        lines.append(f"stability = {label.stability} (not computed: inferred from the agreeing corners of its grid cell; docs/refine.md)")
+    else:
+        lines.append(f"stability = {label.stability} (decided by {label.decided_by.replace('_', ' ')})")
+    return "\n".join(lines)
+
+
+def _label_record(label: Label) -> dict:
+    return {**label.grid_point, "n_complex_pairs": label.n_complex_pairs, "stability": label.stability, "decided_by": label.decided_by}
+
+
+def _label_csv(label: Label, atlas) -> str:
+    return _csv([_label_record(label)])
+
+
+def _label_json(label: Label, atlas) -> str:
+    return _json({
+        "stabmap_query": "label_at", "requested": label.requested, "grid_point": label.grid_point,
+        "outside": list(label.outside), "n_complex_pairs": label.n_complex_pairs, "stability": label.stability,
+        "decided_by": label.decided_by, "inferred": label.inferred,
+    })
+
+
+def _fraction_text(f: StableFraction) -> str:
+    lines = [
+        f"stable fraction {f.fraction:.6g}: {f.stable} of {f.points} grid points stable ({100 * f.fraction:.2f} %), "
+        f"{f.unstable} unstable" + (f", {f.degenerate} degenerate" if f.degenerate else "")
+    ]
+    lines += [f"  {a.describe()}" for a in f.axes.values()]
+    if f.inferred:
+        lines.append(
+            f"  inferred: {f.inferred} of these points were not computed but inferred from their grid cell's corners "
+            f"({f.inferred_stable} of them stable); among the computed points the stable fraction is {f.computed_fraction:.6g}"
+        )
+    else:
+        lines.append("  inferred: 0 (every point was computed)")
+    return "\n".join(lines)
+
+
+def _fraction_record(f: StableFraction) -> dict:
+    row = {k: getattr(f, k) for k in ("fraction", "stable", "points", "unstable", "degenerate", "inferred", "inferred_stable")}
+    for name, a in f.axes.items():
+        row[f"{name}_lo"], row[f"{name}_hi"] = a.bounds
+        row[f"{name}_n"] = len(a.values)
+    return row
+
+
+def _fraction_csv(f: StableFraction) -> str:
+    return _csv([_fraction_record(f)])
+
+
+def _fraction_json(f: StableFraction) -> str:
+    out = {"stabmap_query": "stable_fraction", **{k: v for k, v in _fraction_record(f).items() if not k.startswith(tuple(f.axes))}}
+    out["axes"] = {
+        name: {"units": a.units, "requested": list(a.requested) if isinstance(a.requested, tuple) else a.requested,
+               "grid_lo": a.bounds[0], "grid_hi": a.bounds[1], "grid_values": len(a.values), "outside": a.outside}
+        for name, a in f.axes.items()
+    }
+    return _json(out)
+
+
+def _fixed_axes(result: xr.Dataset) -> list[str]:
+    """The atlas axes that a number in the selection fixed (scalar coordinates of the answer)."""
+    return result.attrs.get("fixed_axes", "").split()
+
+
+def _frame(result: xr.Dataset):
+    """A pandas table of a boundaries/smallest_stable answer: varying axes, fixed axes, then the variables."""
+    scalars = [k for k in result.coords if result[k].ndim == 0]
+    fixed = _fixed_axes(result)
+    table = result.drop_vars(scalars)
+    if not table.sizes:  # smallest_stable of a one-axis atlas: one row
+        frame = table.expand_dims("row").to_dataframe().reset_index(drop=True)
+    elif result.attrs["stabmap_query"] == "boundaries":
+        frame = table.to_dataframe().reset_index(drop=True)
+    else:
+        frame = table.to_dataframe().reset_index()
+    for i, k in enumerate(fixed):
+        frame.insert(i, k, float(result[k]))
+    axes = fixed + [c for c in frame.columns if c in result.coords and c not in fixed]
+    return frame[axes + [c for c in frame.columns if c not in axes]]
+
+
+def _g(v) -> str:
+    if isinstance(v, (bool, np.bool_)):
+        return "yes" if v else "no"
+    if isinstance(v, (float, np.floating)):
+        return "-" if np.isnan(v) else f"{v:.8g}"
+    return str(v)
+
+
+def _table(header: list[str], rows: list[list[str]]) -> list[str]:
+    widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(header)]
+    return ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in [header, *rows]]
+
+
+def _head(result: xr.Dataset) -> list[str]:
+    lines = [f"  {item}" for item in result.attrs["selection"].split("; ") if item]
+    return lines
+
+
+def _more(n: int, limit: int) -> list[str]:
+    return [f"... and {n - limit} more rows (--limit 0 shows all; --csv or --json for every row)"] if limit and n > limit else []
+
+
+def _boundaries_text(b: xr.Dataset, frame, limit: int) -> str:
+    along, units = b.attrs["along"], b.attrs["along_units"]
+    u = f" [{units}]" if units else ""
+    n, lines_total = b.sizes["boundary"], b.attrs["n_lines"]
+    lines = [
+        f"boundaries along {along}{u}: {n} change{'s' if n != 1 else ''} of N_c on {b.attrs['n_lines_with_boundary']} "
+        f"of {lines_total} line{'s' if lines_total != 1 else ''}, each between two neighbouring grid values"
+    ]
+    lines += _head(b)
+    others = [c for c in frame.columns if c in b.coords and b[c].ndim == 1]
+    header = [f"{d} [{b[d].attrs['units']}]" if b[d].attrs.get("units") else d for d in others]
+    header += [f"{along} lower", f"{along} upper", "N_c below", "N_c above"]
+    rows = []
+    shown = frame if not limit else frame.iloc[:limit]
+    star = False
+    for r in shown.to_dict(orient="records"):
+        nb = f"{r['n_complex_pairs_below']}" + ("*" if r["inferred_below"] else "")
+        na = f"{r['n_complex_pairs_above']}" + ("*" if r["inferred_above"] else "")
+        star |= bool(r["inferred_below"] or r["inferred_above"])
+        rows.append([_g(r[d]) for d in others] + [_g(r["boundary_lower"]), _g(r["boundary_upper"]), nb, na])
+    if rows:
+        lines += _table(header, rows)
+    else:
+        lines.append(f"N_c does not change between neighbouring grid values of {along} anywhere in this selection")
+    lines += _more(len(frame), limit)
+    if star:
+        lines.append("* not computed: inferred from the agreeing corners of its grid cell (docs/refine.md)")
+    lines.append(f"Each change lies between the two grid values, not at either; {CRITICAL_HINT.format(along=along)}.")
+    return "\n".join(lines)
+
+
+def _smallest_text(s: xr.Dataset, frame, limit: int) -> str:
+    along, units = s.attrs["along"], s.attrs["along_units"]
+    u = f" [{units}]" if units else ""
+    lo, hi = s.attrs["along_range"]
+    lines = [f"smallest stable {along}{u}, searched upward over {s.attrs['along_grid_values']} grid values {lo:.8g} .. {hi:.8g}"]
+    lines += _head(s)
+    others = [d for d in s["smallest_stable"].dims]
+    header = [f"{d} [{s[d].attrs['units']}]" if s[d].attrs.get("units") else d for d in others]
+    header += [f"smallest stable {along}", "unstable below", "N_c below", "stable to end"]
+    rows = []
+    shown = frame if not limit else frame.iloc[:limit]
+    star = False
+    for r in shown.to_dict(orient="records"):
+        if np.isnan(r["smallest_stable"]):
+            first, below, ncb = "none", "-", "-"
+        else:
+            first = _g(r["smallest_stable"]) + ("*" if r["inferred"] else "")
+            below = _g(r["unstable_below"]) if not np.isnan(r["unstable_below"]) else "(scan start)"
+            ncb = f"{r['n_complex_pairs_below']}" + ("*" if r["inferred_below"] else "") if r["n_complex_pairs_below"] != PAD_NC else "-"
+        star |= bool(r["inferred"] or r["inferred_below"])
+        rows.append([_g(r[d]) for d in others] + [first, below, ncb, _g(r["stable_to_scan_end"]) if first != "none" else "-"])
+    lines += _table(header, rows)
+    lines += _more(len(frame), limit)
+    if star:
+        lines.append("* not computed: inferred from the agreeing corners of its grid cell (docs/refine.md)")
+    lines.append(
+        f"The threshold lies between 'unstable below' and the smallest stable grid value; "
+        f"'(scan start)': stable from the first grid value searched. {CRITICAL_HINT.format(along=along)}."
+    )
+    return "\n".join(lines)
+
+
+def _plain(v):
+    if isinstance(v, dict):
+        return {str(k): _plain(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_plain(x) for x in v]
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return None if math.isnan(v) else float(v)
+    return v
+
+
+def _json(obj) -> str:
+    return json.dumps(_plain(obj), indent=1)
+
+
+def _csv(rows: list[dict]) -> str:
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return buf.getvalue().rstrip("\n")
