@@ -187,15 +187,22 @@ def _query_selection(items: list[str]) -> dict:
 
 def _cmd_plot(args) -> None:
     from .io import open_atlas
-    from .plot import plot_atlas
+    from .plot import MAX_PANELS, plan_figure, plot_atlas
 
     ds = open_atlas(args.atlas)
+    sel = _pairs(args.sel, "--sel")
     if ds.attrs.get("stabmap_kind") == "critical values":
         from .plot import plot_critical
 
-        plot_critical(ds, args.output, sel=_pairs(args.sel, "--sel"))
+        given = [opt for opt, v in (("--x", args.x), ("--y", args.y), ("--facet", args.facet), ("--max-panels", args.max_panels)) if v is not None]
+        if given:
+            raise StabmapError(f"{given[0]} applies to atlases; {args.atlas} holds critical values (fix other axes with --sel)")
+        plot_critical(ds, args.output, sel=sel)
     else:
-        plot_atlas(ds, args.output, x=args.x, y=args.y, sel=_pairs(args.sel, "--sel"))
+        options = {"x": args.x, "y": args.y, "sel": sel, "facet": args.facet, "max_panels": MAX_PANELS if args.max_panels is None else args.max_panels}
+        plot_atlas(ds, args.output, **options)
+        for note in plan_figure(ds, **options).notes:
+            print(f"note: {note}", file=sys.stderr)
     print(f"wrote {args.output}", file=sys.stderr)
 
 
@@ -314,12 +321,14 @@ def parser() -> argparse.ArgumentParser:
     q.add_argument("--limit", type=int, default=40, metavar="N", help="rows of a text table (default 40; 0: all)")
     q.set_defaults(func=_cmd_query)
 
-    pl = sub.add_parser("plot", help="draw a 2-D stability map")
+    pl = sub.add_parser("plot", help="draw an atlas: a map of N_c, small multiples for 3 or 4 axes (docs/plots.md)")
     pl.add_argument("atlas")
     pl.add_argument("-o", "--output", required=True, help="PNG or PDF file")
-    pl.add_argument("--x", help="axis along x (default: the first axis)")
-    pl.add_argument("--y", help="axis along y (default: the second axis)")
-    pl.add_argument("--sel", nargs="*", default=[], metavar="NAME=VALUE", help="values of the other axes (nearest)")
+    pl.add_argument("--x", help="axis along x (default: the first axis not fixed or faceted)")
+    pl.add_argument("--y", help="axis along y (default: the next one)")
+    pl.add_argument("--sel", nargs="*", default=[], metavar="NAME=VALUE", help="fix axes at these values (nearest grid value)")
+    pl.add_argument("--facet", metavar="NAME", help="axis drawn as one panel per value (default: the third axis; a fourth gives rows)")
+    pl.add_argument("--max-panels", type=int, metavar="N", help="at most N panels, evenly spaced values (default 12)")
     pl.set_defaults(func=_cmd_plot)
 
     c = sub.add_parser("critical", help="stable intervals of one parameter (e.g. the critical spin rates), ends to 1e-10")

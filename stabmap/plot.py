@@ -1,8 +1,28 @@
-"""Pictures of an atlas: a 2-D map of the number of complex root pairs with the stability boundary."""
+"""Pictures of an atlas: maps of N_c, the number of complex root pairs, with the boundaries between classes.
+
+``atlas_figure`` draws an atlas Dataset into a new matplotlib Figure and computes nothing: it reads
+``n_complex_pairs`` and ``decided_by`` and their coordinates. ``plot_atlas`` saves that figure to PNG or PDF.
+
+- A 1-D atlas is a strip, a 2-D atlas one map, and an atlas with 3 or 4 axes small multiples: one panel per
+  value of the third axis (the facet), and with a fourth axis one row per value of it. Evenly spaced values are
+  drawn when there are more than ``max_panels`` panels, and the figure says which. Other axes are fixed with
+  ``sel`` (nearest grid value).
+- Classes are coloured from the Okabe-Ito palette (stable: sky blue; 1, 2, 3 ... complex pairs: yellow, orange,
+  vermillion, ...); each class always has the same colour. Degenerate points (p identically zero) are grey and
+  cross-hatched; points of an adaptive atlas that were inferred from their cell's corners (``decided_by`` = 3)
+  carry a light diagonal hatch (a light veil in very large adaptive atlases).
+- Boundaries are drawn on grid-cell edges, between every two neighbouring points whose N_c differ: thick where
+  one side is stable and the other not, thin where only the number of pairs changes. A line is drawn only where
+  two grid points differ, never interpolated between them. Cell edges are the midpoints between grid values
+  (geometric midpoints on a log axis), so they follow log and irregular (``values``) grids.
+"""
 
 from __future__ import annotations
 
+import math
+import re
 import textwrap
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -10,94 +30,555 @@ import xarray as xr
 
 from .errors import StabmapError
 from .io import check_writable
-from .variables import N_COMPLEX_PAIRS
+from .variables import ATTRS, DECIDED_BY, N_COMPLEX_PAIRS
 
-# Okabe-Ito, colour-blind safe; stable gets the calm blue, unstable counts get warm colours.
+MAX_PANELS = 12  # default limit of small multiples
+_LEGEND_WIDTH = 2.5  # [inch] beside small multiples
+
+# Okabe-Ito (colour-blind safe), then Paul Tol's muted colours: stable gets the calm blue, unstable counts get
+# warm colours in order of N_c, so a class has the same colour in every figure.
 _STABLE = "#56B4E9"
-_UNSTABLE = ["#F0E442", "#E69F00", "#D55E00", "#CC79A7", "#882255", "#44AA99", "#999933", "#332288"]
+_UNSTABLE = ["#F0E442", "#E69F00", "#D55E00", "#CC79A7", "#882255", "#332288", "#117733", "#44AA99", "#999933", "#AA4499"]
 _DEGENERATE = "#BBBBBB"
+_BOUNDARY = "#000000"
+_CLASS_EDGE = "#333333"
+_HATCH_INFERRED = "////"
+_HATCH_DEGENERATE = "xxxx"
+_HATCH_RUNS = 100_000  # more separate runs of inferred cells than this: a light veil instead of a hatch
+_INFERRED = int(ATTRS[DECIDED_BY]["flag_values"][ATTRS[DECIDED_BY]["flag_meanings"].split().index("inferred_from_cell_corners")])
+_VECTOR_RUNS = 20_000  # a panel with more runs of equal cells along x is filled as an image (lines and text stay vector)
+
+# Symbols of the scannable names (stabmap.parameters); names without one are shown as they are typed.
+_SYMBOLS = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho", "radius": "a"}
 
 
-def _axis_label(ds: xr.Dataset, dim: str) -> str:
-    units = ds[dim].attrs.get("units", "")
-    return f"{dim} [{units}]" if units else dim
+def colour(n_c: int) -> str:
+    """The colour of the class N_c = ``n_c`` (-1: degenerate) in every stabmap figure."""
+    if n_c < 0:
+        return _DEGENERATE
+    if n_c == 0:
+        return _STABLE
+    return _UNSTABLE[(n_c - 1) % len(_UNSTABLE)]
 
 
-def select(ds: xr.Dataset, sel: dict[str, float], keep: int = 2) -> tuple[xr.Dataset, dict[str, float]]:
-    """Reduce ``ds`` to ``keep`` axes by nearest selection; unselected extra axes take their first value."""
+def class_label(n_c: int) -> str:
+    """Legend text of the class N_c = ``n_c``."""
+    if n_c < 0:
+        return "degenerate (p \u2261 0)"
+    if n_c == 0:
+        return "stable (all roots real)"
+    return f"{n_c} complex pair{'s' if n_c > 1 else ''}"
+
+
+# ---------------------------------------------------------------------------------------------------------- layout
+@dataclass(frozen=True)
+class FigurePlan:
+    """Which axis of the atlas goes where in the figure; made by :func:`plan_figure`, checked, nothing drawn.
+
+    ``fixed`` maps each axis not drawn to ``(index, requested)``: the grid index used and the value asked for
+    with ``sel`` (None when the axis was left at its first value because a figure shows at most four axes).
+    """
+
+    x: str
+    y: str | None = None
+    facet: str | None = None
+    row: str | None = None
+    facet_index: tuple[int, ...] = ()
+    row_index: tuple[int, ...] = ()
+    fixed: dict = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+    @property
+    def n_panels(self) -> int:
+        return max(1, len(self.facet_index)) * max(1, len(self.row_index))
+
+
+def _evenly(n: int, k: int) -> tuple[int, ...]:
+    """``k`` evenly spaced indices of ``n`` (both ends included when k >= 2)."""
+    if k >= n:
+        return tuple(range(n))
+    return tuple(int(i) for i in np.unique(np.round(np.linspace(0, n - 1, k)).astype(int)))
+
+
+def _rows_cols(n_rows: int, n_cols: int, max_panels: int) -> tuple[int, int]:
+    """Rows and columns for a 4-axis atlas: as many panels as allowed, as square as possible, wider than tall."""
+    best = (1, 1)
+    for r in range(1, min(n_rows, max_panels) + 1):
+        c = min(n_cols, max_panels // r)
+        if (r * c, -abs(c - r), c) > (best[0] * best[1], -abs(best[1] - best[0]), best[1]):
+            best = (r, c)
+    return best
+
+
+def plan_figure(
+    ds: xr.Dataset,
+    *,
+    x: str | None = None,
+    y: str | None = None,
+    sel: dict[str, float] | None = None,
+    facet: str | None = None,
+    max_panels: int = MAX_PANELS,
+) -> FigurePlan:
+    """Check the options of :func:`atlas_figure` against ``ds`` and decide the layout (see there)."""
+    if N_COMPLEX_PAIRS not in ds:
+        raise StabmapError(f"not a stabmap atlas: the Dataset has no {N_COMPLEX_PAIRS!r} variable")
+    if isinstance(max_panels, bool) or not isinstance(max_panels, (int, np.integer)) or max_panels < 1:
+        raise StabmapError(f"--max-panels must be a whole number >= 1, got {max_panels!r}")
     dims = list(ds[N_COMPLEX_PAIRS].dims)
-    for k in sel:
+    if not dims:
+        raise StabmapError("this atlas has no axis to plot (a single point); use 'stabmap info' or 'stabmap query'")
+    sel = dict(sel or {})
+    for k, v in sel.items():
         if k not in dims:
             raise StabmapError(f"--sel {k}: not an axis of this atlas; its axes are: {', '.join(dims)}")
-    chosen = dict(sel)
-    free_dims = [d for d in dims if d not in chosen]
-    for d in free_dims[keep:]:
-        chosen[d] = float(ds[d][0])
-    if not chosen:
-        return ds, {}
-    out = ds.sel(chosen, method="nearest")
-    return out, {d: float(out[d]) for d in chosen}
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
+            raise StabmapError(f"--sel {k}={v!r}: give a finite number, e.g. --sel {k}={float(ds[k][0]):g}")
+    roles = [(opt, name) for opt, name in (("--x", x), ("--y", y), ("--facet", facet)) if name is not None]
+    for opt, name in roles:
+        if name not in dims:
+            raise StabmapError(f"{opt} {name}: not an axis of this atlas; choose from {', '.join(dims)}")
+        if name in sel:
+            raise StabmapError(f"{opt} {name}: this axis is also fixed by --sel {name}=...; drop one of the two")
+    for i, (opt, name) in enumerate(roles):
+        for opt2, name2 in roles[i + 1 :]:
+            if name == name2:
+                raise StabmapError(f"{opt} and {opt2} both name {name}; give each axis one place in the figure")
+    free = [d for d in dims if d not in sel]
+    if not free:
+        raise StabmapError(f"--sel fixes every axis ({', '.join(dims)}); leave one or two free to draw, or use 'stabmap query'")
+    if len(free) == 1 and y is not None:
+        raise StabmapError(f"--y {y}: only one axis is left to draw ({free[0]}), along x; drop --y")
+    if len(free) <= 2 and facet is not None:
+        raise StabmapError(
+            f"--facet {facet}: only {len(free)} ax{'is' if len(free) == 1 else 'es'} left to draw ({', '.join(free)}), "
+            "all on the map; facets need a third axis, so drop --facet"
+        )
+    rest = [d for d in free if d not in (x, y, facet)]
+    x = x or rest.pop(0)
+    if len(free) >= 2:
+        y = y or rest.pop(0)
+    if len(free) >= 3:
+        facet = facet or rest.pop(0)
+    row = rest.pop(0) if len(free) >= 4 else None
+
+    fixed, notes = {}, []
+    for k, v in sel.items():
+        fixed[k] = (int(np.argmin(np.abs(np.asarray(ds[k], dtype=float) - v))), float(v))
+    for d in rest:  # a figure shows at most four axes
+        fixed[d] = (0, None)
+        notes.append(f"{d} fixed at its first value (choose with --sel {d}=VALUE)")
+
+    facet_index = row_index = ()
+    panel_notes = []
+    if facet is not None:
+        n_f = ds.sizes[facet]
+        if row is None:
+            facet_index = _evenly(n_f, max_panels)
+        else:
+            r, c = _rows_cols(ds.sizes[row], n_f, max_panels)
+            facet_index, row_index = _evenly(n_f, c), _evenly(ds.sizes[row], r)
+        for d, index in ((facet, facet_index), (row, row_index)):
+            if d is not None and len(index) < ds.sizes[d]:
+                panel_notes.append(f"{d}: {len(index)} of {ds.sizes[d]} values drawn, evenly spaced")
+        if panel_notes:
+            panel_notes[-1] += f" (more with --max-panels, now {max_panels}; one with --sel)"
+    notes = panel_notes + notes
+    return FigurePlan(x, y, facet, row, facet_index, row_index, fixed, tuple(notes))
 
 
-def plot_atlas(ds: xr.Dataset, path: str | Path, *, x: str | None = None, y: str | None = None, sel: dict[str, float] | None = None) -> Path:
-    """Draw ``ds`` (2-D map, or a strip for a 1-D atlas) to PNG or PDF at ``path``."""
-    import matplotlib
+# ------------------------------------------------------------------------------------------------------ geometry
+def _edges(centres: np.ndarray, scale: str | None) -> np.ndarray:
+    """Cell edges around grid values: midpoints (geometric midpoints on a log axis), half a step beyond the ends."""
+    centres = np.asarray(centres, dtype=float)
+    if len(centres) == 1:
+        c = centres[0]
+        if scale == "log" and c > 0:
+            return np.array([c / 1.1, c * 1.1])
+        h = 0.5 * abs(c) if c != 0 else 0.5
+        return np.array([c - h, c + h])
+    if scale == "log" and np.all(centres > 0):
+        lc = np.log(centres)
+        mid = (lc[1:] + lc[:-1]) / 2
+        return np.exp(np.concatenate([[2 * lc[0] - mid[0]], mid, [2 * lc[-1] - mid[-1]]]))
+    mid = (centres[1:] + centres[:-1]) / 2
+    return np.concatenate([[2 * centres[0] - mid[0]], mid, [2 * centres[-1] - mid[-1]]])
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+
+def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Runs of True along the last axis of a 2-D mask: (line, start, stop) with stop exclusive."""
+    padded = np.zeros((mask.shape[0], mask.shape[1] + 2), dtype=np.int8)
+    padded[:, 1:-1] = mask
+    d = np.diff(padded, axis=1)
+    line, start = np.nonzero(d == 1)
+    _, stop = np.nonzero(d == -1)
+    return line, start, stop
+
+
+def _segments(mask_v: np.ndarray, mask_h: np.ndarray, xe: np.ndarray, ye: np.ndarray) -> np.ndarray:
+    """Line segments, shape (k, 2, 2), along the marked cell edges, collinear neighbours joined.
+
+    ``mask_v[j, i]``: the edge between cells (j, i) and (j, i + 1), at x = xe[i + 1] from ye[j] to ye[j + 1].
+    ``mask_h[j, i]``: the edge between cells (j, i) and (j + 1, i), at y = ye[j + 1] from xe[i] to xe[i + 1].
+    """
+    i, j0, j1 = _runs(mask_v.T)
+    vertical = np.stack([np.stack([xe[i + 1], ye[j0]], -1), np.stack([xe[i + 1], ye[j1]], -1)], 1)
+    j, i0, i1 = _runs(mask_h)
+    horizontal = np.stack([np.stack([xe[i0], ye[j + 1]], -1), np.stack([xe[i1], ye[j + 1]], -1)], 1)
+    return np.concatenate([vertical.reshape(-1, 2, 2), horizontal.reshape(-1, 2, 2)])
+
+
+def cell_edge_boundaries(values: np.ndarray, xedges: np.ndarray, yedges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Boundaries of a 2-D class map on the edges of its grid cells.
+
+    Parameters
+    ----------
+    values : array of int, shape (ny, nx)
+        N_c per grid point, rows along y.
+    xedges, yedges : arrays of float, shapes (nx + 1,) and (ny + 1,)
+        Cell edges in data coordinates (see ``_edges``).
+
+    Returns
+    -------
+    stability, classes : arrays of float, shape (k, 2, 2)
+        Segments ``[[x0, y0], [x1, y1]]`` on every edge between two neighbouring cells where exactly one is
+        stable (N_c = 0), and on every other edge where N_c differs. Collinear neighbouring segments are joined.
+    """
+    v = np.asarray(values)
+    xe, ye = np.asarray(xedges, dtype=float), np.asarray(yedges, dtype=float)
+    stable = v == 0
+    dv, dh = v[:, 1:] != v[:, :-1], v[1:, :] != v[:-1, :]
+    sv, sh = stable[:, 1:] != stable[:, :-1], stable[1:, :] != stable[:-1, :]
+    return _segments(sv, sh, xe, ye), _segments(dv & ~sv, dh & ~sh, xe, ye)
+
+
+def _rectangles(mask: np.ndarray, xe: np.ndarray, ye: np.ndarray) -> list[np.ndarray]:
+    """The marked cells as few rectangles: runs along x, merged with identical runs in the rows above."""
+    line, start, stop = _runs(mask)
+    open_, done = {}, []
+    previous = -1
+    for j, a, b in zip(line, start, stop):
+        if j != previous:  # close runs that did not continue into this row
+            for key, (j0, j1) in list(open_.items()):
+                if j1 < j:
+                    done.append((key[0], key[1], j0, j1))
+                    del open_[key]
+            previous = j
+        key = (int(a), int(b))
+        if key in open_ and open_[key][1] == j:
+            open_[key] = (open_[key][0], j + 1)
+        else:
+            if key in open_:
+                done.append((key[0], key[1], *open_[key]))
+            open_[key] = (j, j + 1)
+    done.extend((k[0], k[1], j0, j1) for k, (j0, j1) in open_.items())
+    return [np.array([[xe[a], ye[j0]], [xe[b], ye[j0]], [xe[b], ye[j1]], [xe[a], ye[j1]]]) for a, b, j0, j1 in done]
+
+
+def _fill(ax, values: np.ndarray, xe: np.ndarray, ye: np.ndarray, cmap, norm) -> None:
+    """Colour the cells: one vector rectangle per block of equal cells, or an image when the map is too busy.
+
+    Rectangles are outlined in their own colour, so no hairline seams show between them in a PDF viewer.
+    """
+    from matplotlib.collections import PolyCollection
+
+    change = np.ones(values.shape, dtype=bool)
+    change[:, 1:] = values[:, 1:] != values[:, :-1]
+    if int(change.sum()) > _VECTOR_RUNS:
+        ax.pcolormesh(xe, ye, values, cmap=cmap, norm=norm, shading="flat", rasterized=True)
+        return
+    for v in np.unique(values):
+        c = colour(int(v))
+        cells = PolyCollection(_rectangles(values == v, xe, ye), facecolors=c, edgecolors=c, linewidths=0.3, antialiaseds=False, zorder=1)
+        cells.set_gid(f"cells-{int(v)}")
+        ax.add_collection(cells, autolim=False)
+
+
+def _overlay(ax, mask: np.ndarray, xe: np.ndarray, ye: np.ndarray, gid: str) -> bool:
+    """Hatch the marked cells (one compound path, so the hatch is drawn once); returns True if it had to lighten.
+
+    Degenerate cells are cross-hatched. Inferred cells get a light diagonal hatch, or, when they form more than
+    ``_HATCH_RUNS`` separate runs (a large adaptive atlas), a light white veil drawn as an image.
+    """
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path as MplPath
+
+    if gid == "inferred-cells" and len(_runs(mask)[0]) > _HATCH_RUNS:
+        veil = np.ma.masked_where(~mask, np.ones(mask.shape))
+        mesh = ax.pcolormesh(xe, ye, veil, cmap=_white_cmap(), vmin=0, vmax=1, alpha=0.45, shading="flat", rasterized=True, zorder=2)
+        mesh.set_gid(gid)
+        return True
+    hatch, colour_ = (_HATCH_INFERRED, "#00000066") if gid == "inferred-cells" else (_HATCH_DEGENERATE, "#000000AA")
+    path = MplPath.make_compound_path_from_polys(np.array(_rectangles(mask, xe, ye)))
+    patch = PathPatch(path, facecolor="none", edgecolor=colour_, linewidth=0, hatch=hatch, zorder=2)
+    if hasattr(patch, "set_hatchcolor"):  # matplotlib >= 3.10
+        patch.set_hatchcolor(colour_)
+        patch.set_hatch_linewidth(0.5)
+    patch.set_gid(gid)
+    ax.add_patch(patch)
+    return False
+
+
+def _white_cmap():
+    from matplotlib.colors import ListedColormap
+
+    return ListedColormap(["#FFFFFF"])
+
+
+# -------------------------------------------------------------------------------------------------------- labels
+def _units(units: str) -> str:
+    """CF units as text: 'rad s-1' -> 'rad s⁻¹' (mathtext), '1' -> ''; spaces do not break lines."""
+    if units in ("", "1"):
+        return ""
+    words = []
+    for w in units.split():
+        m = re.fullmatch(r"([A-Za-z]+)(-?\d+)", w)
+        words.append(f"{m.group(1)}$^{{{m.group(2)}}}$" if m else w)
+    return "\u00a0".join(words)
+
+
+def _symbol(name: str) -> str:
+    """'omega' -> '$\\omega$', 'm_2' -> '$m_{2}$'; names without a symbol are returned as they are."""
+    m = re.fullmatch(r"([A-Za-z]+)(?:_(\d+))?", name)
+    if not m or m.group(1) not in _SYMBOLS:
+        return name
+    base, k = _SYMBOLS[m.group(1)], m.group(2)
+    return f"${base}_{{{k}}}$" if k else f"${base}$"
+
+
+def axis_label(ds: xr.Dataset, dim: str, width: int = 60) -> str:
+    """'common spin rate ω [rad s⁻¹]': the coordinate's long_name (parentheses dropped), symbol and units."""
+    attrs = ds[dim].attrs
+    name = re.sub(r"\s*\([^)]*\)", "", attrs.get("long_name", "")).replace(" about its centre of mass", "").strip()
+    sym = _symbol(dim)
+    if not name:
+        text = sym
+    elif sym == dim:
+        text = f"{name} ({dim})"
+    else:
+        text = f"{name} {sym}"
+    units = _units(str(attrs.get("units", "")))
+    if units:
+        text += f" [{units}]"
+    return textwrap.fill(text, width, break_long_words=False, break_on_hyphens=False)
+
+
+def _value_text(ds: xr.Dataset, dim: str, value: float) -> str:
+    units = _units(str(ds[dim].attrs.get("units", "")))
+    return f"{_symbol(dim)} = {value:.4g}" + (f" {units}" if units else "")
+
+
+def _log_axis(ds: xr.Dataset, dim: str) -> bool:
+    return ds[dim].attrs.get("scale") == "log" and bool(np.all(np.asarray(ds[dim]) > 0))
+
+
+# --------------------------------------------------------------------------------------------------------- figure
+def atlas_figure(
+    ds: xr.Dataset,
+    *,
+    x: str | None = None,
+    y: str | None = None,
+    sel: dict[str, float] | None = None,
+    facet: str | None = None,
+    max_panels: int = MAX_PANELS,
+):
+    """Draw an atlas into a new matplotlib Figure (nothing is saved, nothing computed).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        An atlas (``stabmap.compute_atlas``, ``stabmap.open_atlas``).
+    x, y : str, optional
+        Axes of the map (default: the first two axes of the atlas that are not fixed or faceted, in order).
+    sel : dict, optional
+        Axes to fix, ``{name: value}``; the nearest grid value is used and shown.
+    facet : str, optional
+        The axis whose values become panels (default: the third remaining axis). A fourth remaining axis gives
+        the rows; further axes are fixed at their first value, and the figure says so.
+    max_panels : int
+        At most this many panels; evenly spaced values are drawn from longer axes (default 12).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Not registered with pyplot: save it with ``fig.savefig``. ``fig.axes[0]`` is the first map (for a 2-D
+        atlas the only one) in data coordinates, x and y being the grid values, so curves can be overlaid with
+        ``fig.axes[0].plot(x, y)``; its limits are fixed to the grid. The legend is ``fig.legends[0]``.
+
+    Raises
+    ------
+    StabmapError
+        For an option that does not fit the atlas (unknown axis, an axis given two roles, ...).
+    """
+    from matplotlib.collections import LineCollection
     from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
+    plan = plan_figure(ds, x=x, y=y, sel=sel, facet=facet, max_panels=max_panels)
+    fix = {k: i for k, (i, _) in plan.fixed.items()}
+    nc = ds[N_COMPLEX_PAIRS].isel(fix)
+    by = ds[DECIDED_BY].isel(fix) if DECIDED_BY in ds else None
+    order = (plan.y, plan.x) if plan.y else (plan.x,)
+    panels = [(r, c) for r in (plan.row_index or (None,)) for c in (plan.facet_index or (None,))]
+
+    def cut(da, r, c):
+        sl = {}
+        if r is not None:
+            sl[plan.row] = r
+        if c is not None:
+            sl[plan.facet] = c
+        a = np.asarray(da.isel(sl).transpose(*order))
+        return a if plan.y else a[None, :]
+
+    data = [cut(nc, r, c) for r, c in panels]
+    inferred = [cut(by, r, c) == _INFERRED if by is not None else None for r, c in panels]
+    everything = np.concatenate([d.ravel() for d in data])
+    present = sorted(int(v) for v in np.unique(everything))
+    top = max(1, present[-1])
+    cmap = ListedColormap([colour(v) for v in range(-1, top + 1)])
+    norm = BoundaryNorm(np.arange(-1.5, top + 1.5), cmap.N)
+
+    xs = np.asarray(ds[plan.x], dtype=float)
+    xe = _edges(xs, "log" if _log_axis(ds, plan.x) else None)
+    ye = _edges(np.asarray(ds[plan.y], dtype=float), "log" if _log_axis(ds, plan.y) else None) if plan.y else np.array([0.0, 1.0])
+
+    if plan.row is not None:
+        nrows, ncols = len(plan.row_index), len(plan.facet_index)
+    elif plan.facet is not None:
+        k = len(plan.facet_index)
+        ncols = k if k <= 3 else math.ceil(math.sqrt(k))
+        nrows = math.ceil(k / ncols)
+    else:
+        nrows = ncols = 1
+    width = 7.5 if plan.facet is None else max(3.5, 2.6 * ncols + 0.9) + _LEGEND_WIDTH
+    title = _title(ds, plan, everything, 70 if plan.facet is None else int(12 * (width - _LEGEND_WIDTH)))
+    lines = title.count("\n") + 1
+    if plan.facet is None:
+        size = (width, 5.2) if plan.y else (width, max(1.4 + 0.17 * lines, 0.22 * (len(present) + 4)) + 0.6)
+    else:
+        size = (width, 2.3 * nrows + 0.8 + 0.17 * lines)
+    fig = Figure(figsize=size, layout="constrained")
+    if plan.facet is None:
+        maps = side = fig
+    else:  # panels with their titles on the left, the legend on the right: the two never overlap
+        maps, side = fig.subfigures(1, 2, width_ratios=[size[0] - _LEGEND_WIDTH, _LEGEND_WIDTH])
+    grid = maps.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False)
+    axes = [grid[n // ncols, n % ncols] for n in range(len(panels))]
+    for ax in grid.ravel()[len(panels) :]:
+        ax.remove()
+
+    drawn = {"stability": False, "classes": False, "inferred": False, "light": False}
+    for ax, values, inf, (r, c) in zip(axes, data, inferred, panels):
+        _fill(ax, values, xe, ye, cmap, norm)
+        for mask, gid in ((inf, "inferred-cells"), (values < 0, "degenerate-cells")):
+            if mask is not None and mask.any():
+                drawn["inferred"] |= gid == "inferred-cells"
+                drawn["light"] |= _overlay(ax, mask, xe, ye, gid)
+        stab, other = cell_edge_boundaries(values, xe, ye)
+        for segs, width, col, gid in ((other, 0.6, _CLASS_EDGE, "class-boundary"), (stab, 1.5, _BOUNDARY, "stability-boundary")):
+            lines = LineCollection(segs, colors=col, linewidths=width, capstyle="projecting", joinstyle="miter", zorder=3 + (gid == "stability-boundary"))
+            lines.set_gid(gid)
+            ax.add_collection(lines, autolim=False)
+        drawn["stability"] |= len(stab) > 0
+        drawn["classes"] |= len(other) > 0
+        if plan.facet is not None:
+            parts = [_value_text(ds, plan.facet, float(ds[plan.facet][c]))]
+            if plan.row is not None:
+                parts.append(_value_text(ds, plan.row, float(ds[plan.row][r])))
+            parts.append(f"{100 * float(np.mean(values == 0)):.0f} % stable")
+            ax.set_title("\n".join([", ".join(parts[:-1]), parts[-1]]) if plan.row is not None else f"{parts[0]}  ({parts[1]})", fontsize=9)
+
+    first = axes[0]
+    if _log_axis(ds, plan.x):
+        first.set_xscale("log")
+    first.set_xlim(min(xe[0], xe[-1]), max(xe[0], xe[-1]))
+    if plan.y:
+        if _log_axis(ds, plan.y):
+            first.set_yscale("log")
+        first.set_ylim(min(ye[0], ye[-1]), max(ye[0], ye[-1]))
+    else:
+        first.set_ylim(0, 1)
+        first.set_yticks([])
+    for dim, setter, log in ((plan.x, first.set_xticks, first.get_xscale() == "log"), (plan.y, first.set_yticks, first.get_yscale() == "log")):
+        if dim and ds[dim].attrs.get("scale") == "values" and 1 < ds.sizes[dim] <= 8:  # ticks at listed values ...
+            v = np.sort(np.asarray(ds[dim], dtype=float))
+            v_ = np.log(v) if log else v
+            if np.min(np.diff(v_)) >= (v_[-1] - v_[0]) / 12:  # ... unless their labels would collide
+                setter(v)
+
+    if plan.facet is None:
+        first.set_xlabel(axis_label(ds, plan.x))
+        if plan.y:
+            first.set_ylabel(axis_label(ds, plan.y, width=45))
+    else:
+        for n, ax in enumerate(axes):  # tick labels only where no panel is below / to the left
+            ax.tick_params(labelbottom=n + ncols >= len(panels), labelleft=n % ncols == 0)
+        maps.supxlabel(axis_label(ds, plan.x, width=int(12 * (size[0] - _LEGEND_WIDTH))), fontsize=10)
+        maps.supylabel(axis_label(ds, plan.y, width=int(10 * size[1])), fontsize=10)
+
+    handles = []
+    for v in present:
+        hatch = _HATCH_DEGENERATE if v < 0 else None
+        handles.append(Patch(facecolor=colour(v), edgecolor="none", hatch=hatch, label=class_label(v)))
+    if drawn["stability"]:
+        handles.append(Line2D([], [], color=_BOUNDARY, lw=1.5, label="stability boundary"))
+    if drawn["classes"]:
+        handles.append(Line2D([], [], color=_CLASS_EDGE, lw=0.6, label="N$_c$ changes"))
+    if drawn["inferred"] and not drawn["light"]:
+        handles.append(Patch(facecolor="white", edgecolor="#00000066", lw=0, hatch=_HATCH_INFERRED, label="inferred from cell\ncorners (not computed)"))
+    elif drawn["inferred"]:
+        handles.append(Patch(facecolor="#DDDDDD", edgecolor="none", label="lighter: inferred from cell\ncorners (not computed)"))
+    legend = {"frameon": False, "title": "complex root pairs N$_c$", "fontsize": 9, "title_fontsize": 9}
+    if plan.facet is None:
+        fig.legend(handles=handles, loc="outside right upper", alignment="left", **legend)
+    else:
+        side.legend(handles=handles, loc="upper left", bbox_to_anchor=(0.0, 0.97), alignment="left", **legend)
+
+    if plan.facet is None:
+        first.set_title(title, fontsize=10)
+    else:
+        maps.suptitle(title, fontsize=10)
+    return fig
+
+
+def _title(ds: xr.Dataset, plan: FigurePlan, shown: np.ndarray, chars: int) -> str:
+    """The atlas title, the stable fraction of the points shown, the fixed axes, the panels and the notes."""
+    title = [textwrap.fill(ds.attrs.get("title", "") or "stabmap atlas", chars)]
+    part = plan.facet is not None or bool(plan.fixed)
+    title.append(f"{100 * float(np.mean(shown == 0)):.1f} % of {'the ' if part else ''}{shown.size:,} grid points{' shown' if part else ''} stable")
+    if plan.fixed:
+        fixed = []
+        for k, (i, asked) in plan.fixed.items():
+            text = _value_text(ds, k, float(ds[k][i]))
+            if asked is not None and not math.isclose(asked, float(ds[k][i]), rel_tol=1e-9, abs_tol=1e-300):
+                text += f" (nearest to {asked:g})"
+            fixed.append(text)
+        title.append(textwrap.fill("fixed: " + ", ".join(t.replace(" ", "\u00a0") for t in fixed), chars))
+    if plan.facet is not None:
+        title.append(textwrap.fill("panels: " + " × ".join(axis_label(ds, d, width=500) for d in (plan.facet, plan.row) if d), chars))
+    title.extend(textwrap.fill(note, chars) for note in plan.notes)
+    return "\n".join(title)
+
+
+def plot_atlas(
+    ds: xr.Dataset,
+    path: str | Path,
+    *,
+    x: str | None = None,
+    y: str | None = None,
+    sel: dict[str, float] | None = None,
+    facet: str | None = None,
+    max_panels: int = MAX_PANELS,
+) -> Path:
+    """Draw ``ds`` with :func:`atlas_figure` and write it to ``path`` (.png or .pdf) atomically; returns the path.
+
+    Every check runs before anything is written, so bad options leave no file.
+    """
     path = check_writable(path)
     if path.suffix.lower() not in (".png", ".pdf"):
         raise StabmapError(f"plot file {str(path)!r}: use a .png or .pdf name")
-    sub, fixed = select(ds, sel or {})
-    nc = sub[N_COMPLEX_PAIRS]
-    dims = list(nc.dims)
-    if len(dims) == 0:
-        raise StabmapError("this atlas has no axis to plot (a single point); use 'stabmap info' or 'stabmap query'")
-    if x is not None or y is not None:
-        for name in (x, y):
-            if name is not None and name not in dims:
-                raise StabmapError(f"--x/--y {name}: not a remaining axis; choose from {', '.join(dims)}")
-    if len(dims) == 2:
-        xd = x or (y and next(d for d in dims if d != y)) or dims[0]
-        yd = y or next(d for d in dims if d != xd)
-        nc = nc.transpose(yd, xd)
-    else:
-        xd, yd = dims[0], None
-    values = np.asarray(nc)
-    top = max(1, int(values.max()))
-    colours = [_DEGENERATE, _STABLE] + [_UNSTABLE[(i - 1) % len(_UNSTABLE)] for i in range(1, top + 1)]
-    cmap = ListedColormap(colours)
-    norm = BoundaryNorm(np.arange(-1.5, top + 1.5), cmap.N)
-    fig, ax = plt.subplots(figsize=(7.5, 5.5), constrained_layout=True)
-    xs = np.asarray(sub[xd])
-    if yd is None:
-        ax.pcolormesh(_edges(xs, ds[xd].attrs.get("scale")), [0, 1], values[None, :], cmap=cmap, norm=norm)
-        ax.set_yticks([])
-    else:
-        ys = np.asarray(sub[yd])
-        ax.pcolormesh(_edges(xs, ds[xd].attrs.get("scale")), _edges(ys, ds[yd].attrs.get("scale")), values, cmap=cmap, norm=norm)
-        if len(xs) > 1 and len(ys) > 1 and (values == 0).any() and (values != 0).any():
-            ax.contour(xs, ys, (values == 0).astype(float), levels=[0.5], colors="k", linewidths=1.0)
-        ax.set_ylabel(_axis_label(ds, yd))
-        if ds[yd].attrs.get("scale") == "log":
-            ax.set_yscale("log")
-    ax.set_xlabel(_axis_label(ds, xd))
-    if ds[xd].attrs.get("scale") == "log":
-        ax.set_xscale("log")
-    present = sorted(int(v) for v in np.unique(values))
-    handles = [
-        Patch(color=colours[v + 1], label="degenerate" if v < 0 else ("stable (all roots real)" if v == 0 else f"unstable, {v} complex pair{'s' if v > 1 else ''}"))
-        for v in present
-    ]
-    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, title="N_c")
-    title = textwrap.fill(ds.attrs.get("title", "stabmap atlas"), 70)
-    if fixed:
-        title += "\n" + ", ".join(f"{k} = {v:.4g} {ds[k].attrs.get('units', '')}".strip() for k, v in fixed.items())
-    ax.set_title(title, fontsize=10)
-    return _save(fig, path)
+    return _save(atlas_figure(ds, x=x, y=y, sel=sel, facet=facet, max_panels=max_panels), path)
 
 
 def _save(fig, path: Path) -> Path:
@@ -106,25 +587,12 @@ def _save(fig, path: Path) -> Path:
 
     tmp = path.with_name(f".{path.name}.tmp{path.suffix}")
     try:
-        fig.savefig(tmp, dpi=150)
+        fig.savefig(tmp, dpi=150 if path.suffix.lower() == ".png" else 300)
         tmp.replace(path)
     finally:
         plt.close(fig)
         tmp.unlink(missing_ok=True)
     return path
-
-
-def _edges(centres: np.ndarray, scale: str | None) -> np.ndarray:
-    """Cell edges around grid values (geometric midpoints on a log axis)."""
-    if len(centres) == 1:
-        c = centres[0]
-        return np.array([c - 0.5, c + 0.5]) if scale != "log" else np.array([c / 1.1, c * 1.1])
-    if scale == "log" and np.all(centres > 0):
-        lc = np.log(centres)
-        mid = (lc[1:] + lc[:-1]) / 2
-        return np.exp(np.concatenate([[2 * lc[0] - mid[0]], mid, [2 * lc[-1] - mid[-1]]]))
-    mid = (centres[1:] + centres[:-1]) / 2
-    return np.concatenate([[2 * centres[0] - mid[0]], mid, [2 * centres[-1] - mid[-1]]])
 
 
 def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | None = None) -> Path:
@@ -169,7 +637,7 @@ def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | N
         xs = np.broadcast_to(x[:, None], lo.shape).ravel()
         ax.plot(np.concatenate([xs, xs]), np.concatenate([lo_b.ravel(), hi_b.ravel()]), "k.", ms=2.5, label="boundary")
         ax.set_xlim(edges[0], edges[-1])
-        ax.set_xlabel(_axis_label(ds, free[0]))
+        ax.set_xlabel(axis_label(ds, free[0]))
         if ds[free[0]].attrs.get("scale") == "log":
             ax.set_xscale("log")
     else:
@@ -179,7 +647,7 @@ def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | N
         ax.set_xticks([])
     ax.set_ylim(float(scan[0]), float(scan[-1]))
     units = lower.attrs.get("units", "")
-    ax.set_ylabel(f"{along} [{units}]" if units else along)
+    ax.set_ylabel(f"{_symbol(along)} [{_units(units)}]" if _units(units) else _symbol(along))
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     title = textwrap.fill(ds.attrs.get("title", "stabmap critical values"), 70) + f"\nstable {along} (white: unstable); ends to rtol {ds.attrs['critical_rtol']:g}"
     if chosen:
