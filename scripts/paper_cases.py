@@ -221,8 +221,7 @@ def _figure(case: Case, scene, ds, crit, picks, path: Path) -> None:
         draw(t, r, marker="o", ms=6, mfc="none", mec="white", mew=1.6, label="engine, located to 1e-10")
     handles, labels = ax.get_legend_handles_labels()
     if handles:
-        ax.legend(handles, labels, loc="lower right", fontsize=8, framealpha=0.85)
-    fig.suptitle(f"{case.name}: paper {case.equation}", fontsize=9)
+        ax.legend(handles, labels, loc="best", fontsize=8, framealpha=0.85)
     _save(fig, path)
 
 
