@@ -26,6 +26,7 @@ from .errors import StabmapError  # noqa: E402
 from .examples import example, example_names  # noqa: E402
 from .io import open_atlas, write_atlas  # noqa: E402
 from .query import StableFraction, boundaries, label_at, smallest_stable, stable_fraction, summary  # noqa: E402
+from .plot import atlas_figure, plot_atlas  # noqa: E402
 from .refine import compute_refined  # noqa: E402
 from .scene import Axis, Body, Scene  # noqa: E402
 from .scene import load as load_scene  # noqa: E402
@@ -37,6 +38,7 @@ __all__ = [
     "Scene",
     "StableFraction",
     "StabmapError",
+    "atlas_figure",
     "boundaries",
     "cavity",
     "compute_atlas",
@@ -48,6 +50,7 @@ __all__ = [
     "load_scene",
     "loads_scene",
     "open_atlas",
+    "plot_atlas",
     "smallest_stable",
     "stable_fraction",
     "summary",
