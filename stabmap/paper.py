@@ -193,15 +193,20 @@ def paper_polynomial(ch: Chain) -> flint.fmpq_poly:
 
 
 def _det(rows: list) -> flint.fmpq_poly:
-    """Determinant by expansion along the first row (n <= 10 here; the entries are polynomials)."""
-    if len(rows) == 1:
-        return rows[0][0]
-    out = flint.fmpq_poly(0)
-    for j, entry in enumerate(rows[0]):
-        if not entry.is_zero():
-            minor = [r[:j] + r[j + 1 :] for r in rows[1:]]
-            out += (-1) ** j * entry * _det(minor)
-    return out
+    """Determinant of a matrix of polynomials by Bareiss' fraction-free elimination (every division is exact)."""
+    a = [list(r) for r in rows]
+    n, sign, prev = len(a), 1, flint.fmpq_poly(1)
+    for k in range(n - 1):
+        pivot = next((i for i in range(k, n) if not a[i][k].is_zero()), None)
+        if pivot is None:
+            return flint.fmpq_poly(0)
+        if pivot != k:
+            a[k], a[pivot], sign = a[pivot], a[k], -sign
+        for i in range(k + 1, n):
+            for j in range(k + 1, n):
+                a[i][j] = (a[i][j] * a[k][k] - a[i][k] * a[k][j]) // prev
+        prev = a[k][k]
+    return sign * a[n - 1][n - 1]
 
 
 # ---------------------------------------------------------------- the closed-form cases

@@ -205,3 +205,15 @@ def test_paper_cases_check_fails_on_a_wrong_closed_form(monkeypatch):
     case = CASES["paper-n1-fixed-1mode"]
     result = SCRIPT["check_case"](case, quick=True, rows=2, out=None)
     assert any("closed form" in msg for msg in result["problems"])
+
+
+@pytest.mark.parametrize("n", range(2, 11))
+def test_conjecture_counterexample_from_the_printed_determinants(n):
+    # docs/conjecture.md's counterexample, rechecked with the paper's own (32), (30) and (28): one free body
+    # (24) is unstable, the chain of n copies is unstable with ideal joints and stable with K = 1024.
+    q = paper.q
+    body = dict(m=[q(2)] * n, A=[q(4)] * n, C=[q(1)] * n, c=[q(1)] * n, s=[q(2)] * (n - 1) + [q(0)], omega=[q(1)] * n,
+                E=[[q(0.5)]] * n, kappa=[[q(4)]] * n, free=True)
+    assert paper.closed_form_pairs(paper.factors(paper.Chain(**{k: v[:1] if isinstance(v, list) else v for k, v in body.items()}, K=[]), "free-body")) == 1
+    assert paper.complex_pairs(paper.paper_polynomial(paper.Chain(**body, K=[q(0)] * (n - 1)))) >= 1
+    assert paper.complex_pairs(paper.paper_polynomial(paper.Chain(**body, K=[q(1024)] * (n - 1)))) == 0
