@@ -51,6 +51,7 @@ import flint
 import numpy as np
 
 from stabmap import decide as _decide
+from stabmap.paper import complex_pairs, det
 from stabmap.points import PointArrays
 
 #: Sampled region of the random search (docs/conjecture.md, "The search with joints").
@@ -140,33 +141,13 @@ def single_poly(A, C, omega, E=(), kappa=()) -> flint.fmpq_poly:
     return Q * (_q(A) * LAM**2 + _q(C) * w * LAM) - LAM**2 * (LAM + w) * R
 
 
-def _det_poly(rows: list[list[flint.fmpq_poly]]) -> flint.fmpq_poly:
-    """Determinant of a matrix over Q[lam] by Bareiss' fraction-free elimination (exact divisions)."""
-    a = [list(r) for r in rows]
-    n = len(a)
-    sign, prev = 1, flint.fmpq_poly([1])
-    for k in range(n - 1):
-        if a[k][k] == 0:
-            swap = next((r for r in range(k + 1, n) if a[r][k] != 0), None)
-            if swap is None:
-                return flint.fmpq_poly([0])
-            a[k], a[swap] = a[swap], a[k]
-            sign = -sign
-        for i in range(k + 1, n):
-            for j in range(k + 1, n):
-                q, r = divmod(a[i][j] * a[k][k] - a[i][k] * a[k][j], prev)
-                assert r == 0, "Bareiss division must be exact"
-                a[i][j] = q
-        prev = a[k][k]
-    return sign * a[n - 1][n - 1]
-
-
 def chain_poly(n: int, m, c, A, C, omega, E=(), kappa=(), joints=()) -> flint.fmpq_poly:
     """Exact p(lam) = det(diag(Q) Phi) of n identical free bodies (c_k = c, s_k = 2c), MODEL.md.
 
     ``joints`` are K_1..K_{n-1} (padded with zeros). Built here from J, M, G, K directly, with a
     fraction-free determinant, so that it shares no code with the engine's exact path
-    (stabmap/exact.py interpolates determinants at integer points instead).
+    (stabmap/exact.py interpolates determinants at integer points instead; stabmap.paper's Bareiss
+    determinant is shared with the paper's printed forms, which start from other matrices).
     """
     Kj = [_q(k) for k in joints] + [flint.fmpq(0)] * (n - 1 - len(joints))
     M = gram_matrix(n) * (_q(m) * _q(c) ** 2)
@@ -187,7 +168,7 @@ def chain_poly(n: int, m, c, A, C, omega, E=(), kappa=(), joints=()) -> flint.fm
                 entry += Q * (_q(A) * LAM**2 + _q(C) * w * LAM) - LAM**2 * (LAM + w) * R
             row.append(entry)
         rows.append(row)
-    return _det_poly(rows)
+    return det(rows)
 
 
 def factorised_poly(n: int, m, c, A, C, omega, E=(), kappa=()) -> flint.fmpq_poly:
@@ -206,18 +187,6 @@ def factorised_poly(n: int, m, c, A, C, omega, E=(), kappa=()) -> flint.fmpq_pol
         e_k = (-1) ** k * coeffs[n - k] * scale**k
         out += e_k * (LAM**2 * Q) ** k * p1 ** (n - k)
     return out
-
-
-def complex_pairs(p: flint.fmpq_poly) -> int:
-    """N_c = (deg p - real roots with multiplicity) / 2, from FLINT/Arb's certified root isolation."""
-    if p == 0:
-        raise ValueError("p vanishes identically")
-    real = 0
-    for factor, mult in p.numer().factor_squarefree()[1]:
-        real += mult * sum(1 for root in factor.complex_roots() if root[0].imag.is_zero())
-    missing = p.degree() - real
-    assert missing % 2 == 0, missing
-    return missing // 2
 
 
 # ----------------------------------------------------------------------------------------------

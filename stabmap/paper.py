@@ -189,10 +189,10 @@ def paper_polynomial(ch: Chain) -> flint.fmpq_poly:
                 off = [K[min(i, j) + 1] if abs(i - j) == 1 else ZERO, ZERO, mu[min(i, j), max(i, j)]]
                 row.append(_mul(off, Qi))
         rows.append([flint.fmpq_poly(e) for e in row])
-    return _det(rows)
+    return det(rows)
 
 
-def _det(rows: list) -> flint.fmpq_poly:
+def det(rows: list) -> flint.fmpq_poly:
     """Determinant of a matrix of polynomials by Bareiss' fraction-free elimination (every division is exact)."""
     a = [list(r) for r in rows]
     n, sign, prev = len(a), 1, flint.fmpq_poly(1)
