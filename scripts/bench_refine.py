@@ -14,16 +14,14 @@ loaded from the cache before any timing.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import os
 import platform
 import time
 
-import numpy as np
 
 import stabmap
 from stabmap.decide import BY_INFERRED
-from stabmap.scene import Axis
+from stabmap.scene import resample
 
 FULL_SCENES = ["paper-n3-fixed", "paper-n1-fixed", "paper-n1-free", "paper-n2-fixed", "paper-n2-free", "paper-n3-free"]
 QUICK_SCENES = ["paper-n1-fixed", "paper-n2-fixed"]
@@ -32,12 +30,7 @@ MARGINS = (0, 1, 2)
 
 def regrid(scene, num: int):
     """The scene with every grid axis resampled to ``num`` points over the same range."""
-    axes = []
-    for a in scene.grid:
-        lo, hi = a.values[0], a.values[-1]
-        values = np.geomspace(lo, hi, num) if a.scale == "log" else np.linspace(lo, hi, num)
-        axes.append(Axis(a.name, tuple(float(v) for v in values), a.scale))
-    return dataclasses.replace(scene, grid=tuple(axes))
+    return resample(scene, **{a.name: num for a in scene.grid})
 
 
 def _timed(f, *args, **kwargs):

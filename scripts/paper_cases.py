@@ -38,7 +38,7 @@ import numpy as np
 from stabmap import atlas, critical, example, paper
 from stabmap.io import write_atlas
 from stabmap.points import point_arrays
-from stabmap.scene import Axis
+from stabmap.scene import Axis, resample
 
 RTOL = 1e-8  # engine ends are located to 1e-10 and discriminant roots to ~1e-15; this leaves room for both
 
@@ -66,18 +66,6 @@ CASES = (
     Case("paper-n3-free-identical", "(33): identical free bodies, (F~ - 2/3)(F~ - 1/3)(F~ + 7/3)", "identical-free", "C"),
     Case("paper-n3-fixed-split", "a_2 = a_3 = 0: F_1 F_2 F_3, (23) x (24) x (24)", "split", "omega"),
 )
-
-
-def regrid(scene, nums: dict[str, int]):
-    """The scene with grid axes resampled to ``nums[name]`` points over the same range (others unchanged)."""
-    axes = []
-    for a in scene.grid:
-        if a.name in nums:
-            lo, hi = a.values[0], a.values[-1]
-            values = np.geomspace(lo, hi, nums[a.name]) if a.scale == "log" else np.linspace(lo, hi, nums[a.name])
-            a = Axis(a.name, tuple(float(v) for v in values), a.scale)
-        axes.append(a)
-    return dataclasses.replace(scene, grid=tuple(axes))
 
 
 def _other(scene, along: str) -> str:
@@ -137,7 +125,7 @@ def check_case(case: Case, *, quick: bool, rows: int, out: Path | None) -> dict:
     scene = example(case.name)
     other = _other(scene, case.along)
     if quick:
-        scene = regrid(scene, {case.along: 60, other: 40})
+        scene = resample(scene, **{case.along: 60, other: 40})
     t0 = time.perf_counter()
     ds = atlas.compute(scene, progress=False)
     t_atlas = time.perf_counter() - t0
@@ -231,7 +219,7 @@ def write_golden(directory: Path) -> list[Path]:
     paths = []
     for case in CASES:
         scene = example(case.name)
-        scene = regrid(scene, {case.along: 41, _other(scene, case.along): 21})
+        scene = resample(scene, **{case.along: 41, _other(scene, case.along): 21})
         ds = atlas.compute(scene, progress=False)
         ds.attrs["history"] = f"golden atlas of the paper case {case.name}: python scripts/paper_cases.py --golden {directory}"
         paths.append(write_atlas(ds, directory / f"{case.name}.nc"))

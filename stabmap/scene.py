@@ -7,7 +7,7 @@ TOML text stored back into every atlas so the file says how it was made.
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -309,6 +309,21 @@ def _check_cavities(scene: Scene) -> None:
         liquid.check_body(cav, f"bodies[{k}]", extremes)
 
 
+def resample(scene: Scene, **nums: int) -> Scene:
+    """The scene with the named grid axes resampled to ``nums[name]`` points over the same range and scale."""
+    unknown = set(nums) - {a.name for a in scene.grid}
+    if unknown:
+        raise StabmapError(f"resample: {sorted(unknown)[0]!r} is not a grid axis of this scene")
+    axes = []
+    for a in scene.grid:
+        if a.name in nums:
+            lo, hi = a.values[0], a.values[-1]
+            values = np.geomspace(lo, hi, nums[a.name]) if a.scale == "log" else np.linspace(lo, hi, nums[a.name])
+            a = Axis(a.name, tuple(float(v) for v in values), a.scale)
+        axes.append(a)
+    return replace(scene, grid=tuple(axes))
+
+
 def fixed_values(scene: Scene) -> dict[str, float]:
     """Every scalar parameter of the scene that is not a grid axis, by its scannable name."""
     names = {a.name for a in scene.grid}
@@ -334,4 +349,4 @@ def fixed_values(scene: Scene) -> dict[str, float]:
     return {k: v for k, v in out.items() if k not in names}
 
 
-__all__ = ["Axis", "Body", "Scene", "load", "loads", "from_dict", "fixed_values", "SUPPORTS"]
+__all__ = ["Axis", "Body", "Scene", "load", "loads", "from_dict", "fixed_values", "resample", "SUPPORTS"]

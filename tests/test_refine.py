@@ -15,19 +15,14 @@ import pytest
 import stabmap
 from stabmap.cli import main
 from stabmap.decide import BY_INFERRED
-from stabmap.scene import Axis
+from stabmap.scene import Axis, resample
 
 ALL_EXAMPLES = stabmap.example_names()
 
 
 def regrid(scene, *nums: int):
     """The scene with its grid axes resampled to ``nums`` points over the same ranges."""
-    axes = []
-    for a, num in zip(scene.grid, nums):
-        lo, hi = a.values[0], a.values[-1]
-        values = np.geomspace(lo, hi, num) if a.scale == "log" else np.linspace(lo, hi, num)
-        axes.append(Axis(a.name, tuple(float(v) for v in values), a.scale))
-    return dataclasses.replace(scene, grid=tuple(axes))
+    return resample(scene, **{a.name: num for a, num in zip(scene.grid, nums)})
 
 
 def dense(scene):
