@@ -231,7 +231,7 @@ def atlas_shares(names, quick: bool) -> list:
         if quick:  # every 12th grid value of each axis
             scene = dataclasses.replace(scene, grid=tuple(dataclasses.replace(a, values=a.values[::12]) for a in scene.grid))
         t0 = time.perf_counter()
-        ds = compute(scene, workers=1, progress=False)
+        ds = compute(scene, threads=1, progress=False)
         t = time.perf_counter() - t0
         by = ds["decided_by"].values.ravel()
         out.append((name, by.size, 100 * (by == BY_STURM).mean(), 100 * (by == BY_INCLUSION).mean(),

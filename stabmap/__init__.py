@@ -4,6 +4,7 @@
 >>> scene = stabmap.example("paper-n3-fixed")     # or stabmap.load_scene("scene.toml")
 >>> ds = stabmap.compute_atlas(scene)              # xarray.Dataset
 >>> stabmap.write_atlas(ds, "atlas.nc")
+>>> stabmap.compute_to_file(scene, "big.nc", client="tcp://HOST:8786")   # streamed, on a dask cluster
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ if getattr(_kernels, "STABMAP_KERNELS", None) != 1:
 from . import accessor  # noqa: E402,F401  (registers the ds.stabmap accessor)
 from . import cavity  # noqa: E402
 from .atlas import compute as compute_atlas  # noqa: E402
+from .atlas import compute_to_file  # noqa: E402
 from .critical import critical  # noqa: E402
 from .errors import StabmapError  # noqa: E402
 from .examples import example, example_names  # noqa: E402
@@ -43,6 +45,7 @@ __all__ = [
     "cavity",
     "compute_atlas",
     "compute_refined",
+    "compute_to_file",
     "critical",
     "example",
     "example_names",

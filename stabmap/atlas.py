@@ -1,22 +1,29 @@
-"""Compute a stability atlas: the grid of a scene, chunked, decided by dask threads."""
+"""Compute a stability atlas: the grid of a scene, cut into chunks, decided on threads or a dask cluster.
+
+``compute`` returns the atlas in memory.  ``compute_to_file`` streams finished
+chunks to disk (``partial``) and then into the netCDF or Zarr file, so the
+writing process never holds the whole atlas, and an interrupted run resumes
+where it stopped.
+"""
 
 from __future__ import annotations
 
 import datetime as _dt
-import os
+import math
 import sys
+from dataclasses import dataclass, field
+from pathlib import Path
 
-import dask
-import dask.array as da
 import numpy as np
 import xarray as xr
-from dask.diagnostics import ProgressBar
 
 from . import __version__
-from .decide import decide
+from .chunks import check_chunk_points, chunk_locations, chunk_shape, default_chunk_points
+from .cluster import check_threads, cluster_threads, connect, run_chunks
 from .errors import StabmapError
 from .parameters import parse_name
-from .points import block_arrays, spin_axes_last
+from .partial import PartialRun, partial_dir
+from .progress import ProgressLine
 from .scene import Scene, fixed_values
 from .variables import ATTRS, DECIDED_BY, N_COMPLEX_PAIRS, STABILITY, stability_from_pairs
 
@@ -27,65 +34,173 @@ REFERENCES = (
 )
 
 
-def chunk_shape(shape: tuple[int, ...], workers: int, target: int | None = None) -> tuple[int, ...]:
-    """Chunk sizes per axis: about ``target`` points a chunk, trailing axes kept whole first."""
-    total = int(np.prod(shape, dtype=np.int64)) if shape else 1
-    if target is None:
-        target = int(min(32768, max(1024, total // (4 * max(1, workers)))))
-    chunks = []
-    budget = target
-    for size in reversed(shape):
-        c = max(1, min(size, budget))
-        chunks.append(c)
-        budget = max(1, budget // c)
-    return tuple(reversed(chunks))
-
-
-def _block(template, scene: Scene, block_info=None):
-    location = block_info[0]["array-location"] if template.ndim else []
-    order = spin_axes_last(scene)
-    nc, decided_by = decide(block_arrays(scene, location, order))
-    permuted = tuple(template.shape[d] for d in order)
-    back = np.argsort(order)
-    nc = nc.reshape(permuted).transpose(back)
-    decided_by = decided_by.reshape(permuted).transpose(back)
-    return np.stack([nc, decided_by.astype(np.int16)], axis=-1)
-
-
-def compute(scene: Scene, *, workers: int | None = None, progress: bool | None = None, chunk_points: int | None = None) -> xr.Dataset:
-    """Compute the atlas of ``scene`` as a labelled Dataset.
+def compute(
+    scene: Scene,
+    *,
+    client=None,
+    threads: int | None = None,
+    progress: bool | None = None,
+    chunk_points: int | None = None,
+) -> xr.Dataset:
+    """Compute the atlas of ``scene`` as a labelled Dataset (in memory).
 
     Parameters
     ----------
     scene : Scene
         Bodies, support and grid; a scene without grid gives a 0-d atlas (one point).
-    workers : int, optional
-        Threads (default: all cores).
+    client : dask.distributed.Client or str, optional
+        Run the chunks on this cluster (a Client, or a scheduler address such as
+        ``"tcp://10.0.0.5:8786"``).  Default: threads in this process.
+    threads : int, optional
+        Threads of an in-process run (default: all cores); ignored with ``client``.
     progress : bool, optional
-        Progress bar on stderr for runs over two seconds (default: when stderr is a terminal).
+        Progress line on stderr for runs over two seconds (default: when stderr is a terminal).
     chunk_points : int, optional
-        Points per chunk (default: about 32768, fewer for small grids).
+        Points per task (default: about half a second of work, see ``stabmap.chunks``).
     """
-    workers = workers or os.cpu_count() or 1
-    if workers < 1:
-        raise StabmapError(f"workers must be >= 1, got {workers}")
     shape = scene.shape
-    chunks = chunk_shape(shape, workers, chunk_points)
-    template = da.zeros(shape, chunks=chunks, dtype=np.int8)
-    stacked = da.map_blocks(
-        _block, template, scene, dtype=np.int16, new_axis=len(shape), chunks=template.chunks + ((2,),)
-    )
-    if progress is None:
-        progress = sys.stderr.isatty()
-    with dask.config.set(scheduler="threads", num_workers=workers):
-        if progress:
-            with ProgressBar(minimum=2.0, out=sys.stderr, dt=0.5):
-                result = stacked.compute()
-        else:
-            result = stacked.compute()
-    nc = result[..., 0].astype(np.int16)
-    decided_by = result[..., 1].astype(np.int8)
+    nc = np.empty(shape, dtype=np.int16)
+    decided_by = np.empty(shape, dtype=np.int8)
+
+    def keep(i, block):
+        where = tuple(slice(a, b) for a, b in locations[i])
+        nc[where], decided_by[where] = block[0], block[1]
+
+    with _Run(scene, client, threads, progress, chunk_points) as run:
+        locations = run.locations
+        run.run(list(range(len(locations))), keep)
     return _dataset(scene, nc, decided_by)
+
+
+@dataclass
+class FileReport:
+    """What ``compute_to_file`` did: chunks computed now and reused from an interrupted run, and the atlas' counts."""
+
+    path: Path
+    chunks: int
+    computed: int
+    reused: int
+    counts: dict = field(default_factory=dict)
+
+
+def compute_to_file(
+    scene: Scene,
+    path: str | Path,
+    *,
+    client=None,
+    threads: int | None = None,
+    progress: bool | None = None,
+    chunk_points: int | None = None,
+    resume: bool = False,
+) -> FileReport:
+    """Compute the atlas of ``scene`` straight into ``path`` (``.nc``: netCDF4; ``.zarr``: Zarr).
+
+    Finished chunks go to ``PATH.partial/`` as they arrive and the file is
+    written from there chunk by chunk, then renamed into place: memory stays
+    bounded by a few chunks whatever the size of the atlas, and ``path`` is
+    either complete or absent.  If the run is interrupted, ``resume=True``
+    computes only the chunks not yet in ``PATH.partial/`` and gives the same file.
+
+    Parameters are those of ``compute``, and
+    resume : bool
+        Finish the interrupted run of the same scene saved in ``PATH.partial/``
+        (start afresh if there is none).  Without it, an existing
+        ``PATH.partial/`` is an error, so that no finished work is thrown away unasked.
+    """
+    from .io import check_writable, write_streamed
+
+    path = check_writable(path)
+    where = partial_dir(path)
+    scene_toml = scene.to_toml()
+    partial = None
+    if where.exists():
+        if not resume:
+            raise StabmapError(
+                f"an interrupted run of this output is saved in {str(where)!r}; add --resume (resume=True) to finish it, "
+                f"or delete {str(where)!r} to start over"
+            )
+        partial = PartialRun.open(where)
+        if partial.scene_toml != scene_toml:
+            raise StabmapError(
+                f"the interrupted run in {str(where)!r} was computed from a different scene; give the same scene to "
+                f"resume it, or delete {str(where)!r} to start over"
+            )
+    with _Run(scene, client, threads, progress, chunk_points, partial) as run:
+        if partial is None:
+            partial = PartialRun.create(where, scene_toml, scene.shape, run.chunks)
+        done = partial.done()
+        todo = [i for i in range(len(run.locations)) if i not in done]
+        run.done_before = len(done)
+        try:
+            run.run(todo, partial.save)
+        except (StabmapError, KeyboardInterrupt):
+            raise
+        except Exception as exc:
+            raise StabmapError(
+                f"the run failed ({type(exc).__name__}: {exc}); {len(partial.done())} of {len(run.locations)} chunks are "
+                f"saved in {str(where)!r}; fix the cause and run again with --resume"
+            ) from exc
+    counts = write_streamed(scene, partial, run.locations, path)
+    partial.remove()
+    return FileReport(path, len(run.locations), len(todo), len(done), counts)
+
+
+class _Run:
+    """The chunk layout of one run, where its tasks go, and its progress line."""
+
+    def __init__(self, scene, client, threads, progress, chunk_points, partial: PartialRun | None = None):
+        self.scene, self.client_arg, self.partial = scene, client, partial
+        self.threads = check_threads(threads)
+        self.chunk_points = check_chunk_points(chunk_points)
+        self.progress = ProgressLine(sys.stderr.isatty() if progress is None else progress)
+        self.done_before = 0
+
+    def __enter__(self):
+        self._connection = connect(self.client_arg)
+        self.client = self._connection.__enter__()
+        try:
+            if self.client is not None:
+                self.threads = cluster_threads(self.client)
+            self._layout()
+        except BaseException:
+            self.__exit__(*sys.exc_info())
+            raise
+        return self
+
+    def __exit__(self, *exc):
+        self.progress.close()
+        return self._connection.__exit__(*exc)
+
+    def _layout(self):
+        shape = self.scene.shape
+        if self.partial is not None:
+            self.chunks = self.partial.chunks
+            if self.chunk_points is not None and chunk_shape(shape, self.chunk_points) != self.chunks:
+                raise StabmapError(
+                    f"chunk_points {self.chunk_points} gives other chunks than the interrupted run's {list(self.chunks)}; "
+                    "leave chunk_points (--chunk-points) out to resume"
+                )
+        else:
+            points = self.chunk_points or default_chunk_points(self.scene, self.threads)
+            self.chunks = chunk_shape(shape, points)
+        self.locations = chunk_locations(shape, self.chunks)
+
+    def run(self, todo: list[int], on_result) -> None:
+        total, per = len(self.locations), max(1, math.prod(self.chunks))
+        finished = [0]
+
+        def handle(i, block):
+            on_result(i, block)
+            finished[0] += 1
+            done = self.done_before + finished[0]
+            rate = finished[0] / max(self.progress.elapsed, 1e-9)
+            eta = (len(todo) - finished[0]) / rate if rate else float("nan")
+            self.progress.show(
+                f"[atlas] {done:,}/{total:,} chunks of ~{per:,} points | {self.progress.elapsed:.0f} s, "
+                f"about {eta:.0f} s to go"
+            )
+
+        run_chunks(self.scene, self.locations, todo, handle, client=self.client, threads=self.threads)
 
 
 def coordinates(scene: Scene, skip: tuple[str, ...] = ()) -> dict:
@@ -102,12 +217,12 @@ def coordinates(scene: Scene, skip: tuple[str, ...] = ()) -> dict:
     return coords
 
 
-def _dataset(scene: Scene, nc: np.ndarray, decided_by: np.ndarray) -> xr.Dataset:
+def _dataset(scene: Scene, nc: np.ndarray, decided_by: np.ndarray, stability: np.ndarray | None = None) -> xr.Dataset:
     dims = tuple(a.name for a in scene.grid)
     coords = coordinates(scene)
     data = {
         N_COMPLEX_PAIRS: (dims, nc, ATTRS[N_COMPLEX_PAIRS]),
-        STABILITY: (dims, stability_from_pairs(nc), ATTRS[STABILITY]),
+        STABILITY: (dims, stability_from_pairs(nc) if stability is None else stability, ATTRS[STABILITY]),
         DECIDED_BY: (dims, decided_by, ATTRS[DECIDED_BY]),
     }
     return xr.Dataset(data, coords=coords, attrs=global_attrs(scene, "stabmap atlas"))

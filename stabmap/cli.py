@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 import time
 
 import numpy as np
@@ -27,6 +29,7 @@ def _pairs(items: list[str], what: str) -> dict[str, float]:
 
 def _scene_for_run(args):
     """The scene of an ``atlas`` or ``critical`` run, after every check that can fail before the work."""
+    from .cluster import check_threads
     from .examples import example
     from .io import check_writable
     from .scene import load
@@ -37,31 +40,73 @@ def _scene_for_run(args):
     if args.png:
         check_writable(args.png)
     scene = load(args.scene) if args.scene else example(args.example)
-    if args.workers is not None and args.workers < 1:
-        raise StabmapError(f"--workers must be >= 1, got {args.workers}")
+    for option in ("threads", "workers"):
+        if getattr(args, option, None) is not None:
+            check_threads(getattr(args, option), f"--{option}")
     return scene
 
 
 def _cmd_atlas(args) -> None:
-    from .atlas import compute
+    from .atlas import compute_to_file
     from .io import write_atlas
     from .plot import plot_atlas
 
     refine = _refine_options(args)
+    where = _where_to_run(args)
     scene = _scene_for_run(args)
     t0 = time.perf_counter()
     if refine is None:
-        ds = compute(scene, workers=args.workers, progress=not args.quiet)
+        with _cluster(where) as client:
+            report = compute_to_file(
+                scene, args.output, client=client, threads=args.threads, progress=not args.quiet,
+                chunk_points=args.chunk_points, resume=args.resume,
+            )
+        stats = _summary_line(report.counts)
+        if report.reused:
+            stats += f"; resumed: {report.reused} of {report.chunks} chunks were already done, {report.computed} computed now"
+        ds = None
     else:
         from .refine import compute_refined
 
-        ds = compute_refined(scene, workers=args.workers, progress=not args.quiet, **refine)
-    write_atlas(ds, args.output)
-    stats = _summary_line(ds)
+        ds = compute_refined(scene, threads=args.threads, progress=not args.quiet, **refine)
+        write_atlas(ds, args.output)
+        stats = _summary_line(None, ds)
     print(f"wrote {args.output}: {stats} in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
     if args.png:
+        if ds is None:
+            from .io import open_atlas
+
+            ds = open_atlas(args.output)
         plot_atlas(ds, args.png)
         print(f"wrote {args.png}", file=sys.stderr)
+
+
+def _where_to_run(args) -> str | int | None:
+    """--scheduler ADDRESS, --workers N (a local cluster) or None (threads here), checked before any work."""
+    from .chunks import check_chunk_points
+
+    if args.scheduler is not None and args.workers is not None:
+        raise StabmapError("give --scheduler ADDRESS (an existing cluster) or --workers N (a local one), not both")
+    cluster = args.scheduler if args.scheduler is not None else args.workers
+    if cluster is not None and args.threads is not None:
+        raise StabmapError("--threads sets the threads of an in-process run; on a cluster each worker has its own (dask worker --nthreads)")
+    if cluster is not None and args.refine:
+        raise StabmapError("--refine runs in this process only; drop --scheduler/--workers, or drop --refine for a dense atlas on the cluster")
+    check_chunk_points(args.chunk_points, "--chunk-points")
+    if args.refine and (args.resume or args.chunk_points is not None):
+        raise StabmapError(f"{'--resume' if args.resume else '--chunk-points'} applies to dense atlases; drop --refine or the option")
+    return cluster
+
+
+def _cluster(where):
+    """A context giving the client argument of ``compute_to_file``: None, an address, or a local cluster's Client."""
+    import contextlib
+
+    if isinstance(where, int):
+        from .cluster import local_cluster
+
+        return local_cluster(where)
+    return contextlib.nullcontext(where)
 
 
 def _refine_options(args) -> dict | None:
@@ -77,13 +122,13 @@ def _refine_options(args) -> dict | None:
     return {"coarse_stride": check_coarse_stride(args.coarse_stride, "--coarse-stride"), "margin": check_margin(margin, "--margin")}
 
 
-def _summary_line(ds) -> str:
+def _summary_line(counts: dict | None, ds=None) -> str:
     from .query import summary
 
-    s = summary(ds)
+    s = counts if counts is not None else summary(ds)
     exact = s["decided_by"]["exact_rational_arithmetic"]
     line = f"{s['points']} points, {100 * s['stable_fraction']:.1f} % stable, {exact} decided in exact arithmetic"
-    evaluated = ds.attrs.get("n_evaluated_points")
+    evaluated = None if ds is None else ds.attrs.get("n_evaluated_points")
     if evaluated is not None:
         evaluated = int(evaluated)
         line += (
@@ -220,7 +265,7 @@ def _cmd_critical(args) -> None:
             f"the file afterwards with 'stabmap plot {args.output} -o PNG --sel {others[-1]}=VALUE'"
         )
     t0 = time.perf_counter()
-    ds = critical(scene, args.along, rtol=args.rtol, workers=args.workers)
+    ds = critical(scene, args.along, rtol=args.rtol, threads=args.threads)
     write_atlas(ds, args.output)
     print(f"wrote {args.output} in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
     if not args.quiet:
@@ -268,9 +313,13 @@ def parser() -> argparse.ArgumentParser:
     a = sub.add_parser("atlas", help="compute an atlas from a scene and write netCDF4")
     a.add_argument("scene", nargs="?", help="scene TOML file")
     a.add_argument("--example", metavar="NAME", help="a bundled example scene (see 'stabmap examples')")
-    a.add_argument("-o", "--output", required=True, help="netCDF file to write, e.g. atlas.nc")
+    a.add_argument("-o", "--output", required=True, help="file to write: atlas.nc (netCDF4) or atlas.zarr (Zarr)")
     a.add_argument("--png", metavar="FILE", help="also draw the atlas to this PNG/PDF")
-    a.add_argument("--workers", type=int, help="threads (default: all cores)")
+    a.add_argument("--threads", type=int, help="threads of an in-process run (default: all cores)")
+    a.add_argument("--workers", type=int, metavar="N", help="start a local dask cluster of N worker processes for the run")
+    a.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing dask.distributed cluster, e.g. tcp://HOST:8786 (docs/cluster.md)")
+    a.add_argument("--chunk-points", type=int, metavar="P", help="grid points per task (default: about half a second of work each)")
+    a.add_argument("--resume", action="store_true", help="finish an interrupted run from OUTPUT.partial/, computing only the missing chunks")
     a.add_argument("--refine", action="store_true", help="adaptive: a coarse lattice, refined only where labels change (docs/refine.md)")
     a.add_argument("--coarse-stride", type=int, metavar="S", help="with --refine: grid steps between coarse nodes, a power of two (default: 64-127 cells per axis)")
     a.add_argument("--margin", type=int, metavar="M", help="with --refine: cells split around every disagreeing cell (default 2)")
@@ -338,7 +387,7 @@ def parser() -> argparse.ArgumentParser:
     c.add_argument("-o", "--output", required=True, help="netCDF file to write, e.g. critical.nc")
     c.add_argument("--png", metavar="FILE", help="also draw the stable intervals to this PNG/PDF")
     c.add_argument("--rtol", type=float, default=1e-10, help="relative width of the located ends (default 1e-10)")
-    c.add_argument("--workers", type=int, help="threads (default: all cores)")
+    c.add_argument("--threads", type=int, help="threads (default: all cores)")
     c.add_argument("-q", "--quiet", action="store_true", help="no interval listing")
     c.set_defaults(func=_cmd_critical)
 
@@ -349,15 +398,37 @@ def parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
+    # 'kill' (SIGTERM) stops a run as Ctrl-C does: temporary files removed, finished chunks kept for --resume.
+    previous = signal.signal(signal.SIGTERM, _interrupt) if threading.current_thread() is threading.main_thread() else None
     try:
         args.func(args)
     except StabmapError as exc:
         print(f"stabmap: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("stabmap: interrupted; no output file was written", file=sys.stderr)
+        print(f"stabmap: interrupted; {_interrupted_note(args)}", file=sys.stderr)
         return 130
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     return 0
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+def _interrupted_note(args) -> str:
+    from .partial import partial_dir
+
+    output = getattr(args, "output", None)
+    if output is None or args.func is not _cmd_atlas:
+        return "no output file was written"
+    saved = partial_dir(output)
+    if not saved.is_dir():
+        return f"{output} was not written"
+    chunks = len(list(saved.glob("chunk-*.npy")))
+    return f"{output} was not written; {chunks} finished chunks are saved in {saved}: run the same command with --resume to finish"
 
 
 if __name__ == "__main__":

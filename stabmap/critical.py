@@ -26,7 +26,6 @@ docs/critical.md.
 from __future__ import annotations
 
 import math
-import os
 import time
 from dataclasses import dataclass
 
@@ -35,6 +34,7 @@ import xarray as xr
 
 from .atlas import compute as compute_atlas
 from .atlas import coordinates, global_attrs
+from .cluster import check_threads
 from .decide import BY_EXACT, decide_values
 from .errors import StabmapError
 from .parameters import parse_name
@@ -118,7 +118,7 @@ def critical(
     *,
     rtol: float = DEFAULT_RTOL,
     atol: float | None = None,
-    workers: int | None = None,
+    threads: int | None = None,
     progress: bool | None = None,
 ) -> xr.Dataset:
     """The intervals of ``along`` where the rotation is stable, ends located to ``rtol``.
@@ -138,7 +138,7 @@ def critical(
         Absolute floor of the bracket width. It only matters for a boundary at
         or very near 0, where a relative width cannot be reached. Default:
         1e-6 * rtol * max |scan value|.
-    workers : int, optional
+    threads : int, optional
         Threads (default: all cores).
     progress : bool, optional
         Progress bar on stderr for a scan over two seconds (default: when stderr is a terminal).
@@ -151,9 +151,7 @@ def critical(
     """
     index = check_along(scene, along)
     rtol = check_rtol(rtol)
-    workers = workers or os.cpu_count() or 1
-    if workers < 1:
-        raise StabmapError(f"workers must be >= 1, got {workers}")
+    threads = check_threads(threads)
     scan = np.sort(scene.grid[index].array)
     if atol is None:
         atol = ATOL_FACTOR * rtol * float(np.abs(scan).max())
@@ -162,17 +160,17 @@ def critical(
     others = tuple(a for d, a in enumerate(scene.grid) if d != index)
     counts = _Counts()
     t0 = time.perf_counter()
-    nc = _scan(scene, index, workers, progress, counts)
-    brackets = _bisect(scene, along, others, _initial_brackets(nc, scan), rtol, atol, workers, counts)
+    nc = _scan(scene, index, threads, progress, counts)
+    brackets = _bisect(scene, along, others, _initial_brackets(nc, scan), rtol, atol, threads, counts)
     ds = _dataset(scene, along, others, scan, nc, brackets)
     ds.attrs.update(_attrs(along, scan, rtol, atol, counts))
     ds.attrs["history"] += _history(along, counts, time.perf_counter() - t0)
     return ds
 
 
-def _scan(scene: Scene, index: int, workers: int, progress: bool | None, counts: _Counts) -> np.ndarray:
+def _scan(scene: Scene, index: int, threads: int, progress: bool | None, counts: _Counts) -> np.ndarray:
     """N_c on the whole grid, as (other axes..., along) with the along values increasing."""
-    atlas = compute_atlas(scene, workers=workers, progress=progress)
+    atlas = compute_atlas(scene, threads=threads, progress=progress)
     nc = np.moveaxis(atlas[N_COMPLEX_PAIRS].values, index, -1)
     if scene.grid[index].values[0] > scene.grid[index].values[-1]:
         nc = nc[..., ::-1]
@@ -196,7 +194,7 @@ def _converged(b: _Brackets, rtol: float, atol: float) -> np.ndarray:
     return (width <= np.maximum(rtol * np.maximum(np.abs(b.lo), np.abs(b.hi)), atol)) | no_room
 
 
-def _bisect(scene, along, others, brackets: _Brackets, rtol, atol, workers, counts: _Counts) -> _Brackets:
+def _bisect(scene, along, others, brackets: _Brackets, rtol, atol, threads, counts: _Counts) -> _Brackets:
     """Halve every bracket until converged (one batched decision per step); returns all final brackets."""
     shape = tuple(len(a.values) for a in others)
     done = []
@@ -211,7 +209,7 @@ def _bisect(scene, along, others, brackets: _Brackets, rtol, atol, workers, coun
         idx = np.unravel_index(active.owner, shape) if shape else ()
         values = {a.name: a.array[i] for a, i in zip(others, idx)}
         values[along] = mid
-        nc_mid, by = decide_values(scene, values, workers=workers)
+        nc_mid, by = decide_values(scene, values, threads=threads)
         counts.bisection_points += mid.size
         counts.exact += int((by == BY_EXACT).sum())
         counts.iterations += 1

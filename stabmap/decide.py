@@ -38,14 +38,14 @@ def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
     return nc, decided_by_from_status(status)
 
 
-def decide_values(scene, values: dict[str, np.ndarray], *, workers: int | None = None, chunk_points: int = 32768):
+def decide_values(scene, values: dict[str, np.ndarray], *, threads: int | None = None, chunk_points: int = 32768):
     """``decide`` for points given by equal-length 1-D arrays of axis values, in chunks on a thread pool.
 
     The kernels release the GIL, so threads run the chunks in parallel.
     """
     npts = len(next(iter(values.values()))) if values else 1
-    workers = workers or os.cpu_count() or 1
-    size = max(1, min(chunk_points, -(-npts // workers)))
+    threads = threads or os.cpu_count() or 1
+    size = max(1, min(chunk_points, -(-npts // threads)))
     bounds = [(a, min(a + size, npts)) for a in range(0, npts, size)]
 
     def run(bound):
@@ -54,7 +54,7 @@ def decide_values(scene, values: dict[str, np.ndarray], *, workers: int | None =
 
     nc = np.empty(npts, dtype=np.int16)
     by = np.empty(npts, dtype=np.int8)
-    with ThreadPoolExecutor(workers) as pool:
+    with ThreadPoolExecutor(threads) as pool:
         for (a, b), (n, d) in zip(bounds, pool.map(run, bounds)):
             nc[a:b], by[a:b] = n, d
     return nc, by

@@ -1,13 +1,26 @@
-"""Atlas files: netCDF4, compressed, written atomically."""
+"""Atlas files: netCDF4 (``.nc``) or Zarr (``.zarr``), compressed, written atomically."""
 
 from __future__ import annotations
 
 import os
+import shutil
 from pathlib import Path
 
+import dask
+import dask.array as da
+import netCDF4
+import numpy as np
 import xarray as xr
 
 from .errors import StabmapError
+from .variables import stability_from_pairs
+
+ZARR_SUFFIX = ".zarr"
+NETCDF_CHUNK_CACHE = 4 << 20  # bytes, while streaming
+
+
+def is_zarr(path: str | Path) -> bool:
+    return Path(path).suffix.lower() == ZARR_SUFFIX
 
 
 def check_writable(path: str | Path) -> Path:
@@ -16,41 +29,134 @@ def check_writable(path: str | Path) -> Path:
     parent = path.parent if str(path.parent) else Path(".")
     if not parent.is_dir():
         raise StabmapError(f"cannot write {str(path)!r}: directory {str(parent)!r} does not exist")
-    if path.is_dir():
-        raise StabmapError(f"cannot write {str(path)!r}: it is a directory; give a file name such as atlas.nc")
+    if path.is_dir() and not (is_zarr(path) and _is_zarr_store(path)):
+        raise StabmapError(f"cannot write {str(path)!r}: it is a directory; give a file name such as atlas.nc or atlas.zarr")
     if not os.access(parent, os.W_OK):
         raise StabmapError(f"cannot write {str(path)!r}: no write permission in {str(parent)!r}")
+    if is_zarr(path):
+        _need_zarr()
     return path
 
 
+def _is_zarr_store(path: Path) -> bool:
+    return any((path / name).exists() for name in ("zarr.json", ".zgroup", ".zattrs"))
+
+
+def _need_zarr() -> None:
+    try:
+        import zarr  # noqa: F401
+    except ImportError:
+        raise StabmapError("Zarr atlases (.zarr) need the zarr package: pip install 'stabmap[zarr]', or write .nc") from None
+
+
 def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
-    """Write ``ds`` to ``path`` (netCDF4, zlib level 4) atomically.
+    """Write ``ds`` to ``path`` (netCDF4 with zlib level 4, or Zarr for ``.zarr``) atomically.
 
     The data go to a temporary file in the same directory, renamed over
     ``path`` only when complete, so a failure or Ctrl-C never leaves a partial file.
     """
     path = check_writable(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    encoding = {name: {"zlib": True, "complevel": 4} for name in ds.data_vars}
     try:
-        ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=encoding)
-        os.replace(tmp, path)
+        if is_zarr(path):
+            ds.to_zarr(tmp, mode="w", consolidated=False)
+        else:
+            encoding = {name: {"zlib": True, "complevel": 4, **_chunksizes(ds[name])} for name in ds.data_vars}
+            ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=encoding)
+        _replace(tmp, path)
     except BaseException:
-        tmp.unlink(missing_ok=True)
+        _remove(tmp)
         raise
     return path
 
 
+def _chunksizes(var: xr.DataArray) -> dict:
+    """netCDF chunks equal to the dask chunks of a streamed variable (each one written once, whole)."""
+    if var.chunks is None or var.ndim == 0:
+        return {}
+    return {"chunksizes": tuple(c[0] for c in var.chunks)}
+
+
+def _replace(tmp: Path, path: Path) -> None:
+    """Move ``tmp`` to ``path``; a Zarr store (a directory) replaces the old one only once it is complete."""
+    if not tmp.is_dir() or not path.exists():
+        os.replace(tmp, path)
+        return
+    old = path.with_name(f".{path.name}.{os.getpid()}.old")
+    os.replace(path, old)
+    os.replace(tmp, path)
+    _remove(old)
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir():
+        shutil.rmtree(path, ignore_errors=True)
+    else:
+        path.unlink(missing_ok=True)
+
+
+def write_streamed(scene, partial, locations: list, path: Path) -> dict:
+    """Write the atlas whose chunks are in ``partial`` to ``path``, one chunk in memory at a time.
+
+    Returns the atlas' ``query.summary`` counts.
+    """
+    from .atlas import _dataset
+    from .query import Tally
+
+    tally = Tally()
+    for i in range(len(locations)):
+        block = partial.load(i)
+        tally.add(block[0], block[1])
+    shape = tuple(partial.shape)
+    chunks = da.core.normalize_chunks(tuple(partial.chunks), shape)
+    numblocks = tuple(len(c) for c in chunks)
+
+    def lazy(part):
+        """One variable, read chunk by chunk: each block read feeds one write and is freed at once."""
+        if not shape:
+            return part(partial.load(0))
+
+        def load(block_id=None):
+            return part(partial.load(int(np.ravel_multi_index(block_id, numblocks))))
+
+        dtype = part(np.zeros((2,), np.int16)).dtype
+        return da.map_blocks(load, chunks=chunks, dtype=dtype, meta=np.empty((0,) * len(shape), dtype))
+
+    ds = _dataset(
+        scene,
+        lazy(lambda b: b[0]),
+        lazy(lambda b: b[1].astype(np.int8)),
+        lazy(lambda b: stability_from_pairs(b[0])),
+    )
+    # Synchronous: the chunk files are on this machine, and one chunk at a time bounds the memory.
+    # Each netCDF chunk is written once, whole, so netCDF's chunk cache (64 MiB a variable by default,
+    # the largest use of memory here) only needs to hold one.
+    previous = netCDF4.get_chunk_cache()
+    netCDF4.set_chunk_cache(NETCDF_CHUNK_CACHE)
+    try:
+        with dask.config.set(scheduler="synchronous"):
+            write_atlas(ds, path)
+    finally:
+        netCDF4.set_chunk_cache(*previous)
+    return tally.summary()
+
+
 def open_atlas(path: str | Path) -> xr.Dataset:
-    """Open a saved atlas (loaded into memory; the file is closed on return)."""
+    """Open a saved atlas, netCDF or Zarr (loaded into memory; the file is closed on return)."""
     path = Path(path)
-    if not path.is_file():
+    zarr = is_zarr(path) and path.is_dir()
+    if not (path.is_file() or zarr):
         raise StabmapError(f"atlas file {str(path)!r} does not exist")
     try:
-        with xr.open_dataset(path, engine="netcdf4") as ds:
-            ds = ds.load()
-    except (OSError, ValueError) as exc:
-        raise StabmapError(f"cannot read {str(path)!r} as a netCDF atlas: {exc}") from None
+        if zarr:
+            _need_zarr()
+            with xr.open_zarr(path, consolidated=False) as ds:
+                ds = ds.load()
+        else:
+            with xr.open_dataset(path, engine="netcdf4") as ds:
+                ds = ds.load()
+    except (OSError, ValueError, KeyError) as exc:
+        raise StabmapError(f"cannot read {str(path)!r} as a {'Zarr' if zarr else 'netCDF'} atlas: {exc}") from None
     if "stabmap_format_version" not in ds.attrs:
         raise StabmapError(f"{str(path)!r} is a netCDF file but not a stabmap atlas (no stabmap_format_version)")
     return ds

@@ -517,14 +517,30 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
 
 def summary(ds: xr.Dataset) -> dict:
     """Counts that describe an atlas: points, stable fraction, N_c histogram, who decided."""
-    nc = np.asarray(ds[N_COMPLEX_PAIRS]).ravel()
-    by = np.asarray(ds[DECIDED_BY]).ravel()
-    values, counts = np.unique(nc, return_counts=True)
-    return {
-        "points": int(nc.size),
-        "stable": int((nc == 0).sum()),
-        "degenerate": int((nc < 0).sum()),
-        "stable_fraction": float((nc == 0).mean()) if nc.size else float("nan"),
-        "n_complex_pairs": {int(v): int(c) for v, c in zip(values, counts)},
-        "decided_by": {flag_meaning(DECIDED_BY, v): int((by == v).sum()) for v in ATTRS[DECIDED_BY]["flag_values"]},
-    }
+    return Tally().add(np.asarray(ds[N_COMPLEX_PAIRS]), np.asarray(ds[DECIDED_BY])).summary()
+
+
+class Tally:
+    """``summary`` accumulated block by block, for atlases streamed to a file without being held whole."""
+
+    def __init__(self):
+        self.nc: dict[int, int] = {}
+        self.by = {int(v): 0 for v in ATTRS[DECIDED_BY]["flag_values"]}
+
+    def add(self, nc: np.ndarray, decided_by: np.ndarray) -> Tally:
+        for table, values in ((self.nc, nc), (self.by, decided_by)):
+            for v, c in zip(*np.unique(values, return_counts=True)):
+                table[int(v)] = table.get(int(v), 0) + int(c)
+        return self
+
+    def summary(self) -> dict:
+        points = sum(self.nc.values())
+        stable = self.nc.get(0, 0)
+        return {
+            "points": points,
+            "stable": stable,
+            "degenerate": sum(c for v, c in self.nc.items() if v < 0),
+            "stable_fraction": stable / points if points else float("nan"),
+            "n_complex_pairs": dict(sorted(self.nc.items())),
+            "decided_by": {flag_meaning(DECIDED_BY, v): c for v, c in self.by.items()},
+        }

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
 import sys
 import time
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
@@ -36,8 +35,10 @@ import xarray as xr
 
 from .atlas import _dataset
 from .decide import BY_INFERRED, decide
+from .cluster import check_threads
 from .errors import StabmapError
 from .points import point_arrays, spin_axes_last
+from .progress import ProgressLine
 from .scene import Scene
 
 DEFAULT_MARGIN = 2  # cells split around a disagreeing cell; docs/refine.md has the measurements behind 2
@@ -158,38 +159,26 @@ def _children(split: np.ndarray, finer: _Level, halves: tuple[bool, ...]) -> np.
     return split
 
 
-class _Progress:
-    """One self-overwriting line on stderr, shown once a run has taken two seconds (like the dense progress bar)."""
+class _Progress(ProgressLine):
+    """The refinement's progress line: level, points done, share of the dense grid evaluated."""
 
-    def __init__(self, enabled: bool, total: int, minimum: float = 2.0, dt: float = 0.5):
-        self.enabled, self.total, self.minimum, self.dt = enabled, total, minimum, dt
-        self.t0 = time.perf_counter()
-        self.last = 0.0
-        self.shown = False
+    def __init__(self, enabled: bool, total: int):
+        super().__init__(enabled)
+        self.total = total
 
     def update(self, stride: int, level_done: int, level_total: int, evaluated: int) -> None:
-        now = time.perf_counter() - self.t0
-        if not self.enabled or now < self.minimum or now - self.last < self.dt:
-            return
-        self.last, self.shown = now, True
         pct = 100 * evaluated / max(1, self.total)
-        sys.stderr.write(
-            f"\r[refine] stride {stride:>4}: {level_done:,}/{level_total:,} points | "
-            f"evaluated {evaluated:,} = {pct:.1f} % of dense | {now:.0f} s   "
+        self.show(
+            f"[refine] stride {stride:>4}: {level_done:,}/{level_total:,} points | "
+            f"evaluated {evaluated:,} = {pct:.1f} % of dense | {self.elapsed:.0f} s"
         )
-        sys.stderr.flush()
-
-    def close(self) -> None:
-        if self.shown:
-            sys.stderr.write("\n")
-            sys.stderr.flush()
 
 
 class _Evaluator:
     """Decides grid points on a thread pool and holds the state of the whole grid."""
 
-    def __init__(self, scene: Scene, pool: ThreadPoolExecutor, workers: int, chunk_points: int, progress: _Progress):
-        self.scene, self.pool, self.workers, self.chunk_points, self.progress = scene, pool, workers, chunk_points, progress
+    def __init__(self, scene: Scene, pool: ThreadPoolExecutor, threads: int, chunk_points: int, progress: _Progress):
+        self.scene, self.pool, self.threads, self.chunk_points, self.progress = scene, pool, threads, chunk_points, progress
         shape = scene.shape
         self.nc = np.zeros(shape, dtype=np.int16)
         self.by = np.full(shape, BY_INFERRED, dtype=np.int8)
@@ -223,7 +212,7 @@ class _Evaluator:
 
     def _decide(self, flat: np.ndarray, stride: int) -> tuple[np.ndarray, np.ndarray]:
         npts = flat.size
-        size = min(self.chunk_points, max(1024, -(-npts // (4 * self.workers))))
+        size = min(self.chunk_points, max(1024, -(-npts // (4 * self.threads))))
         bounds = [(a, min(a + size, npts)) for a in range(0, npts, size)]
         nc = np.empty(npts, dtype=np.int16)
         by = np.empty(npts, dtype=np.int8)
@@ -324,7 +313,7 @@ def compute_refined(
     *,
     coarse_stride: int | None = None,
     margin: int = DEFAULT_MARGIN,
-    workers: int | None = None,
+    threads: int | None = None,
     progress: bool | None = None,
     chunk_points: int | None = None,
 ) -> xr.Dataset:
@@ -348,7 +337,7 @@ def compute_refined(
     margin : int, optional
         Cells around every disagreeing cell that are split too (default 2; 0 and
         1 are cheaper and miss more of the features smaller than a cell).
-    workers : int, optional
+    threads : int, optional
         Threads (default: all cores).
     progress : bool, optional
         Progress line on stderr for runs over two seconds (default: when stderr is a terminal).
@@ -363,9 +352,7 @@ def compute_refined(
     """
     coarse_stride = check_coarse_stride(coarse_stride)
     margin = check_margin(margin)
-    workers = workers or os.cpu_count() or 1
-    if workers < 1:
-        raise StabmapError(f"workers must be >= 1, got {workers}")
+    threads = check_threads(threads)
     chunk_points = CHUNK_POINTS if chunk_points is None else int(chunk_points)
     if chunk_points < 1:
         raise StabmapError(f"chunk_points must be >= 1, got {chunk_points}")
@@ -375,9 +362,9 @@ def compute_refined(
     strides = tuple(coarse_stride or default_coarse_stride(n) for n in shape)
     total = math.prod(shape)
     t0 = time.perf_counter()
-    with ThreadPoolExecutor(max_workers=workers) as pool:
+    with ThreadPoolExecutor(max_workers=threads) as pool:
         bar = _Progress(progress, total)
-        ev = _Evaluator(scene, pool, workers, chunk_points, bar)
+        ev = _Evaluator(scene, pool, threads, chunk_points, bar)
         try:
             if shape:
                 _run_levels(ev, strides, margin)

@@ -50,7 +50,7 @@ def scene():
 
 @pytest.fixture(scope="module")
 def atlas(scene):
-    return stabmap.compute_atlas(scene, workers=2, chunk_points=10, progress=False)
+    return stabmap.compute_atlas(scene, threads=2, chunk_points=10, progress=False)
 
 
 def test_dataset_layout(atlas):
@@ -87,7 +87,7 @@ def test_atlas_equals_point_by_point_and_reference(atlas, scene):
 
 
 def test_chunking_does_not_change_the_atlas(scene, atlas):
-    other = stabmap.compute_atlas(scene, workers=1, chunk_points=1000, progress=False)
+    other = stabmap.compute_atlas(scene, threads=1, chunk_points=1000, progress=False)
     xr.testing.assert_identical(other.drop_attrs(), atlas.drop_attrs())
 
 

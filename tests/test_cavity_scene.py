@@ -71,7 +71,7 @@ cavity = {{ shape = "spheroid", radius = 1.0, half_height = 1.0, density = 800.0
 [grid]
 half_height_1 = {{ values = {ratios.tolist()} }}
 """)
-    ds = atlas.compute(s, progress=False, workers=1)
+    ds = atlas.compute(s, progress=False, threads=1)
     expected = ((ratios > 1) & (ratios < 3)).astype(int)
     assert ds.n_complex_pairs.values.tolist() == expected.tolist()
 
@@ -110,7 +110,7 @@ cavity = {{ shape = "spheroid", radius = {a}, half_height = {a}, density = {rho}
 [grid]
 omega = {{ values = {omega.tolist()} }}
 """)
-    nc = atlas.compute(wet, progress=False, workers=1).n_complex_pairs.values
+    nc = atlas.compute(wet, progress=False, threads=1).n_complex_pairs.values
     critical = np.sqrt(4 * A_dry_about_joint(m, A, c) * m * c * 9.81) / C  # Maievskii
     far = np.abs(omega - critical) > 1e-6 * critical
     assert np.array_equal(nc[far], (omega < critical)[far].astype(int))
@@ -138,11 +138,11 @@ def test_scanned_cavity_axes_match_one_scene_per_value():
 omega = { start = 80.0, stop = 200.0, num = 25 }
 half_height_1 = { values = [0.02, 0.055, 0.09] }
 density_1 = { values = [500.0, 1000.0] }"""
-    ds = atlas.compute(top(grid=grid), progress=False, workers=1)
+    ds = atlas.compute(top(grid=grid), progress=False, threads=1)
     for h in (0.02, 0.055, 0.09):
         for rho in (500.0, 1000.0):
             line = CYLINDER.replace("half_height = 0.055", f"half_height = {h}").replace("density = 1000.0", f"density = {rho}")
-            one = atlas.compute(top(line, "[grid]\nomega = { start = 80.0, stop = 200.0, num = 25 }"), progress=False, workers=1)
+            one = atlas.compute(top(line, "[grid]\nomega = { start = 80.0, stop = 200.0, num = 25 }"), progress=False, threads=1)
             assert np.array_equal(ds.n_complex_pairs.sel(half_height_1=h, density_1=rho).values, one.n_complex_pairs.values)
     assert ds.half_height_1.attrs["units"] == "m" and float(ds.radius_1) == 0.05
 

@@ -210,7 +210,7 @@ K_1 = { values = [0.0, 10.0, 20.0, 50.0, 100.0] }
 
 @pytest.fixture(scope="module")
 def atlas3():
-    return stabmap.compute_atlas(stabmap.loads_scene(SCENE), workers=2, progress=False)
+    return stabmap.compute_atlas(stabmap.loads_scene(SCENE), threads=2, progress=False)
 
 
 @pytest.fixture(scope="module")

@@ -45,7 +45,7 @@ def scene(grid: dict) -> stabmap.Scene:
 @pytest.fixture(scope="module")
 def top():
     return stabmap.compute_atlas(
-        scene({"omega": {"start": -60.0, "stop": 60.0, "num": 97}, "c_1": {"values": C1}}), workers=2, progress=False
+        scene({"omega": {"start": -60.0, "stop": 60.0, "num": 97}, "c_1": {"values": C1}}), threads=2, progress=False
     )
 
 
@@ -179,7 +179,7 @@ def test_smallest_stable_over_the_whole_scan_sees_negative_spin(top):
 def test_three_axes_over_one_needs_the_others_fixed():
     ds = stabmap.compute_atlas(
         scene({"omega": {"start": 0.5, "stop": 60.5, "num": 61}, "c_1": {"values": [0.1, 0.2]}, "m_1": {"values": [1.0, 2.0]}}),
-        workers=2, progress=False,
+        threads=2, progress=False,
     )
     with pytest.raises(stabmap.StabmapError, match=r"over 'c_1': fix the other axes as well \(m_1=1"):
         stabmap.smallest_stable(ds, "omega", over="c_1")
@@ -196,7 +196,7 @@ def test_three_axes_over_one_needs_the_others_fixed():
 
 
 def test_one_axis_atlas(tmp_path):
-    ds = stabmap.compute_atlas(scene({"omega": {"start": 0.5, "stop": 30.5, "num": 31}}), workers=1, progress=False)
+    ds = stabmap.compute_atlas(scene({"omega": {"start": 0.5, "stop": 30.5, "num": 31}}), threads=1, progress=False)
     s = stabmap.smallest_stable(ds)
     first = next(w for w in ds["omega"].values if maievskii_stable(w, 0.1))
     assert s["smallest_stable"].ndim == 0 and float(s["smallest_stable"]) == first
@@ -212,7 +212,7 @@ def test_one_axis_atlas(tmp_path):
 @pytest.fixture(scope="module")
 def refined():
     sc = scene({"omega": {"start": 0.5, "stop": 60.5, "num": 121}, "m_1": {"start": 0.5, "stop": 4.5, "num": 17}})
-    return stabmap.compute_refined(sc, workers=2, progress=False, coarse_stride=8)
+    return stabmap.compute_refined(sc, threads=2, progress=False, coarse_stride=8)
 
 
 def test_inferred_points_are_counted_and_flagged(refined):

@@ -26,11 +26,11 @@ def regrid(scene, *nums: int):
 
 
 def dense(scene):
-    return stabmap.compute_atlas(scene, workers=2, progress=False)
+    return stabmap.compute_atlas(scene, threads=2, progress=False)
 
 
 def refined(scene, **kwargs):
-    return stabmap.compute_refined(scene, workers=2, progress=False, **kwargs)
+    return stabmap.compute_refined(scene, threads=2, progress=False, **kwargs)
 
 
 def check_against_dense(ref, den) -> np.ndarray:
@@ -141,7 +141,7 @@ def test_any_number_of_axes(shape):
 def test_threads_and_chunks_do_not_change_the_result():
     scene = regrid(stabmap.example("paper-n1-free"), 257, 257)
     a = refined(scene, coarse_stride=16)
-    b = stabmap.compute_refined(scene, coarse_stride=16, workers=1, chunk_points=100, progress=False)
+    b = stabmap.compute_refined(scene, coarse_stride=16, threads=1, chunk_points=100, progress=False)
     assert (a["n_complex_pairs"].values == b["n_complex_pairs"].values).all()
     assert (a["decided_by"].values == b["decided_by"].values).all()
 
@@ -153,7 +153,7 @@ def test_threads_and_chunks_do_not_change_the_result():
         ({"coarse_stride": 0}, "coarse_stride must be a power of two"),
         ({"coarse_stride": 8.0}, "coarse_stride must be a whole power of two"),
         ({"margin": -1}, "margin must be a whole number of cells >= 0"),
-        ({"workers": -2}, "workers must be >= 1"),
+        ({"threads": -2}, "threads must be a whole number >= 1"),
     ],
 )
 def test_bad_arguments(kwargs, message):

@@ -1,0 +1,298 @@
+"""Atlases on a real dask.distributed cluster (scheduler and workers as processes on loopback), streamed to
+files, surviving a killed worker, and resumed after an interrupted run."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import stabmap
+from stabmap import cli, cluster
+from stabmap.atlas import compute, compute_to_file
+from stabmap.chunks import chunk_locations, chunk_shape, default_chunk_points
+from stabmap.io import open_atlas
+from stabmap.partial import partial_dir
+
+# Degree 18 (three bodies, four liquid modes each): about 0.1 ms a point, so a run lasts seconds and can be
+# interrupted or lose a worker while chunks are still pending.
+SLOW = """
+title = "three tops with liquid, four modes each"
+support = "fixed"
+omega = 40.0
+joints = [30.0, 20.0]
+
+[[bodies]]
+m = 2.0
+A = 0.04
+C = 0.05
+c = 0.2
+s = 0.5
+fluid = { E = [0.002, 0.0005, 0.0002, 0.0001], kappa = [1.6, 3.1, 5.2, 7.7] }
+
+[[bodies]]
+m = 1.0
+A = 0.02
+C = 0.03
+c = 0.15
+s = 0.4
+fluid = { E = [0.001, 0.0002, 0.0001, 0.00005], kappa = [1.8, 2.9, 4.8, 8.1] }
+
+[[bodies]]
+m = 0.5
+A = 0.01
+C = 0.012
+c = 0.1
+s = 0.3
+fluid = { E = [0.0005, 0.0001, 0.00005, 0.00002], kappa = [1.7, 3.3, 5.5, 7.9] }
+
+[grid]
+omega = { start = 1.0, stop = 120.0, num = 240 }
+m_2 = { start = 0.2, stop = 4.0, num = 160 }
+"""
+SLOW_CHUNK = 1024  # 38 chunks
+
+
+def _same_atlas(a: xr.Dataset, b: xr.Dataset) -> None:
+    """Cell for cell, coordinate for coordinate, attribute for attribute (but the time in 'history')."""
+    xr.testing.assert_identical(a.drop_attrs(), b.drop_attrs())
+    for name in set(a.variables) | set(b.variables):
+        assert a[name].dtype == b[name].dtype, name
+    keys = (set(a.attrs) | set(b.attrs)) - {"history"}
+    assert {k: str(a.attrs.get(k)) for k in keys} == {k: str(b.attrs.get(k)) for k in keys}
+
+
+@pytest.fixture(scope="module")
+def slow_scene_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("scene") / "slow.toml"
+    path.write_text(SLOW)
+    return path
+
+
+@pytest.fixture(scope="module")
+def slow_local(slow_scene_file):
+    """The in-process atlas; computing it also fills the kernel cache that worker processes then load."""
+    return compute(stabmap.load_scene(slow_scene_file), threads=2, progress=False)
+
+
+class LoopbackCluster:
+    """``dask scheduler`` and ``dask worker`` processes on 127.0.0.1 (workers without nanny: one pid each)."""
+
+    def __init__(self, tmp_path, workers: int):
+        self.file = tmp_path / "scheduler.json"
+        self.procs = [self._start("scheduler", "--host", "127.0.0.1", "--port", "0", "--scheduler-file", str(self.file))]
+        deadline = time.monotonic() + 60
+        while not self.file.exists():
+            assert time.monotonic() < deadline, "the dask scheduler did not start"
+            time.sleep(0.1)
+        self.address = json.loads(self.file.read_text())["address"]
+        self.workers = [
+            self._start("worker", self.address, "--nthreads", "1", "--no-nanny", "--name", f"w{i}") for i in range(workers)
+        ]
+        self.procs += self.workers
+        from distributed import Client
+
+        with Client(self.address, timeout=60) as c:
+            c.wait_for_workers(workers, timeout=120)
+
+    @staticmethod
+    def _start(*args):
+        return subprocess.Popen(
+            [sys.executable, "-m", "dask", *args, "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+        )
+
+    def close(self):
+        for p in reversed(self.procs):
+            if p.poll() is None:
+                p.terminate()
+        for p in self.procs:
+            try:
+                p.wait(20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+
+
+@pytest.fixture(scope="module")
+def loopback(tmp_path_factory, slow_local):
+    c = LoopbackCluster(tmp_path_factory.mktemp("cluster"), workers=2)
+    yield c
+    c.close()
+
+
+def test_chunk_layout_covers_the_grid_once():
+    for shape, points in [((7, 5, 3), 4), ((240, 160), 1024), ((1,), 100), ((3, 4), 1), ((), 10)]:
+        chunks = chunk_shape(shape, points)
+        seen = np.zeros(shape, dtype=int)
+        for loc in chunk_locations(shape, chunks):
+            seen[tuple(slice(a, b) for a, b in loc)] += 1
+        assert (seen == 1).all()
+        assert int(np.prod(chunks)) <= points
+
+
+def test_default_chunks_bounded_by_time_memory_and_balance(slow_scene_file):
+    scene = stabmap.load_scene(slow_scene_file)
+    small = default_chunk_points(scene, threads=2)
+    assert 1024 <= small <= 38400 // 8  # at least four tasks a thread, never tiny ones
+    big = stabmap.scene.resample(scene, omega=4000, m_2=4000)
+    # 16 M points of degree 18: the time bound (about half a second on a core) decides, not the grid.
+    assert 256 <= default_chunk_points(big, threads=2) <= 16384
+    dry = stabmap.example("paper-n1-fixed-dry")  # degree 2: over a million points a second; the cap decides
+    assert default_chunk_points(stabmap.scene.resample(dry, **{a.name: 4000 for a in dry.grid}), threads=2) == 1 << 18
+
+
+def test_cluster_equals_in_process(loopback, slow_scene_file, slow_local):
+    ds = compute(stabmap.load_scene(slow_scene_file), client=loopback.address, progress=False, chunk_points=4096)
+    _same_atlas(ds, slow_local)
+
+
+def test_client_object_and_stream_to_zarr(loopback, slow_scene_file, slow_local, tmp_path):
+    from distributed import Client
+
+    with Client(loopback.address, set_as_default=False) as client:
+        report = compute_to_file(stabmap.load_scene(slow_scene_file), tmp_path / "a.zarr", client=client, progress=False)
+    assert report.computed == report.chunks and report.reused == 0
+    assert report.counts == stabmap.summary(slow_local)
+    _same_atlas(open_atlas(tmp_path / "a.zarr"), slow_local)
+    assert not partial_dir(tmp_path / "a.zarr").exists()
+
+
+def test_cli_scheduler_and_local_workers_give_the_in_process_file(loopback, slow_scene_file, tmp_path, capsys):
+    base = ["atlas", str(slow_scene_file), "-q"]
+    assert cli.main(base + ["-o", str(tmp_path / "here.nc"), "--threads", "2"]) == 0
+    assert cli.main(base + ["-o", str(tmp_path / "remote.nc"), "--scheduler", loopback.address]) == 0
+    assert cli.main(base + ["-o", str(tmp_path / "local.nc"), "--workers", "2", "--chunk-points", "2000"]) == 0
+    here = open_atlas(tmp_path / "here.nc")
+    _same_atlas(open_atlas(tmp_path / "remote.nc"), here)
+    _same_atlas(open_atlas(tmp_path / "local.nc"), here)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["here.nc", "local.nc", "remote.nc"]
+
+
+def test_killed_worker_does_not_lose_the_atlas(tmp_path, slow_scene_file, slow_local):
+    c = LoopbackCluster(tmp_path, workers=2)
+    try:
+        out = tmp_path / "a.nc"
+        result = {}
+
+        def run():
+            try:
+                result["report"] = compute_to_file(
+                    stabmap.load_scene(slow_scene_file), out, client=c.address, chunk_points=SLOW_CHUNK, progress=False
+                )
+            except BaseException as exc:  # noqa: BLE001 - handed to the test thread
+                result["error"] = exc
+
+        t = threading.Thread(target=run)
+        t.start()
+        saved = partial_dir(out)
+        deadline = time.monotonic() + 120
+        while len(list(saved.glob("chunk-*.npy"))) < 4:
+            assert time.monotonic() < deadline and t.is_alive(), result
+            time.sleep(0.02)
+        victim = c.workers[0]
+        victim.send_signal(signal.SIGKILL)
+        done_at_kill = len(list(saved.glob("chunk-*.npy")))
+        t.join(300)
+        assert victim.wait(10) == -signal.SIGKILL
+        assert "error" not in result, result.get("error")
+        report = result["report"]
+        assert done_at_kill < report.chunks  # the worker died with chunks still to do
+        assert report.computed == report.chunks
+        _same_atlas(open_atlas(out), slow_local)
+    finally:
+        c.close()
+
+
+def _start_cli(args, **kw):
+    return subprocess.Popen([sys.executable, "-m", "stabmap", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
+
+
+def _wait_for_chunks(saved, proc, n):
+    deadline = time.monotonic() + 120
+    while len(list(saved.glob("chunk-*.npy"))) < n:
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline
+        time.sleep(0.02)
+
+
+@pytest.mark.parametrize("how", [signal.SIGKILL, signal.SIGINT, signal.SIGTERM])
+def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(how, tmp_path, slow_scene_file, slow_local, monkeypatch, capsys):
+    out = tmp_path / "a.nc"
+    saved = partial_dir(out)
+    args = ["atlas", str(slow_scene_file), "-o", str(out), "--threads", "1", "--chunk-points", str(SLOW_CHUNK), "-q"]
+    proc = _start_cli(args)
+    _wait_for_chunks(saved, proc, 3)
+    proc.send_signal(how)
+    stdout, stderr = proc.communicate(timeout=60)
+    if how == signal.SIGKILL:
+        assert proc.returncode == -signal.SIGKILL
+    else:  # Ctrl-C and kill: a clean stop that says how to go on
+        assert proc.returncode == 130, stderr
+        assert "--resume" in stderr and str(saved) in stderr
+    assert not out.exists()
+    assert [p.name for p in tmp_path.iterdir()] == [saved.name]  # no temporary file left beside it
+    done = {p.name for p in saved.glob("chunk-*.npy")}
+    total = len(chunk_locations((240, 160), chunk_shape((240, 160), SLOW_CHUNK)))
+    assert 3 <= len(done) < total
+
+    # Without --resume the finished work is not thrown away silently.
+    assert cli.main(args) == 2
+    assert "--resume" in capsys.readouterr().err
+    # --resume computes exactly the missing chunks (counted at the task function itself).
+    calls = []
+    task = cluster.atlas_chunk
+    monkeypatch.setattr(cluster, "atlas_chunk", lambda scene, loc: calls.append(loc) or task(scene, loc))
+    assert cli.main(args + ["--resume"]) == 0
+    err = capsys.readouterr().err
+    assert len(calls) == total - len(done)
+    assert f"resumed: {len(done)} of {total} chunks were already done" in err
+    assert not saved.exists()
+    _same_atlas(open_atlas(out), slow_local)
+
+
+def test_resume_refuses_another_scene_and_other_chunks(tmp_path, slow_scene_file, capsys):
+    out = tmp_path / "a.nc"
+    proc = _start_cli(["atlas", str(slow_scene_file), "-o", str(out), "--threads", "1", "--chunk-points", str(SLOW_CHUNK), "-q"])
+    _wait_for_chunks(partial_dir(out), proc, 1)
+    proc.kill()
+    proc.wait()
+    other = tmp_path / "other.toml"
+    other.write_text(SLOW.replace("omega = 40.0", "omega = 41.0"))
+    assert cli.main(["atlas", str(other), "-o", str(out), "--resume"]) == 2
+    assert "different scene" in capsys.readouterr().err
+    assert cli.main(["atlas", str(slow_scene_file), "-o", str(out), "--resume", "--chunk-points", "5000"]) == 2
+    assert "leave chunk_points (--chunk-points) out to resume" in capsys.readouterr().err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "extra,message",
+    [
+        (["--scheduler", "tcp://127.0.0.1:9", "--workers", "2"], "not both"),
+        (["--workers", "0"], "--workers must be a whole number >= 1"),
+        (["--threads", "0"], "--threads must be a whole number >= 1"),
+        (["--workers", "2", "--threads", "2"], "--threads sets the threads of an in-process run"),
+        (["--workers", "2", "--refine"], "--refine runs in this process only"),
+        (["--refine", "--resume"], "--resume applies to dense atlases"),
+        (["--chunk-points", "0"], "--chunk-points must be a whole number >= 1"),
+    ],
+)
+def test_bad_cluster_options_fail_before_any_work(extra, message, tmp_path, capsys):
+    out = tmp_path / "a.nc"
+    assert cli.main(["atlas", "--example", "paper-n1-fixed", "-o", str(out), *extra]) == 2
+    assert message in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_unreachable_scheduler_is_a_clear_error(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", 1.0)
+    assert cli.main(["atlas", "--example", "paper-n1-fixed", "-o", str(tmp_path / "a.nc"), "--scheduler", "tcp://127.0.0.1:9"]) == 2
+    err = capsys.readouterr().err
+    assert "cannot reach the dask scheduler at 'tcp://127.0.0.1:9'" in err
+    assert list(tmp_path.iterdir()) == []
