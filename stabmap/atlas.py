@@ -161,6 +161,13 @@ class _Run:
         try:
             if self.client is not None:
                 self.threads = cluster_threads(self.client)
+                if self.progress.enabled:
+                    workers = len(self.client.nthreads())
+                    print(
+                        f"[atlas] on the dask cluster at {self.client.scheduler.address}: {workers} workers, "
+                        f"{self.threads} threads; dashboard {self.client.dashboard_link}",
+                        file=sys.stderr,
+                    )
             self._layout()
         except BaseException:
             self.__exit__(*sys.exc_info())
