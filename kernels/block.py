@@ -11,21 +11,29 @@ from .status import DECIDED_FLOAT, DECIDED_INCLUSION, DEGENERATE, UNDECIDED
 
 
 @kernel
-def charpoly_block(body, joint, g, E, kappa, nmodes, free, out):
+def charpoly_block(body, joint, g, E, kappa, nmodes, free, parent, at, out):
     """Rigorous enclosures of p(lambda) for a block of points.
 
     Parameters
     ----------
     body : float64[npts, n, 6]
-        (m [kg], A [kg m^2], C [kg m^2], c [m], s [m], omega [rad/s]) per body, bottom first.
+        (m [kg], A [kg m^2], C [kg m^2], c [m], s [m], omega [rad/s]) per body; s is not read
+        (joint positions come in ``at``).
     joint : float64[npts, n]
-        K_0 (base, fixed support only) and K_1..K_{n-1} [N m/rad].
+        Stiffness of the joint of body k with its parent [N m/rad]; joint[:, 0] is the base
+        joint (fixed support only).  A chain: K_0 (base) and K_1..K_{n-1}.
     g : float64[npts]
         Gravity [m/s^2] (ignored for a free system).
     E, kappa : float64[npts, n, Lmax]
         Liquid modes E [kg m^2] and kappa [1]; only the first nmodes[k] of body k are read.
     nmodes : int64[n]
     free : bool
+    parent : int64[n]
+        The tree in a regular numbering: parent[0] = -1, 0 <= parent[k] < k (a chain: k - 1).
+        ValueError otherwise.
+    at : float64[npts, n]
+        Position [m] of the joint of body k on the axis of parent[k], from the parent's own
+        joint, up positive; at[:, 0] is not read.  A chain: at[:, k] = s of body k - 1.
     out : float64[npts, sum(nmodes + 2) + 1, 3]
         Written: coefficients as (hi, lo, rad) with p_i in [hi + lo - rad, hi + lo + rad],
         ascending powers of lambda.
@@ -33,14 +41,14 @@ def charpoly_block(body, joint, g, E, kappa, nmodes, free, out):
     npts, n = body.shape[0], body.shape[1]
     rowdeg = nmodes + 2
     degree = int(rowdeg.sum())
-    ws = allocate(n, max(1, nmodes.max()), degree)
+    ws = allocate(n, max(1, nmodes.max()), degree, parent)
     for p in range(npts):
-        reuse = same_structure(body, joint, g, p)
-        charpoly_point(body[p], joint[p], g[p], E[p], kappa[p], nmodes, rowdeg, free, ws, out[p], reuse)
+        reuse = same_structure(body, joint, at, g, p)
+        charpoly_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, out[p], reuse)
 
 
 @kernel
-def count_block(body, joint, g, E, kappa, nmodes, free, out_nc, out_status):
+def count_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out_status):
     """Number of complex-conjugate root pairs N_c of p(lambda) for a block of points.
 
     Inputs as for ``charpoly_block``.  Writes ``out_nc`` (int16[npts], -1 where
@@ -53,12 +61,13 @@ def count_block(body, joint, g, E, kappa, nmodes, free, out_nc, out_status):
     npts, n = body.shape[0], body.shape[1]
     rowdeg = nmodes + 2
     degree = int(rowdeg.sum())
-    ws = allocate(n, max(1, nmodes.max()), degree)
+    ws = allocate(n, max(1, nmodes.max()), degree, parent)
     c = np.empty((degree + 1, 3))
     cs = allocate_count(degree)
     starts = np.empty(n + 1, np.int64)
     for p in range(npts):
-        matrix_point(body[p], joint[p], g[p], E[p], kappa[p], nmodes, free, ws, same_structure(body, joint, g, p))
+        reuse = same_structure(body, joint, at, g, p)
+        matrix_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, ws, reuse)
         nblocks = diagonal_blocks(ws[5], starts)
         total, status = 0, DECIDED_FLOAT
         for b in range(nblocks):

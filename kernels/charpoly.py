@@ -4,20 +4,30 @@ MODEL.md: p(lambda) = det Phi(lambda) * prod_k Q_k(lambda) with
 Phi = lambda^2 M + lambda G - K - diag(liquid_k) and Q_k = prod_l (lambda + beta_kl),
 beta_kl = omega_k - lambda_kl = omega_k (kappa_kl - 2) / kappa_kl.
 
-We expand det(diag(Q) Phi T) instead, with T the lower-triangular matrix of ones
-(theta = T phi, phi the relative tilts).  det T = 1, so the polynomial is the
+We expand det(diag(Q) Phi T) instead, with T the path matrix of the tree of
+bodies: T[k, j] = 1 if body j lies on the path from the base to body k (j = k
+included), else 0, so theta = T phi with phi_j = theta_j - theta_parent(j) the
+tilt of body j relative to its parent (docs/trees.md: T is the transpose of
+Wittenburg's path matrix with every arc pointing at the base; for a chain it is
+the lower-triangular matrix of ones).  det T = 1, so the polynomial is the
 same, but K T is exact and sparse: the elastic Laplacian maps column j of T to
-K_{j-1} (e_j - e_{j-1}).  Hence every zero that the physics puts into the
-constant terms (the rigid tilt of a free chain, ideal joints, g = 0) is an exact
-zero, and the matching lambda = 0 roots are factored out exactly instead of
-being smeared into tiny nonzero coefficients.
+K_j (e_j - e_parent(j)).  Hence every zero that the physics puts into the
+constant terms (the rigid tilt of a free system, ideal joints, g = 0) is an
+exact zero, and the matching lambda = 0 roots are factored out exactly instead
+of being smeared into tiny nonzero coefficients.
 
 Every number is an interval (hi, lo, rad) of ``dd.py`` stored along a last axis
 of length 3.  Per-point parameter layout (all float64):
-  body[k]   = (m, A, C, c, s, omega) of body k (0-based, bottom first)
-  joint[k]  = K_k, k = 0..n-1 (K_0 is the base stiffness, fixed support only)
+  body[k]   = (m, A, C, c, s, omega) of body k (0-based); s is not read here
+  joint[k]  = stiffness of the joint of body k with its parent (joint[0]: the
+              base joint, fixed support only; in a chain joint[k] = K_k)
+  at[k]     = position of that joint on the parent's axis, measured from the
+              parent's own joint (at[0] is not read; in a chain at[k] = s_{k-1})
   g         = gravity (fixed support only)
   E[k, l], kappa[k, l] for l < nmodes[k]
+Per block: parent (int64[n]), the tree in a regular numbering (Wittenburg):
+parent[0] = -1 (body 0, the scene's body 1, is on the base or is the free
+system's reference body) and 0 <= parent[k] < k.  A chain has parent[k] = k - 1.
 """
 
 from __future__ import annotations
@@ -34,14 +44,43 @@ def _set(X, i, v):
 
 
 @kernel
-def _lever_arms(body, free, J):
-    """Write the lever-arm matrix J (MODEL.md) into J (n, n, 3)."""
+def check_parent(parent, n):
+    """Raise ValueError unless parent (int64[n]) is a tree in a regular numbering (module docstring)."""
+    if parent.shape[0] != n or (n > 0 and parent[0] != -1):
+        raise ValueError("parent must have one entry per body and parent[0] == -1")
+    for k in range(1, n):
+        if parent[k] < 0 or parent[k] >= k:
+            raise ValueError("parent must be a regular numbering: 0 <= parent[k] < k for k >= 1")
+
+
+@kernel
+def path_matrix(parent, T):
+    """Write T[k, j] = True if body j is on the path from the base to body k (j == k included)."""
+    T[:] = False
+    for k in range(parent.shape[0]):
+        j = k
+        while j >= 0:
+            T[k, j] = True
+            j = parent[j]
+
+
+@kernel
+def _lever_arms(body, at, parent, free, J):
+    """Write the lever-arm matrix J (MODEL.md, docs/trees.md) into J (n, n, 3).
+
+    J[k, k] = c_k; for every body i on the path below body k, J[k, i] is the
+    position on the axis of i of the joint through which the path leaves i.
+    """
     n = body.shape[0]
     J[:] = 0.0
     for k in range(n):
-        for i in range(k):
-            J[k, i, 0] = body[i, 4]
         J[k, k, 0] = body[k, 3]
+        child = k
+        i = parent[k]
+        while i >= 0:
+            J[k, i, 0] = at[child]
+            child = i
+            i = parent[i]
     if not free:
         return
     mt = (0.0, 0.0, 0.0)
@@ -57,28 +96,40 @@ def _lever_arms(body, free, J):
 
 
 @kernel
-def _stiffness_T(body, joint, g, free, K):
-    """Write K T (see module docstring) into K (n, n, 3)."""
+def _stiffness_T(body, joint, at, parent, g, free, sub, K):
+    """Write K T (see module docstring) into K (n, n, 3); sub (n, 3) is scratch."""
     n = body.shape[0]
     K[:] = 0.0
     for j in range(1, n):
         K[j, j, 0] = joint[j]
-        K[j - 1, j, 0] = -joint[j]
+        K[parent[j], j, 0] = -joint[j]
     if free:
         return
     K[0, 0, 0] = joint[0]
-    above = (0.0, 0.0, 0.0)  # mass of the bodies above body k
+    # sub[k]: mass of the subtree of body k; children come after their parent, so go backwards.
     for k in range(n - 1, -1, -1):
+        outboard = (0.0, 0.0, 0.0)  # mass of the bodies beyond body k
+        leaf = True
         a = dd.mul(body[k, 0], 0.0, 0.0, body[k, 3], 0.0, 0.0)
-        a = dd.fma(*a, body[k, 4], 0.0, 0.0, *above)  # a_k = m_k c_k + s_k sum_{j>k} m_j
+        for j in range(k + 1, n):
+            if parent[j] != k:
+                continue
+            # a_k = m_k c_k + sum over the children j of k of at_j (mass of the subtree of j)
+            a = dd.fma(*a, at[j], 0.0, 0.0, sub[j, 0], sub[j, 1], sub[j, 2])
+            outboard = (sub[j, 0], sub[j, 1], sub[j, 2]) if leaf else dd.add(*outboard, sub[j, 0], sub[j, 1], sub[j, 2])
+            leaf = False
+        if leaf:
+            a = dd.add(*a, 0.0, 0.0, 0.0)  # as m_k c_k + s_k * 0: the same rounding bound as a chain's top body
         ga = dd.mul(g, 0.0, 0.0, *a)
-        for j in range(k + 1):
+        j = k
+        while j >= 0:  # row k of -g diag(a) T: the bodies on the path to k
             K[k, j, 0], K[k, j, 1], K[k, j, 2] = dd.add(K[k, j, 0], K[k, j, 1], K[k, j, 2], *dd.neg(*ga))
-        above = dd.add(*above, body[k, 0], 0.0, 0.0)
+            j = parent[j]
+        _set(sub, k, dd.add(*outboard, body[k, 0], 0.0, 0.0))
 
 
 @kernel
-def _inertia_T(body, J, M):
+def _inertia_T(body, parent, J, M):
     """Write M T, M = diag(A) + J^T diag(m) J, into M (n, n, 3)."""
     n = body.shape[0]
     for i in range(n):
@@ -88,10 +139,12 @@ def _inertia_T(body, J, M):
                 t = dd.mul(body[k, 0], 0.0, 0.0, J[k, i, 0], J[k, i, 1], J[k, i, 2])
                 acc = dd.fma(*acc, *t, J[k, j, 0], J[k, j, 1], J[k, j, 2])
             _set(M[i], j, acc)
-    # Column j of M T collects the columns i >= j of M.
+    # Column j of M T collects the columns of M of the subtree of j: add each column into its
+    # parent's, children first (backwards in a regular numbering).  A chain: columns i >= j.
     for k in range(n):
-        for j in range(n - 2, -1, -1):
-            _set(M[k], j, dd.add(M[k, j, 0], M[k, j, 1], M[k, j, 2], M[k, j + 1, 0], M[k, j + 1, 1], M[k, j + 1, 2]))
+        for j in range(n - 1, 0, -1):
+            i = parent[j]
+            _set(M[k], i, dd.add(M[k, i, 0], M[k, i, 1], M[k, i, 2], M[k, j, 0], M[k, j, 1], M[k, j, 2]))
 
 
 @kernel
@@ -119,18 +172,18 @@ def _liquid_polys(omega, E, kappa, L, q, w):
 
 
 @kernel
-def _matrix(body, joint, g, E, kappa, nmodes, free, J, M, K, q, w, P, reuse):
+def _matrix(body, joint, at, g, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, reuse):
     """Write P = diag(Q) Phi T as interval polynomials into P (n, n, 3 + Lmax, 3).
 
     Row k has degree 2 + nmodes[k]; unused trailing coefficients are exact zeros.
     ``reuse``: M T and K T in M, K are those of this point already (only omega
-    or the liquid changed since the previous point).
+    or the liquid changed since the previous point).  T from ``path_matrix``.
     """
     n = body.shape[0]
     if not reuse:
-        _lever_arms(body, free, J)
-        _inertia_T(body, J, M)
-        _stiffness_T(body, joint, g, free, K)
+        _lever_arms(body, at, parent, free, J)
+        _inertia_T(body, parent, J, M)
+        _stiffness_T(body, joint, at, parent, g, free, sub, K)
     P[:] = 0.0
     for k in range(n):
         L = nmodes[k]
@@ -139,18 +192,19 @@ def _matrix(body, joint, g, E, kappa, nmodes, free, J, M, K, q, w, P, reuse):
         G = dd.mul(body[k, 2], 0.0, 0.0, omega, 0.0, 0.0)  # C_k omega_k
         for j in range(n):
             e = P[k, j]
-            # P_kj = Q (lambda^2 MT_kj + lambda GT_kj - KT_kj) - [j <= k] lambda^2 (lambda + omega) R
+            # P_kj = Q (lambda^2 MT_kj + lambda GT_kj - KT_kj) - T_kj lambda^2 (lambda + omega) R
             mk = (M[k, j, 0], M[k, j, 1], M[k, j, 2])
             kk = (-K[k, j, 0], -K[k, j, 1], K[k, j, 2])
+            on_path = T[k, j]
             for a in range(L + 1):
                 qa = (q[a, 0], q[a, 1], q[a, 2])
                 if dd.is_zero(*qa):
                     continue
                 _set(e, a, dd.fma(e[a, 0], e[a, 1], e[a, 2], *qa, *kk))
-                if j <= k:
+                if on_path:
                     _set(e, a + 1, dd.fma(e[a + 1, 0], e[a + 1, 1], e[a + 1, 2], *qa, *G))
                 _set(e, a + 2, dd.fma(e[a + 2, 0], e[a + 2, 1], e[a + 2, 2], *qa, *mk))
-            if j <= k:
+            if on_path:
                 for a in range(L):
                     wa = (w[a, 0], w[a, 1], w[a, 2])
                     _set(e, a + 3, dd.add(e[a + 3, 0], e[a + 3, 1], e[a + 3, 2], *dd.neg(*wa)))
@@ -251,8 +305,12 @@ def diagonal_blocks(P, starts):
 
 
 @kernel
-def allocate(n, lmax, degree):
-    """Scratch arrays for one block: allocated once per block, reused for every point."""
+def allocate(n, lmax, degree, parent):
+    """Scratch arrays for one block: allocated once per block, reused for every point.
+
+    Checks ``parent`` (ValueError unless a regular numbering) and stores its path matrix.
+    """
+    check_parent(parent, n)
     J = np.empty((n, n, 3))
     M = np.empty((n, n, 3))
     K = np.empty((n, n, 3))
@@ -260,16 +318,19 @@ def allocate(n, lmax, degree):
     w = np.empty((lmax + 1, 3))
     P = np.empty((n, n, lmax + 3, 3))
     D = np.empty((1 << n, degree + 1, 3))
-    return J, M, K, q, w, P, D
+    T = np.empty((n, n), np.bool_)
+    path_matrix(parent, T)
+    sub = np.empty((n, 3))
+    return J, M, K, q, w, P, D, T, sub
 
 
 @kernel
-def same_structure(body, joint, g, p):
+def same_structure(body, joint, at, g, p):
     """True if point p has the inertia and stiffness of point p - 1 (only omega or the liquid differ)."""
     if p == 0 or g[p] != g[p - 1]:
         return False
     for k in range(body.shape[1]):
-        if joint[p, k] != joint[p - 1, k]:
+        if joint[p, k] != joint[p - 1, k] or at[p, k] != at[p - 1, k]:
             return False
         for col in range(5):  # m, A, C, c, s; column 5 is omega
             if body[p, k, col] != body[p - 1, k, col]:
@@ -278,10 +339,10 @@ def same_structure(body, joint, g, p):
 
 
 @kernel
-def matrix_point(body, joint, g, E, kappa, nmodes, free, ws, reuse):
-    """Build P = diag(Q) Phi T of one point into ws[5]; ws from ``allocate``."""
-    J, M, K, q, w, P, D = ws
-    _matrix(body, joint, g, E, kappa, nmodes, free, J, M, K, q, w, P, reuse)
+def matrix_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
+    """Build P = diag(Q) Phi T of one point into ws[5]; ws from ``allocate`` (with this parent)."""
+    J, M, K, q, w, P, D, T, sub = ws
+    _matrix(body, joint, at, g, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, reuse)
 
 
 @kernel
@@ -293,7 +354,7 @@ def block_det(ws, rowdeg, i0, i1, out):
 
 
 @kernel
-def charpoly_point(body, joint, g, E, kappa, nmodes, rowdeg, free, ws, out, reuse=False):
+def charpoly_point(body, joint, at, g, E, kappa, nmodes, parent, rowdeg, free, ws, out, reuse=False):
     """Enclosure of p(lambda) for one point into out (deg + 1, 3); ws from ``allocate``, rowdeg = nmodes + 2."""
-    matrix_point(body, joint, g, E, kappa, nmodes, free, ws, reuse)
+    matrix_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     block_det(ws, rowdeg, 0, body.shape[0], out)

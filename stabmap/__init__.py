@@ -1,4 +1,4 @@
-"""stabmap: stability atlases of spinning chains of gyroscopes with liquid-filled cavities.
+"""stabmap: stability atlases of spinning chains and trees of gyroscopes with liquid-filled cavities.
 
 >>> import stabmap
 >>> scene = stabmap.example("paper-n3-fixed")     # or stabmap.load_scene("scene.toml")

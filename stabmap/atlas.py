@@ -238,7 +238,7 @@ def _dataset(scene: Scene, nc: np.ndarray, decided_by: np.ndarray, stability: np
 def global_attrs(scene: Scene, kind: str) -> dict:
     """CF global attributes of every file stabmap writes, with the scene that made it."""
     now = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
-    return {
+    attrs = {
         "Conventions": "CF-1.10",
         "title": scene.title or kind,
         "source": f"stabmap {__version__}",
@@ -250,3 +250,6 @@ def global_attrs(scene: Scene, kind: str) -> dict:
         "polynomial_degree_bound": scene.degree,
         "scene": scene.to_toml(),
     }
+    if scene.topology is not None:
+        attrs["topology_parent"] = np.array(scene.topology.parent, dtype=np.int32)
+    return attrs

@@ -46,7 +46,7 @@ def default_chunk_points(scene: Scene, threads: int) -> int:
     total = math.prod(scene.shape)
     by_time = points_per_second(scene.degree) * TASK_SECONDS
     one = point_arrays(scene, {})
-    per_point = sum(a.nbytes for a in (one.body, one.joint, one.g, one.E, one.kappa)) + 8
+    per_point = sum(a.nbytes for a in (one.body, one.joint, one.g, one.E, one.kappa, one.at)) + 8
     by_memory = MAX_CHUNK_BYTES // per_point
     balance = max(1024, total // (4 * max(1, threads)))
     return int(max(1, min(by_time, by_memory, MAX_CHUNK_POINTS, balance)))

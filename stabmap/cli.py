@@ -153,6 +153,8 @@ def _cmd_info(args) -> None:
     a = ds.attrs
     print(f"{args.atlas}: {a.get('title', '')}")
     print(f"  support {a.get('support')}, {a.get('n_bodies')} bodies, characteristic polynomial of degree <= {a.get('polynomial_degree_bound')}")
+    if "topology_parent" in a:
+        print(f"  a tree: parent = {[int(p) for p in np.atleast_1d(a['topology_parent'])]} (0: the base; docs/trees.md)")
     print("  axes:")
     for d in ds[N_COMPLEX_PAIRS].dims:
         c = ds[d]
@@ -306,7 +308,7 @@ def _cmd_examples(args) -> None:
 
 
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="stabmap", description="Stability atlases of spinning chains of gyroscopes with liquid-filled cavities.")
+    p = argparse.ArgumentParser(prog="stabmap", description="Stability atlases of spinning chains and trees of gyroscopes with liquid-filled cavities.")
     p.add_argument("--version", action="version", version=f"stabmap {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
@@ -408,6 +410,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"stabmap: interrupted; {_interrupted_note(args)}", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # output piped into e.g. head, which stopped reading
+        sys.stdout = None
+        return 0
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)

@@ -10,24 +10,36 @@ from __future__ import annotations
 import flint
 import numpy as np
 
+from . import topology
+
 
 def _q(x: float) -> flint.fmpq:
     num, den = float(x).as_integer_ratio()
     return flint.fmpq(num, den)
 
 
-def char_poly(body, joint, g, E, kappa, nmodes, free: bool) -> flint.fmpq_poly:
-    """p(lambda) of MODEL.md for one point, exactly (ascending coefficients via ``.coeffs()``)."""
+def char_poly(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=None) -> flint.fmpq_poly:
+    """p(lambda) of MODEL.md for one point, exactly (ascending coefficients via ``.coeffs()``).
+
+    ``parent`` and ``at`` as for the kernels (a regular numbering, parent[0] = -1); None: a chain.
+    The matrices come from Wittenburg's S and T (``stabmap.topology``, docs/trees.md), not from
+    the kernels' walk along each path.
+    """
     n = len(body)
+    parent = [k - 1 for k in range(n)] if parent is None else [int(p) for p in parent]
+    at = [0.0] + [body[parent[k]][4] for k in range(1, n)] if at is None else at
     m = [_q(body[k][0]) for k in range(n)]
     A = [_q(body[k][1]) for k in range(n)]
     C = [_q(body[k][2]) for k in range(n)]
     c = [_q(body[k][3]) for k in range(n)]
-    s = [_q(body[k][4]) for k in range(n)]
     w = [_q(body[k][5]) for k in range(n)]
-    K = [_q(joint[k]) for k in range(n)]
+    Kj = [_q(joint[k]) for k in range(n)]  # the joint of body k with its parent (k = 0: the base joint)
+    arm = [_q(at[k]) for k in range(n)]
     zero = flint.fmpq(0)
-    J = [[s[i] if i < k else (c[k] if i == k else zero) for i in range(n)] for k in range(n)]
+    tree = [p + 1 for p in parent]  # 1-based, 0 = the base
+    S = topology.incidence(*topology.arcs(tree))[1:].tolist()  # arcs away from the base; no base row
+    T = topology.path_matrix(*topology.arcs(tree)).tolist()
+    J = [[zero + x for x in row] for row in topology.lever_arms(tree, arm, c).tolist()]
     if free:
         mt = sum(m, zero)
         for i in range(n):
@@ -35,17 +47,17 @@ def char_poly(body, joint, g, E, kappa, nmodes, free: bool) -> flint.fmpq_poly:
             for k in range(n):
                 J[k][i] -= mean
     M = [[(A[i] if i == j else zero) + sum((m[k] * J[k][i] * J[k][j] for k in range(n)), zero) for j in range(n)] for i in range(n)]
-    Kmat = [[zero] * n for _ in range(n)]
-    for j in range(1, n):  # joint j joins bodies j-1 and j (0-based)
-        Kmat[j - 1][j - 1] += K[j]
-        Kmat[j][j] += K[j]
-        Kmat[j - 1][j] -= K[j]
-        Kmat[j][j - 1] -= K[j]
+    if free:
+        Kj[0] = zero  # no base joint
+    # Elastic: sum_a K_a phi_a^2 / 2 with phi = -S^T theta, so K = S diag(K_a) S^T.
+    Kmat = [[sum((S[i][a] * S[j][a] * Kj[a] for a in range(n)), zero) for j in range(n)] for i in range(n)]
     if not free:
-        Kmat[0][0] += K[0]
         gq = _q(g)
+        # a = m c - S+ diag(at) T m: each body's own first moment plus, for every joint a on it,
+        # at_a times the mass beyond a (-T m).
+        beyond = [-sum((T[a][j] * m[j] for j in range(n)), zero) for a in range(n)]
         for k in range(n):
-            a_k = m[k] * c[k] + s[k] * sum(m[k + 1 :], zero)
+            a_k = m[k] * c[k] + sum((arm[a] * beyond[a] for a in range(n) if S[k][a] > 0), zero)
             Kmat[k][k] -= gq * a_k
     rows = []
     for k in range(n):
@@ -106,11 +118,11 @@ def complex_pairs(p: flint.fmpq_poly) -> int:
     return (p.degree() - count_real_roots(p)) // 2
 
 
-def decide_points(body, joint, g, E, kappa, nmodes, free, index) -> np.ndarray:
+def decide_points(body, joint, g, E, kappa, nmodes, free, parent, at, index) -> np.ndarray:
     """Exact N_c for the points ``index`` of a block (arrays as for the kernels)."""
     out = np.empty(len(index), dtype=np.int16)
     for i, p in enumerate(index):
-        out[i] = complex_pairs(char_poly(body[p], joint[p], g[p], E[p], kappa[p], nmodes, free))
+        out[i] = complex_pairs(char_poly(body[p], joint[p], g[p], E[p], kappa[p], nmodes, free, parent, at[p]))
     return out
 
 

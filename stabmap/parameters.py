@@ -33,6 +33,8 @@ BODY = {
 BODY_COLUMNS = ("m", "A", "C", "c", "s", "omega")  # column order of the kernels' body array
 JOINT = ParameterInfo("K", "N m rad-1", "stiffness of joint {k}", 0.0, False)
 BASE = ParameterInfo("K", "N m rad-1", "stiffness of the base joint", 0.0, False)
+# A tree (scene [topology]): where body k's joint sits on its parent's axis, up positive.
+POSITION = ParameterInfo("at", "m", "position of the joint of body {k} on its parent's axis", None, False)
 CAVITY = {
     "radius": ParameterInfo("a", "m", "radius (equatorial semi-axis) of the cavity of body {k}", 0.0, True),
     "half_height": ParameterInfo("c", "m", "half height (polar semi-axis) of the cavity of body {k}", 0.0, True),
@@ -48,12 +50,12 @@ GLOBAL = {
     "g": ParameterInfo("g", "m s-2", "gravitational acceleration", None, False),
 }
 
-_NAME = re.compile(r"^(m|A|C|c|s|omega|K|radius|half_height|density)_(\d+)$")
+_NAME = re.compile(r"^(m|A|C|c|s|omega|K|at|radius|half_height|density)_(\d+)$")
 
 
 @dataclass(frozen=True)
 class Name:
-    """A parsed parameter name: kind is 'global', 'body', 'cavity', 'joint', 'every_body' or 'every_joint'.
+    """A parsed parameter name: kind is 'global', 'body', 'cavity', 'joint', 'position', 'every_body' or 'every_joint'.
 
     index is 1-based (K: 0 = base); 0 for the common axes of every body (``m``, ``A``, ``C``, ``c``, ``s``)
     and of every joint between bodies (``K``, which leaves the base joint K_0 alone).
@@ -72,6 +74,8 @@ class Name:
             return BASE if self.kind == "joint" and self.index == 0 else JOINT
         if self.kind == "cavity":
             return CAVITY[self.symbol]
+        if self.kind == "position":
+            return POSITION
         return BODY[self.symbol]
 
     @property
@@ -104,17 +108,25 @@ def parse_name(name: str, n_bodies: int, support: str) -> Name:
         raise StabmapError(
             f"unknown parameter name {name!r}; scannable names are omega, g, "
             "m_k A_k C_k c_k s_k omega_k (body k = 1..n), radius_k half_height_k density_k (the cavity "
-            "of body k), K_k (joint k, K_0 the base), and m A C c s K for every body or joint at once"
+            "of body k), K_k (joint k, K_0 the base), at_k (a tree's joint positions), and m A C c s K "
+            "for every body or joint at once"
         )
     symbol, index = match.group(1), int(match.group(2))
     if symbol == "K":
         if index == 0 and support == "free":
             raise StabmapError(f"{name!r}: a free system has no base joint; K_0 is for support = \"fixed\"")
         if index > n_bodies - 1:
-            raise StabmapError(f"{name!r}: a chain of {n_bodies} bodies has joints K_1..K_{n_bodies - 1} (and K_0 at a fixed base)")
+            raise StabmapError(
+                f"{name!r}: a chain of {n_bodies} bodies has joints K_1..K_{n_bodies - 1} (and K_0 at a fixed base); "
+                "in a tree, K_k is the joint of body k+1 with its parent"
+            )
         return Name(name, "joint", symbol, index)
     if not 1 <= index <= n_bodies:
         raise StabmapError(f"{name!r}: bodies are numbered 1..{n_bodies}")
+    if symbol == "at":
+        if index == 1:
+            raise StabmapError(f"{name!r}: body 1's joint is the base point (or a free system's reference point); it has no position to scan")
+        return Name(name, "position", symbol, index)
     return Name(name, "cavity" if symbol in CAVITY else "body", symbol, index)
 
 

@@ -6,29 +6,52 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import liquid
+from . import liquid, topology
 from .parameters import BODY_COLUMNS, SCANNABLE_CAVITY, parse_name
 from .scene import Scene
 
 
 @dataclass
 class PointArrays:
-    """Arguments of ``kernels.count_block`` for npts points (layout: kernels/charpoly.py)."""
+    """Arguments of ``kernels.count_block`` for npts points (layout: kernels/charpoly.py).
+
+    Bodies are in the kernels' regular numbering (``stabmap.topology.kernel_layout``).
+    Without ``parent`` and ``at`` the bodies form a chain: parent[k] = k - 1 and
+    at[:, k] = s of body k - 1.
+    """
 
     body: np.ndarray  # (npts, n, 6)
-    joint: np.ndarray  # (npts, n): K_0, K_1..K_{n-1}
+    joint: np.ndarray  # (npts, n): the joint of body k with its parent; a chain: K_0, K_1..K_{n-1}
     g: np.ndarray  # (npts,)
     E: np.ndarray  # (npts, n, Lmax)
     kappa: np.ndarray  # (npts, n, Lmax)
     nmodes: np.ndarray  # (n,) int64
     free: bool
+    parent: np.ndarray | None = None  # (n,) int64: parent[0] = -1, 0 <= parent[k] < k
+    at: np.ndarray | None = None  # (npts, n): position of each joint on the parent's axis
+
+    def __post_init__(self):
+        npts, n = self.body.shape[:2]
+        if self.parent is None:
+            self.parent = np.arange(-1, n - 1, dtype=np.int64)
+        if self.at is None:
+            self.at = chain_positions(self.body)
+        if self.parent.shape != (n,) or self.at.shape != (npts, n):
+            raise ValueError(f"parent must have shape ({n},) and at ({npts}, {n})")
 
     def kernel_args(self):
-        return self.body, self.joint, self.g, self.E, self.kappa, self.nmodes, self.free
+        return self.body, self.joint, self.g, self.E, self.kappa, self.nmodes, self.free, self.parent, self.at
+
+
+def chain_positions(body: np.ndarray) -> np.ndarray:
+    """Joint positions ``at`` (..., n) of a chain from the bodies' s: at_k = s_{k-1}, at_0 = 0."""
+    at = np.zeros(body.shape[:-1])
+    at[..., 1:] = body[..., :-1, 4]
+    return at
 
 
 def base_arrays(scene: Scene):
-    """Parameter arrays of the scene with no grid axis applied (body, joint, g, E, kappa)."""
+    """Parameter arrays of the scene with no grid axis applied (body, joint, g, E, kappa), in scene order."""
     n = scene.n
     body = np.empty((n, 6))
     for k, b in enumerate(scene.bodies):
@@ -52,6 +75,8 @@ def point_arrays(scene: Scene, values: dict[str, np.ndarray]) -> PointArrays:
     npts = int(np.prod(shape, dtype=np.int64))
     body = np.broadcast_to(body0, shape + body0.shape).copy()
     joint = np.broadcast_to(joint0, shape + joint0.shape).copy()
+    tree = scene.topology
+    at = np.broadcast_to(np.asarray(tree.at if tree else np.zeros(scene.n), dtype=np.float64), shape + (scene.n,)).copy()
     g = np.full(shape, g0)
     own_omega = [b.omega is not None for b in scene.bodies]
     names = {key: parse_name(key, scene.n, scene.support) for key in arrays}
@@ -73,6 +98,8 @@ def point_arrays(scene: Scene, values: dict[str, np.ndarray]) -> PointArrays:
             joint[..., name.index] = value
         elif name.kind == "body":
             body[..., name.index - 1, BODY_COLUMNS.index(name.symbol)] = value
+        elif name.kind == "position":
+            at[..., name.index - 1] = value
     E = np.broadcast_to(E0, shape + E0.shape)
     kappa = np.broadcast_to(kappa0, shape + kappa0.shape)
     if any(b.cavity is not None for b in scene.bodies):
@@ -88,14 +115,26 @@ def point_arrays(scene: Scene, values: dict[str, np.ndarray]) -> PointArrays:
             first = len(b.E)
             E[..., k, first : first + Ek.shape[-1]] = Ek
             kappa[..., k, first : first + Ek.shape[-1]] = kappak
+    if tree is None:
+        at = chain_positions(body)
+        order, parent = np.arange(scene.n), np.arange(-1, scene.n - 1, dtype=np.int64)
+    else:
+        order, parent = topology.kernel_layout(tree.parent)
+
+    def kernel_order(x: np.ndarray) -> np.ndarray:
+        """Bodies (axis 1) in the kernels' regular numbering: the scene's own unless it numbers a tree otherwise."""
+        return x if np.array_equal(order, np.arange(scene.n)) else np.ascontiguousarray(x[:, order])
+
     return PointArrays(
-        body=body.reshape(npts, scene.n, 6),
-        joint=joint.reshape(npts, scene.n),
+        body=kernel_order(body.reshape(npts, scene.n, 6)),
+        joint=kernel_order(joint.reshape(npts, scene.n)),
         g=g.reshape(npts),
-        E=np.ascontiguousarray(E.reshape((npts,) + E0.shape)),
-        kappa=np.ascontiguousarray(kappa.reshape((npts,) + kappa0.shape)),
-        nmodes=scene.nmodes,
+        E=kernel_order(np.ascontiguousarray(E.reshape((npts,) + E0.shape))),
+        kappa=kernel_order(np.ascontiguousarray(kappa.reshape((npts,) + kappa0.shape))),
+        nmodes=scene.nmodes[order],
         free=scene.free,
+        parent=parent,
+        at=kernel_order(at.reshape(npts, scene.n)),
     )
 
 

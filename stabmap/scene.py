@@ -1,4 +1,4 @@
-"""Scenes: a chain of bodies, its support and the grid to scan, read from TOML.
+"""Scenes: a chain or a tree of bodies, its support and the grid to scan, read from TOML.
 
 A scene is data: frozen dataclasses here, a TOML file on disk, and the same
 TOML text stored back into every atlas so the file says how it was made.
@@ -12,14 +12,16 @@ from pathlib import Path
 
 import numpy as np
 
-from . import liquid
+from . import liquid, topology
 from .errors import StabmapError
 from .liquid import Cavity
-from .parameters import BASE, BODY, EVERY_BODY, GLOBAL, JOINT, SCANNABLE_CAVITY, ParameterInfo, check_value, parse_name
+from .parameters import BASE, BODY, EVERY_BODY, GLOBAL, JOINT, POSITION, SCANNABLE_CAVITY, ParameterInfo, check_value, parse_name
+from .topology import Topology
 
 SUPPORTS = ("fixed", "free")
 DEFAULT_G = 9.81
-_TOP_KEYS = {"title", "support", "g", "omega", "joints", "K_0", "bodies", "grid"}
+_TOP_KEYS = {"title", "support", "g", "omega", "joints", "K_0", "topology", "bodies", "grid"}
+_TOPOLOGY_KEYS = {"parent", "at"}
 _BODY_KEYS = {"m", "A", "C", "c", "s", "omega", "fluid", "cavity"}
 _FLUID_KEYS = {"E", "kappa"}
 _AXIS_KEYS = {"start", "stop", "num", "scale", "values"}
@@ -57,7 +59,14 @@ class Axis:
 
 @dataclass(frozen=True)
 class Scene:
-    """A chain of n bodies (body 1 at the bottom) and the grid of parameters to scan."""
+    """n bodies and the grid of parameters to scan.
+
+    Without ``topology`` the bodies form a chain, body 1 at the bottom, body k + 1
+    on body k at s_k.  With it they form a tree (docs/trees.md): body k is mounted
+    on body parent[k - 1] at at[k - 1] on that body's axis, and s is not used.
+    Either way K_0 is the joint of body 1 with the base and K_k (k >= 1) the joint
+    of body k + 1 with the body it is mounted on.
+    """
 
     bodies: tuple[Body, ...]
     support: str = "fixed"
@@ -67,6 +76,7 @@ class Scene:
     K_0: float = 0.0  # base stiffness (fixed support)
     title: str = ""
     grid: tuple[Axis, ...] = field(default=())
+    topology: Topology | None = None  # None: a chain
 
     @property
     def n(self) -> int:
@@ -103,8 +113,13 @@ class Scene:
         out.append(f"joints = {_toml_list(self.joint_stiffness())}")
         if not self.free:
             out.append(f"K_0 = {self.K_0!r}")
+        if self.topology is not None:
+            parents = ", ".join(str(p) for p in self.topology.parent)
+            out += ["", "[topology]", f"parent = [{parents}]", f"at = {_toml_list(self.topology.at)}"]
         for b in self.bodies:
-            out += ["", "[[bodies]]", f"m = {b.m!r}", f"A = {b.A!r}", f"C = {b.C!r}", f"c = {b.c!r}", f"s = {b.s!r}"]
+            out += ["", "[[bodies]]", f"m = {b.m!r}", f"A = {b.A!r}", f"C = {b.C!r}", f"c = {b.c!r}"]
+            if self.topology is None:
+                out.append(f"s = {b.s!r}")
             if b.omega is not None:
                 out.append(f"omega = {b.omega!r}")
             if b.E:
@@ -157,8 +172,9 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
     if not isinstance(raw_bodies, list) or not raw_bodies:
         raise StabmapError("bodies is missing: add at least one [[bodies]] table (body 1 at the bottom)")
     n = len(raw_bodies)
+    tree = _topology(data["topology"], n) if "topology" in data else None
     base_dir = None if base_dir is None else Path(base_dir)
-    bodies = tuple(_body(raw, k + 1, n, base_dir) for k, raw in enumerate(raw_bodies))
+    bodies = tuple(_body(raw, k + 1, n, base_dir, tree is not None) for k, raw in enumerate(raw_bodies))
     title = data.get("title", "")
     if not isinstance(title, str):
         raise StabmapError(f"title must be a string, got {title!r}")
@@ -172,6 +188,11 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
     if not isinstance(joints, list):
         raise StabmapError(f"joints must be a list of stiffnesses K_1..K_{n - 1}, got {joints!r}")
     if joints and len(joints) != n - 1:
+        if tree is not None:
+            raise StabmapError(
+                f"joints has {len(joints)} values; a tree of {n} bodies has {n - 1} joints between bodies "
+                f"(K_1..K_{n - 1}, K_k the joint of body k+1 with its parent)"
+            )
         raise StabmapError(
             f"joints has {len(joints)} values; a chain of {n} bodies has {n - 1} joints (K_1..K_{n - 1})"
         )
@@ -181,8 +202,10 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
         if support == "free":
             raise StabmapError('K_0: a free system has no base joint; remove K_0 or use support = "fixed"')
         K_0 = check_value("K_0", data["K_0"], BASE)
-    grid = _grid(data.get("grid", {}), n, support)
-    scene = Scene(bodies=bodies, support=support, omega=omega, g=g, joints=joints, K_0=K_0, title=title, grid=grid)
+    grid = _grid(data.get("grid", {}), n, support, tree is not None)
+    scene = Scene(
+        bodies=bodies, support=support, omega=omega, g=g, joints=joints, K_0=K_0, title=title, grid=grid, topology=tree
+    )
     _check_omega(scene)
     _check_cavities(scene)
     return scene
@@ -196,17 +219,42 @@ def _no_unknown(table: dict, allowed: set, where: str) -> None:
         raise StabmapError(f"{where}: unknown key {unknown[0]!r}; allowed keys are {', '.join(sorted(allowed))}")
 
 
-def _body(raw: dict, k: int, n: int, base_dir: Path | None) -> Body:
+def _topology(raw: dict, n: int) -> Topology:
+    """The ``[topology]`` table: the parent of each body and the position of its joint on the parent's axis."""
+    _no_unknown(raw, _TOPOLOGY_KEYS, "topology")
+    for key, example in (("parent", "parent = [0, 1, 1] (0: the base)"), ("at", "at = [0.0, 0.3, 0.3] (0 for body 1)")):
+        if key not in raw:
+            what = "the parent of each body" if key == "parent" else "the position of each body's joint on its parent's axis [m]"
+            raise StabmapError(f"topology.{key} is missing: give {what}, one per [[bodies]] table, e.g. {example}")
+        if not isinstance(raw[key], list) or len(raw[key]) != n:
+            got = f"{len(raw[key])} values" if isinstance(raw[key], list) else repr(raw[key])
+            raise StabmapError(f"topology.{key} must be a list with one value per body ({n} [[bodies]] tables), got {got}")
+    parent = topology.check_parent(raw["parent"], "topology.parent")
+    at = tuple(check_value(f"topology.at[{k + 1}]", v, POSITION) for k, v in enumerate(raw["at"]))
+    if at[0] != 0.0:
+        raise StabmapError(
+            f"topology.at[1] must be 0, got {at[0]}: body 1's joint is the base point (or a free system's "
+            "reference point), not a place on another body"
+        )
+    return Topology(parent=parent, at=at)
+
+
+def _body(raw: dict, k: int, n: int, base_dir: Path | None, tree: bool = False) -> Body:
     where = f"bodies[{k}]"
     _no_unknown(raw, _BODY_KEYS, where)
+    if tree and "s" in raw:
+        raise StabmapError(
+            f"{where}.s is not used in a scene with [topology]: the joints' positions are topology.at "
+            "(where each body's joint sits on its parent's axis); remove s"
+        )
     cavity = liquid.parse(raw["cavity"], f"{where}.cavity", base_dir) if "cavity" in raw else None
     # A dry shell may be massless when the engine adds the liquid (Kelvin's spinning shell).
     dry = cavity is not None and not cavity.liquid_in_body
     values = {}
     for key in ("m", "A", "C", "c", "s"):
         if key not in raw:
-            if key == "s" and k == n:
-                values[key] = 0.0  # the top body has no upper joint
+            if key == "s" and (k == n or tree):
+                values[key] = 0.0  # the top body has no upper joint; a tree's joints are placed by topology.at
                 continue
             raise StabmapError(f"{where}.{key} is missing ({BODY[key].long_name.format(k=k)} [{BODY[key].units}])")
         info = BODY[key]
@@ -234,13 +282,23 @@ def _body(raw: dict, k: int, n: int, base_dir: Path | None) -> Body:
     return Body(omega=omega, E=E, kappa=kappa, cavity=cavity, **values)
 
 
-def _grid(raw: dict, n: int, support: str) -> tuple[Axis, ...]:
+def _grid(raw: dict, n: int, support: str, tree: bool = False) -> tuple[Axis, ...]:
     if not isinstance(raw, dict):
         raise StabmapError(f"grid must be a table of axes, got {raw!r}")
     axes = []
     for name, spec in raw.items():
         parsed = parse_name(name, n, support)
         where = f"grid.{name}"
+        if tree and parsed.symbol == "s":
+            raise StabmapError(
+                f"grid axis {name!r} has no effect in a scene with [topology]: joints sit at topology.at; "
+                "scan at_k, the position of body k's joint on its parent's axis"
+            )
+        if not tree and parsed.kind == "position":
+            raise StabmapError(
+                f"grid axis {name!r}: at_k places a joint in a scene with [topology]; in a chain body {parsed.index} "
+                f"hangs at s_{parsed.index - 1} on body {parsed.index - 1}, so scan s_{parsed.index - 1}"
+            )
         _no_unknown(spec, _AXIS_KEYS, where)
         if "values" in spec:
             extra = set(spec) - {"values", "scale"}
@@ -334,8 +392,10 @@ def fixed_values(scene: Scene) -> dict[str, float]:
         out["g"] = scene.g
     for k, b in enumerate(scene.bodies, start=1):
         for key in EVERY_BODY:
-            if key not in names:
+            if key not in names and not (key == "s" and scene.topology is not None):
                 out[f"{key}_{k}"] = getattr(b, key)
+        if scene.topology is not None and k > 1:
+            out[f"at_{k}"] = scene.topology.at[k - 1]
         if b.omega is not None:
             out[f"omega_{k}"] = b.omega
         if b.cavity is not None and b.cavity.geometric:

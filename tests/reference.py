@@ -14,6 +14,11 @@ Conventions (all from MODEL.md):
   (lam + omega_k - lambda_kl))`` with ``lambda_kl = 2 omega_k / kappa_kl``.
 * ``p(lam) = det Phi(lam) * prod_k Q_k(lam)`` with
   ``Q_k = prod_l (lam + omega_k - lambda_kl)``.
+
+Trees of bodies (``docs/trees.md``) get their own derivation in
+:func:`tree_matrices`: bodies placed with exact trigonometry, M and K as
+Hessians of the kinetic and potential energy, no lever-arm formula and no
+incidence or path matrix, so it also checks the engine's use of those.
 """
 
 from __future__ import annotations
@@ -29,6 +34,8 @@ __all__ = [
     "lam",
     "exact",
     "char_poly",
+    "tree_char_poly",
+    "tree_matrices",
     "system_matrices",
     "lever_arms",
     "liquid_Q",
@@ -282,6 +289,11 @@ def char_poly(bodies, support, g=0, joints=(), K0=0):
     """
     bs, joints, g, K0 = _normalise(bodies, support, g, joints, K0)
     M, G, K = system_matrices(bodies, support, g, joints, K0)
+    return _det_poly(bs, M, G, K)
+
+
+def _det_poly(bs, M, G, K):
+    """``det Phi(lam) * prod_k Q_k(lam)`` for validated bodies ``bs`` and exact matrices (see :func:`char_poly`)."""
     n = len(bs)
     rows = []
     for k, b in enumerate(bs):
@@ -303,6 +315,99 @@ def char_poly(bodies, support, g=0, joints=(), K0=0):
         rows.append(row)
     det = DomainMatrix(rows, (n, n), _RING).det()
     return sympy.Poly(_RING.to_sympy(det), lam, domain=QQ)
+
+
+def tree_matrices(bodies, parent, at, support, g=0, stiffness=None):
+    """``(M, G, K)`` of bodies joined as a tree, from the Lagrangian of the geometry.
+
+    Deliberately not MODEL.md's lever-arm formula: every body is placed in a
+    vertical plane with exact trigonometry, the kinetic and potential energies are
+    written out literally, and ``M`` and ``K`` are their Hessians at the upright
+    state (for a free system after eliminating the translation of the whole system
+    by Routh's procedure: its momentum is zero).  Motion out of the plane has the
+    same ``M`` and ``K``; the spin only adds ``G = diag(C_k omega_k)``.
+
+    Parameters
+    ----------
+    bodies : list of dict
+        Keys ``m, A, C, c, omega`` (and optional ``E``, ``kappa``) as in
+        :func:`char_poly`; ``c`` is measured from the body's own joint O_k.
+    parent : sequence of int
+        ``parent[k - 1]`` is the body that body k is mounted on; 0 the base
+        (fixed support) or nothing (free support).  Exactly one body has 0; any
+        numbering.
+    at : sequence of numbers
+        ``at[k - 1]``: the height of O_k above O_parent along the parent's axis
+        (ignored for the body on the base).
+    support : {"fixed", "free"}
+    g : number
+        Gravity (fixed support; dropped for a free system).
+    stiffness : sequence of numbers, optional
+        ``stiffness[k - 1]``: the spring between the tilts of body k and of its
+        parent (for the body on the base: of the base, fixed support only).
+
+    Returns
+    -------
+    M, G, K : sympy.Matrix
+    """
+    if support not in ("fixed", "free"):
+        raise ValueError(f"support must be 'fixed' or 'free', not {support!r}")
+    bs = [_body(dict(b, s=b.get("s", 0))) for b in bodies]
+    n = len(bs)
+    parent = [int(p) for p in parent]
+    at = [exact(a) for a in at]
+    stiffness = [exact(x) for x in (stiffness if stiffness is not None else [0] * n)]
+    if len(parent) != n or len(at) != n or len(stiffness) != n:
+        raise ValueError("parent, at and stiffness need one entry per body")
+    if parent.count(0) != 1:
+        raise ValueError("exactly one body must hang on the base")
+    root = parent.index(0)
+    if support == "free" and stiffness[root] != 0:
+        raise ValueError("a free system has no base joint to be stiff")
+    th = sympy.symbols(f"th1:{n + 1}")
+    x0, z0 = sympy.symbols("x0 z0")
+    # Place every joint O_k and centre C_k; a parent is placed before its children.
+    O = {}
+    Cm = {}
+    pending = list(range(n))
+    while pending:
+        for k in list(pending):
+            p = parent[k] - 1
+            if p == -1:
+                O[k] = sympy.Matrix([x0, z0]) if support == "free" else sympy.Matrix([0, 0])
+            elif p in O:
+                O[k] = O[p] + at[k] * sympy.Matrix([sympy.sin(th[p]), sympy.cos(th[p])])
+            else:
+                continue
+            Cm[k] = O[k] + bs[k]["c"] * sympy.Matrix([sympy.sin(th[k]), sympy.cos(th[k])])
+            pending.remove(k)
+    coords = list(th) + ([x0, z0] if support == "free" else [])
+    rates = sympy.symbols(f"v1:{len(coords) + 1}")
+    T = 0
+    for k, b in enumerate(bs):
+        v = Cm[k].jacobian(coords) * sympy.Matrix(rates)
+        T += b["m"] * (v.T * v)[0] / 2 + b["A"] * rates[k] ** 2 / 2
+    V = sum((stiffness[k] * (th[k] - (th[parent[k] - 1] if parent[k] else 0)) ** 2 / 2 for k in range(n)),
+            sympy.Integer(0))
+    if support == "fixed":
+        V += exact(g) * sum((b["m"] * Cm[k][1] for k, b in enumerate(bs)), sympy.Integer(0))
+    upright = {q: 0 for q in coords}
+    Mfull = sympy.hessian(T, rates).subs(upright)
+    K = sympy.hessian(V, th).subs(upright)
+    M = Mfull[:n, :n]
+    if support == "free":
+        # Routh: the translation is cyclic with zero momentum; eliminate it (Schur complement).
+        Mtx, Mxx = Mfull[:n, n:], Mfull[n:, n:]
+        M = M - Mtx * Mxx.inv() * Mtx.T
+    G = sympy.diag(*[b["C"] * b["omega"] for b in bs])
+    return sympy.Matrix(M), G, sympy.Matrix(K)
+
+
+def tree_char_poly(bodies, parent, at, support, g=0, stiffness=None):
+    """Exact ``p(lam)`` of a tree of bodies from :func:`tree_matrices` (same conventions as :func:`char_poly`)."""
+    M, G, K = tree_matrices(bodies, parent, at, support, g, stiffness)
+    bs = [_body(dict(b, s=b.get("s", 0))) for b in bodies]
+    return _det_poly(bs, M, G, K)
 
 
 def _as_poly(poly):

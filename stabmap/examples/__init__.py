@@ -1,4 +1,4 @@
-"""Bundled example scenes (the paper's cases n = 1, 2, 3, fixed and free)."""
+"""Bundled example scenes (the paper's cases n = 1, 2, 3, fixed and free; a cavity; trees of bodies)."""
 
 from __future__ import annotations
 
