@@ -312,7 +312,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"stabmap {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
-    a = sub.add_parser("atlas", help="compute an atlas from a scene and write netCDF4")
+    a = sub.add_parser("atlas", help="compute an atlas from a scene and write netCDF4 or Zarr, here or on a dask cluster")
     a.add_argument("scene", nargs="?", help="scene TOML file")
     a.add_argument("--example", metavar="NAME", help="a bundled example scene (see 'stabmap examples')")
     a.add_argument("-o", "--output", required=True, help="file to write: atlas.nc (netCDF4) or atlas.zarr (Zarr)")
