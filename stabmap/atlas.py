@@ -18,8 +18,8 @@ import numpy as np
 import xarray as xr
 
 from . import __version__
-from .chunks import check_chunk_points, chunk_locations, chunk_shape, default_chunk_points
-from .cluster import check_threads, cluster_threads, connect, run_chunks
+from .chunks import atlas_chunk, check_chunk_points, chunk_locations, chunk_shape, default_chunk_points
+from .cluster import check_threads, cluster_threads, connect, run_tasks
 from .errors import StabmapError
 from .parameters import parse_name
 from .partial import PartialRun, partial_dir
@@ -207,7 +207,8 @@ class _Run:
                 f"about {eta:.0f} s to go"
             )
 
-        run_chunks(self.scene, self.locations, todo, handle, client=self.client, threads=self.threads)
+        args = [(self.scene, location) for location in self.locations]
+        run_tasks(atlas_chunk, args, todo, handle, client=self.client, threads=self.threads)
 
 
 def coordinates(scene: Scene, skip: tuple[str, ...] = ()) -> dict:

@@ -1,7 +1,7 @@
-"""Where the chunks of an atlas run: local threads, or a dask.distributed cluster.
+"""Where the tasks of a run go: local threads, or a dask.distributed cluster.
 
-The tasks are the same function either way (``chunks.atlas_chunk``), so the
-results are identical cell for cell.  Only a bounded window of tasks is in
+The tasks are the same function either way (for an atlas ``chunks.atlas_chunk``),
+so the results are identical cell for cell.  Only a bounded window of tasks is in
 flight at a time: the scheduler never holds millions of tasks, and finished
 blocks reach the writing process (and leave it) one by one.
 """
@@ -15,12 +15,8 @@ import uuid
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 
-import numpy as np
-
 from . import __version__
-from .chunks import atlas_chunk
 from .errors import StabmapError
-from .scene import Scene
 
 CONNECT_TIMEOUT = 20.0  # seconds to reach a scheduler
 WORKER_TIMEOUT = 120.0  # seconds to wait for a scheduler's first worker
@@ -92,20 +88,21 @@ def _stabmap_version() -> str:
     return stabmap.__version__
 
 
-def run_chunks(
-    scene: Scene,
-    locations: list,
+def run_tasks(
+    task: Callable,
+    args: list[tuple],
     todo: list[int],
-    on_result: Callable[[int, np.ndarray], None],
+    on_result: Callable[[int, object], None],
     *,
     client=None,
     threads: int = 1,
 ) -> None:
-    """Decide the chunks ``todo`` (indices into ``locations``), handing each block to ``on_result`` as it finishes.
+    """Run ``task(*args[i])`` for every i in ``todo``, handing each result to ``on_result(i, result)`` as it finishes.
 
-    At most ``2 * threads + 2`` tasks are in flight.  On any error or Ctrl-C the
-    tasks not yet finished are cancelled and the exception propagates; blocks
-    already handed over stay handed over.
+    On local threads (``client`` None) or on a dask.distributed cluster.  At most
+    ``2 * threads + 2`` tasks are in flight.  On any error or Ctrl-C the tasks not
+    yet finished are cancelled and the exception propagates; results already
+    handed over stay handed over.
     """
     window = 2 * threads + 2
     if client is None:
@@ -113,16 +110,17 @@ def run_chunks(
     else:
         token = uuid.uuid4().hex[:8]
         executor = client.get_executor(retries=RETRIES, pure=False)
+        name = getattr(task, "__name__", "task").replace("_", "-")
 
         def options(i):
-            return {"key": f"stabmap-chunk-{i}-{token}"}
+            return {"key": f"stabmap-{name}-{i}-{token}"}
 
     pending: dict = {}
     queue = iter(todo)
     try:
         while True:
             for i in queue:
-                pending[executor.submit(atlas_chunk, scene, locations[i], **options(i))] = i
+                pending[executor.submit(task, *args[i], **options(i))] = i
                 if len(pending) >= window:
                     break
             if not pending:
@@ -132,7 +130,7 @@ def run_chunks(
     except BaseException:
         for f in pending:
             f.cancel()
-        if client is None:  # a thread cannot be stopped mid-chunk: running ones finish theirs
+        if client is None:  # a thread cannot be stopped mid-task: running ones finish theirs
             executor.shutdown(cancel_futures=True)
         else:  # cluster tasks are cancelled on the scheduler
             executor.shutdown(wait=False)

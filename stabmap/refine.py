@@ -27,15 +27,14 @@ import itertools
 import math
 import sys
 import time
-from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
 
 from .atlas import _dataset
+from .cluster import check_threads, run_tasks
 from .decide import BY_INFERRED, decide
-from .cluster import check_threads
 from .errors import StabmapError
 from .points import point_arrays, spin_axes_last
 from .progress import ProgressLine
@@ -177,8 +176,8 @@ class _Progress(ProgressLine):
 class _Evaluator:
     """Decides grid points on a thread pool and holds the state of the whole grid."""
 
-    def __init__(self, scene: Scene, pool: ThreadPoolExecutor, threads: int, chunk_points: int, progress: _Progress):
-        self.scene, self.pool, self.threads, self.chunk_points, self.progress = scene, pool, threads, chunk_points, progress
+    def __init__(self, scene: Scene, threads: int, chunk_points: int, progress: _Progress):
+        self.scene, self.threads, self.chunk_points, self.progress = scene, threads, chunk_points, progress
         shape = scene.shape
         self.nc = np.zeros(shape, dtype=np.int16)
         self.by = np.full(shape, BY_INFERRED, dtype=np.int8)
@@ -216,21 +215,15 @@ class _Evaluator:
         bounds = [(a, min(a + size, npts)) for a in range(0, npts, size)]
         nc = np.empty(npts, dtype=np.int16)
         by = np.empty(npts, dtype=np.int8)
-        futures = {self.pool.submit(self._chunk, flat[a:b]): (a, b) for a, b in bounds}
-        done_points = 0
-        try:
-            pending = set(futures)
-            while pending:
-                done, pending = wait(pending, timeout=self.progress.dt, return_when=FIRST_COMPLETED)
-                for f in done:
-                    a, b = futures[f]
-                    nc[a:b], by[a:b] = f.result()
-                    done_points += b - a
-                self.progress.update(stride, done_points, npts, self.evaluated + done_points)
-        except BaseException:
-            for f in futures:
-                f.cancel()
-            raise
+        done_points = [0]
+
+        def keep(i, result):
+            a, b = bounds[i]
+            nc[a:b], by[a:b] = result
+            done_points[0] += b - a
+            self.progress.update(stride, done_points[0], npts, self.evaluated + done_points[0])
+
+        run_tasks(self._chunk, [(flat[a:b],) for a, b in bounds], list(range(len(bounds))), keep, threads=self.threads)
         return nc, by
 
     def _chunk(self, flat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -362,16 +355,15 @@ def compute_refined(
     strides = tuple(coarse_stride or default_coarse_stride(n) for n in shape)
     total = math.prod(shape)
     t0 = time.perf_counter()
-    with ThreadPoolExecutor(max_workers=threads) as pool:
-        bar = _Progress(progress, total)
-        ev = _Evaluator(scene, pool, threads, chunk_points, bar)
-        try:
-            if shape:
-                _run_levels(ev, strides, margin)
-            else:
-                ev.evaluate_point()
-        finally:
-            bar.close()
+    bar = _Progress(progress, total)
+    ev = _Evaluator(scene, threads, chunk_points, bar)
+    try:
+        if shape:
+            _run_levels(ev, strides, margin)
+        else:
+            ev.evaluate_point()
+    finally:
+        bar.close()
     ds = _dataset(scene, ev.nc, ev.by)
     ds.attrs["history"] += (
         f"; adaptive refinement (coarse stride {list(strides)}, margin {margin}): "

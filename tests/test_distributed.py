@@ -15,7 +15,7 @@ import pytest
 import xarray as xr
 
 import stabmap
-from stabmap import cli, cluster
+from stabmap import atlas, cli, cluster
 from stabmap.atlas import compute, compute_to_file
 from stabmap.chunks import chunk_locations, chunk_shape, default_chunk_points
 from stabmap.io import open_atlas
@@ -246,8 +246,8 @@ def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(how, t
     assert "--resume" in capsys.readouterr().err
     # --resume computes exactly the missing chunks (counted at the task function itself).
     calls = []
-    task = cluster.atlas_chunk
-    monkeypatch.setattr(cluster, "atlas_chunk", lambda scene, loc: calls.append(loc) or task(scene, loc))
+    task = atlas.atlas_chunk
+    monkeypatch.setattr(atlas, "atlas_chunk", lambda scene, loc: calls.append(loc) or task(scene, loc))
     assert cli.main(args + ["--resume"]) == 0
     err = capsys.readouterr().err
     assert len(calls) == total - len(done)
