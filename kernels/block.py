@@ -7,7 +7,7 @@ import numpy as np
 from .charpoly import allocate, block_det, charpoly_point, diagonal_blocks, matrix_point, same_structure
 from .count import allocate_count, count_point
 from .options import kernel
-from .status import DECIDED_FLOAT, DECIDED_INCLUSION, DEGENERATE, UNDECIDED
+from .status import DECIDED_FLOAT, DECIDED_INCLUSION, ZERO_POLYNOMIAL, UNDECIDED
 
 
 @kernel
@@ -73,9 +73,9 @@ def count_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out_
         for b in range(nblocks):
             d = block_det(ws, rowdeg, starts[b], starts[b + 1], c)
             nc, st = count_point(c[: d + 1], cs)
-            if st == DEGENERATE or st == UNDECIDED:
+            if st == ZERO_POLYNOMIAL or st == UNDECIDED:
                 total, status = -1, st
-                if st == DEGENERATE:
+                if st == ZERO_POLYNOMIAL:
                     break
             elif status != UNDECIDED:
                 total += nc

@@ -2,5 +2,5 @@
 
 DECIDED_FLOAT = 0  # the interval Sturm sequence proved the count
 UNDECIDED = 1  # the intervals could not decide: the caller must use exact arithmetic
-DEGENERATE = 2  # p(lambda) is identically zero
+ZERO_POLYNOMIAL = 2  # p(lambda) is identically zero
 DECIDED_INCLUSION = 3  # disjoint root-inclusion disks proved the count

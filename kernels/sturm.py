@@ -18,7 +18,7 @@ from __future__ import annotations
 from . import dd
 from .options import kernel
 from .scaling import nonzero_span, rescale, root_scale
-from .status import DECIDED_FLOAT, DEGENERATE, UNDECIDED
+from .status import DECIDED_FLOAT, ZERO_POLYNOMIAL, UNDECIDED
 
 
 @kernel
@@ -35,12 +35,12 @@ def count_complex_pairs(c, W):
     Returns
     -------
     (n_complex_pairs, status)
-        status is DECIDED_FLOAT, UNDECIDED (n_complex_pairs = -1) or DEGENERATE
+        status is DECIDED_FLOAT, UNDECIDED (n_complex_pairs = -1) or ZERO_POLYNOMIAL
         (p identically zero, n_complex_pairs = -1).
     """
     z, top = nonzero_span(c)
     if top < 0:
-        return -1, DEGENERATE
+        return -1, ZERO_POLYNOMIAL
     if not dd.certain_nonzero(c[top, 0], c[top, 1], c[top, 2]):
         return -1, UNDECIDED
     real = z  # exact zeros at the bottom are lambda = 0 roots

@@ -32,13 +32,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import kernels  # noqa: E402
+from stabmap import kernels  # noqa: E402
 from bench_kernel import companion_pairs, random_points, timed  # noqa: E402
-from stabmap import exact  # noqa: E402
-from stabmap.atlas import compute  # noqa: E402
-from stabmap.decide import BY_EXACT, BY_INCLUSION, BY_STURM, decided_by_from_status  # noqa: E402
+from stabmap.systems.gyroscopes import exact  # noqa: E402
+from stabmap.run.atlas import compute  # noqa: E402
+from stabmap.systems.gyroscopes.decide import decided_by_from_status  # noqa: E402
+from stabmap.systems.gyroscopes.outputs import BY_EXACT, BY_INCLUSION, BY_STURM  # noqa: E402
 from stabmap.examples import example  # noqa: E402
-from stabmap.points import PointArrays  # noqa: E402
+from stabmap.systems.gyroscopes.points import PointArrays  # noqa: E402
 
 
 # --- point sets ---------------------------------------------------------------------------------

@@ -22,9 +22,9 @@ import time
 import numpy as np
 
 import stabmap
-from stabmap.atlas import compute
-from stabmap.cluster import local_cluster
-from stabmap.scene import resample
+from stabmap.run.atlas import compute
+from stabmap.run.runner import local_cluster
+from stabmap.scene.grid import resample
 
 
 def _timed(fn, repeat: int = 1) -> float:
@@ -72,7 +72,7 @@ def overhead(scene, chunk_points: list[int], repeat: int) -> list[dict]:
 
 
 def _n_tasks(scene, cp: int) -> int:
-    from stabmap.chunks import chunk_locations, chunk_shape
+    from stabmap.run.chunks import chunk_locations, chunk_shape
 
     return len(chunk_locations(scene.shape, chunk_shape(scene.shape, cp)))
 
@@ -82,11 +82,13 @@ PEAK = textwrap.dedent(
     import os, resource, sys
     import numpy as np
     import stabmap
-    from stabmap.scene import resample
-    from stabmap.atlas import compute, compute_to_file
-    from stabmap.chunks import chunk_locations, chunk_shape
-    from stabmap.io import write_atlas, write_streamed
-    from stabmap.partial import PartialRun, partial_dir
+    from stabmap.scene.grid import resample
+    from stabmap.run.atlas import compute, compute_to_file
+    from stabmap.run.chunks import chunk_locations, chunk_shape
+    from stabmap import systems
+    from stabmap.store.checkpoint import Checkpoint, partial_dir
+    from stabmap.store.dataset import atlas_dataset
+    from stabmap.store.files import write_atlas, write_streamed
     how, side, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
     dry = stabmap.example("paper-n1-fixed-dry")
     # Warm up every code path first, so that the growth below is the run's own memory, not imports.
@@ -98,15 +100,21 @@ PEAK = textwrap.dedent(
         compute_to_file(scene, out, threads=2, progress=False)
     elif how == "in-memory":
         write_atlas(compute(scene, threads=2, progress=False), out)
-    else:  # only the write, from saved chunks (random labels): sizes beyond what this benchmark can compute
+    else:  # only the write, from a checkpoint (random labels): sizes beyond what this benchmark can compute
+        system = systems.of(scene)
         chunks = chunk_shape(scene.shape, 1 << 18)
-        run = PartialRun.create(partial_dir(out), scene.to_toml(), scene.shape, chunks)
+        saved = Checkpoint.create(partial_dir(out), system, scene, chunks)
         rng = np.random.default_rng(0)
         for i, loc in enumerate(chunk_locations(scene.shape, chunks)):
-            run.save(i, rng.integers(0, 3, size=(2,) + tuple(b - a for a, b in loc), dtype=np.int16))
+            nc = rng.integers(0, 3, size=tuple(b - a for a, b in loc), dtype=np.int16)
+            block = system.inferred(nc)
+            block["n_complex_pairs"] = nc
+            saved.save(i, loc, block)
         before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-        write_streamed(scene, run, chunk_locations(scene.shape, chunks), out)
-        run.remove()
+        arrays, store = saved.arrays()
+        with store:
+            write_streamed(atlas_dataset(system, scene, arrays), out)
+        saved.remove()
     after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     print(before, after)
     """

@@ -22,8 +22,8 @@ from pathlib import Path
 import numba
 import numpy as np
 
-import kernels
-from kernels.sturm import count_complex_pairs
+from stabmap import kernels
+from stabmap.kernels.sturm import count_complex_pairs
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_kernel import random_points  # noqa: E402

@@ -22,9 +22,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-import kernels
-from stabmap import exact
-from stabmap.points import PointArrays
+from stabmap import kernels
+from stabmap.systems.gyroscopes import exact
+from stabmap.systems.gyroscopes.points import PointArrays
 
 EXACT_SAMPLE = 20  # undecided points timed in exact arithmetic (the rest extrapolated)
 

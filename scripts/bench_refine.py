@@ -20,8 +20,8 @@ import time
 
 
 import stabmap
-from stabmap.decide import BY_INFERRED
-from stabmap.scene import resample
+from stabmap.systems.gyroscopes.outputs import BY_INFERRED
+from stabmap.scene.grid import resample
 
 FULL_SCENES = ["paper-n3-fixed", "paper-n1-fixed", "paper-n1-free", "paper-n2-fixed", "paper-n2-free", "paper-n3-free"]
 QUICK_SCENES = ["paper-n1-fixed", "paper-n2-fixed"]

@@ -25,9 +25,11 @@ import time
 
 import numpy as np
 
-from stabmap import atlas, liquid, scene
-from stabmap.critical import critical
-from stabmap.decide import BY_EXACT
+from stabmap import loads_scene
+from stabmap.run import atlas
+from stabmap.systems.gyroscopes import liquid, scene
+from stabmap.run.critical import critical
+from stabmap.systems.gyroscopes.outputs import BY_EXACT
 
 SCENE = """
 title = "{title}"
@@ -54,7 +56,7 @@ QUICK = dict(modes=(1, 2, 4, 8), nw=24, nh=6)
 def make(name: str, N: int, tail: bool, nw: int, nh: int) -> scene.Scene:
     C, (w0, w1) = SCENES[name]
     text = SCENE.format(title=name, C=C, N=N, tail="true" if tail else "false", w0=w0, w1=w1, nw=nw, nh=nh)
-    return scene.loads(text)
+    return loads_scene(text)
 
 
 def critical_spin(s: scene.Scene) -> np.ndarray:

@@ -50,9 +50,9 @@ from pathlib import Path
 import flint
 import numpy as np
 
-from stabmap import decide as _decide
-from stabmap.paper import complex_pairs, det
-from stabmap.points import PointArrays
+from stabmap.systems.gyroscopes import decide as _decide
+from stabmap.systems.gyroscopes.paper import complex_pairs, det
+from stabmap.systems.gyroscopes.points import PointArrays
 
 #: Sampled region of the random search (docs/conjecture.md, "The search with joints").
 RANGES = {
@@ -226,7 +226,7 @@ def engine_counts(n: int, prm: dict, joints: np.ndarray | None = None) -> tuple[
 def engine_parallel(n: int, prm: dict, joints: np.ndarray | None, pool, chunk: int) -> tuple[np.ndarray, np.ndarray]:
     """``engine_counts`` over chunks on a process pool (the exact fallback holds the GIL, so threads would not help).
 
-    The workers run ``stabmap.decide.decide`` itself, which pickles by reference whether this
+    The workers run ``stabmap.systems.gyroscopes.decide.decide`` itself, which pickles by reference whether this
     file runs as a script or through ``runpy``.
     """
     N = prm["E"].shape[0]

@@ -7,10 +7,10 @@
 
 Each case is a bundled scene (``stabmap atlas --example NAME``) with two grid axes. For each one:
 
-1. The atlas is computed by the engine and drawn (``stabmap.plot.atlas_figure``).
+1. The atlas is computed by the engine and drawn (``stabmap.read.plot.atlas_figure``).
 2. On a few rows of the second axis the engine locates every change of N_c along the case's
    ``along`` axis to 1e-10 relative (``stabmap.critical``).
-3. Where the paper gives a closed form (``stabmap.paper.factors``: (23) without liquid is
+3. Where the paper gives a closed form (``stabmap.systems.gyroscopes.paper.factors``: (23) without liquid is
    Maievskii's condition; (23) and (24) with one liquid mode, (33), (34) and the split
    (23) x (24) x (24) factor into polynomials of degree <= 3 whose discriminant decides), its
    boundaries are the real roots of the discriminant, as a polynomial in the ``along`` parameter,
@@ -19,7 +19,7 @@ Each case is a bundled scene (``stabmap atlas --example NAME``) with two grid ax
    the same N_c on either side and to agree to RTOL relative, and every point of the map to have
    the closed form's N_c (exact rational arithmetic).
 4. Every case, closed form or not, is checked against the paper's printed determinant
-   ((22), (29)-(32), (28); ``stabmap.paper.paper_polynomial``) in exact rational arithmetic: the N_c
+   ((22), (29)-(32), (28); ``stabmap.systems.gyroscopes.paper.paper_polynomial``) in exact rational arithmetic: the N_c
    of every atlas point on the checked rows, and of both ends of every located boundary.
 
 ``--check`` exits 1 if anything disagrees, and prints which case, row and value.
@@ -35,10 +35,13 @@ from pathlib import Path
 
 import numpy as np
 
-from stabmap import atlas, critical, example, paper
-from stabmap.io import write_atlas
-from stabmap.points import point_arrays
-from stabmap.scene import Axis, resample
+from stabmap import example
+from stabmap.run import atlas
+from stabmap.run.critical import critical
+from stabmap.systems.gyroscopes import paper
+from stabmap.store.files import write_atlas
+from stabmap.systems.gyroscopes.points import point_arrays
+from stabmap.scene.grid import Axis, resample
 
 RTOL = 1e-8  # engine ends are located to 1e-10 and discriminant roots to ~1e-15; this leaves room for both
 
@@ -47,7 +50,7 @@ RTOL = 1e-8  # engine ends are located to 1e-10 and discriminant roots to ~1e-15
 class Case:
     name: str  # bundled example scene
     equation: str
-    closed_form: str | None  # stabmap.paper.factors case, or None where the paper has no closed form
+    closed_form: str | None  # stabmap.systems.gyroscopes.paper.factors case, or None where the paper has no closed form
     along: str  # the axis along which boundaries are located
 
 
@@ -185,7 +188,7 @@ def check_case(case: Case, *, quick: bool, rows: int, out: Path | None) -> dict:
 
 def _figure(case: Case, scene, ds, crit, picks, path: Path) -> None:
     """The engine's map, the closed-form boundary (dense) and the located boundaries on the checked rows."""
-    from stabmap.plot import _save, atlas_figure
+    from stabmap.read.plot import atlas_figure, save_figure
 
     fig = atlas_figure(ds)
     ax = fig.axes[0]
@@ -210,7 +213,7 @@ def _figure(case: Case, scene, ds, crit, picks, path: Path) -> None:
     handles, labels = ax.get_legend_handles_labels()
     if handles:
         ax.legend(handles, labels, loc="best", fontsize=8, framealpha=0.85)
-    _save(fig, path)
+    save_figure(fig, path)
 
 
 def write_golden(directory: Path) -> list[Path]:

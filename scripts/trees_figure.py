@@ -17,7 +17,7 @@ import matplotlib
 import numpy as np
 
 import stabmap
-from stabmap import topology
+from stabmap.systems.gyroscopes import topology
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt

@@ -1,61 +1,74 @@
-"""stabmap: stability atlases of spinning chains and trees of gyroscopes with liquid-filled cavities.
+"""stabmap: stability atlases of spinning multibody systems, every label proved.
 
 >>> import stabmap
 >>> scene = stabmap.example("paper-n3-fixed")     # or stabmap.load_scene("scene.toml")
 >>> ds = stabmap.compute_atlas(scene)              # xarray.Dataset
 >>> stabmap.write_atlas(ds, "atlas.nc")
 >>> stabmap.compute_to_file(scene, "big.nc", client="tcp://HOST:8786")   # streamed, on a dask cluster
+
+The pipeline is scene -> points -> decide -> store -> read: ``stabmap.systems``
+(one subpackage per system, with its scenes and its decision), ``stabmap.run``
+(grid, chunks, tasks here or on a cluster, refinement, critical values),
+``stabmap.store`` (outputs, files, checkpoints) and ``stabmap.read`` (query,
+plot).  The names below are loaded when first used, so ``import stabmap`` is light.
 """
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
+import importlib
 
-import kernels as _kernels
+import wrapt
 
-if getattr(_kernels, "STABMAP_KERNELS", None) != 1:
-    raise ImportError(
-        f"the 'kernels' package found at {getattr(_kernels, '__file__', '?')} is not stabmap's "
-        "(an unrelated PyPI package has the same name); uninstall it: pip uninstall kernels"
-    )
+from .errors import StabmapError
+from .version import __version__
 
-from . import accessor  # noqa: E402,F401  (registers the ds.stabmap accessor)
-from . import cavity  # noqa: E402
-from .atlas import compute as compute_atlas  # noqa: E402
-from .atlas import compute_to_file  # noqa: E402
-from .critical import critical  # noqa: E402
-from .errors import StabmapError  # noqa: E402
-from .examples import example, example_names  # noqa: E402
-from .io import open_atlas, write_atlas  # noqa: E402
-from .query import StableFraction, boundaries, label_at, smallest_stable, stable_fraction, summary  # noqa: E402
-from .plot import atlas_figure, plot_atlas  # noqa: E402
-from .refine import compute_refined  # noqa: E402
-from .scene import Axis, Body, Scene  # noqa: E402
-from .scene import load as load_scene  # noqa: E402
-from .scene import loads as loads_scene  # noqa: E402
+_API = {
+    "Axis": "stabmap.scene.grid",
+    "Body": "stabmap.systems.gyroscopes.scene",
+    "Scene": "stabmap.systems.gyroscopes.scene",
+    "StableFraction": "stabmap.read.query",
+    "atlas_figure": "stabmap.read.plot",
+    "boundaries": "stabmap.read.query",
+    "compute_atlas": ("stabmap.run.atlas", "compute"),
+    "compute_refined": "stabmap.run.refine",
+    "compute_to_file": "stabmap.run.atlas",
+    "critical": "stabmap.run.critical",
+    "example": "stabmap.examples",
+    "example_names": "stabmap.examples",
+    "label_at": "stabmap.read.query",
+    "load_scene": "stabmap.systems",
+    "loads_scene": "stabmap.systems",
+    "open_atlas": "stabmap.store.files",
+    "plot_atlas": "stabmap.read.plot",
+    "plot_critical": "stabmap.read.plot",
+    "smallest_stable": "stabmap.read.query",
+    "stable_fraction": "stabmap.read.query",
+    "summary": "stabmap.read.summary",
+    "write_atlas": "stabmap.store.files",
+}
+_MODULES = {"cavity": "stabmap.systems.gyroscopes.cavity"}
 
-__all__ = [
-    "Axis",
-    "Body",
-    "Scene",
-    "StableFraction",
-    "StabmapError",
-    "atlas_figure",
-    "boundaries",
-    "cavity",
-    "compute_atlas",
-    "compute_refined",
-    "compute_to_file",
-    "critical",
-    "example",
-    "example_names",
-    "label_at",
-    "load_scene",
-    "loads_scene",
-    "open_atlas",
-    "plot_atlas",
-    "smallest_stable",
-    "stable_fraction",
-    "summary",
-    "write_atlas",
-]
+__all__ = sorted(["StabmapError", "__version__", *_API, *_MODULES])
+
+
+def __getattr__(name: str):
+    if name in _MODULES:
+        return importlib.import_module(_MODULES[name])
+    if name not in _API:
+        raise AttributeError(f"module 'stabmap' has no attribute {name!r}")
+    module, attr = _API[name] if isinstance(_API[name], tuple) else (_API[name], name)
+    value = getattr(importlib.import_module(module), attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return __all__
+
+
+def _register_accessor(_xarray) -> None:
+    importlib.import_module("stabmap.read.accessor")
+
+
+# ``ds.stabmap`` on every Dataset: registered as soon as xarray is imported (at once if it already is).
+wrapt.register_post_import_hook(_register_accessor, "xarray")

@@ -7,10 +7,10 @@ from fractions import Fraction
 
 import numpy as np
 
-import kernels
-from stabmap.decide import decide
-from stabmap.points import block_arrays
-from stabmap.scene import from_dict
+from stabmap import kernels
+from stabmap.systems.gyroscopes.decide import decide
+from stabmap.systems.gyroscopes.points import point_arrays
+from stabmap.systems.gyroscopes.scene import from_dict
 
 
 def random_system(rng: random.Random, n: int, modes: int, support: str) -> dict:
@@ -61,14 +61,14 @@ def reference_args(system: dict) -> dict:
 
 def engine_point(system: dict):
     """(N_c, decided_by) of the engine for the single point of a grid-less system."""
-    nc, by = decide(block_arrays(from_dict(system), []))
+    nc, by = decide(point_arrays(from_dict(system), {}))
     return int(nc[0]), int(by[0])
 
 
 def engine_enclosure(system: dict) -> list[tuple[Fraction, Fraction]]:
     """The kernel's coefficient intervals (midpoint, radius) as exact fractions."""
     scene = from_dict(system)
-    pts = block_arrays(scene, [])
+    pts = point_arrays(scene, {})
     out = np.zeros((1, scene.degree + 1, 3))
     kernels.charpoly_block(*pts.kernel_args(), out)
     return [(Fraction(h) + Fraction(lo), Fraction(r)) for h, lo, r in out[0]]

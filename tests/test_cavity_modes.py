@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy import optimize, special
 
-from stabmap import cavity
+from stabmap.systems.gyroscopes import cavity
 from stabmap.errors import StabmapError
 
 OMEGA = 1.3

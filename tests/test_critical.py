@@ -10,8 +10,8 @@ import pytest
 import reference as ref
 import stabmap
 from stabmap.cli import main
-from stabmap.critical import critical
-from stabmap.scene import from_dict
+from stabmap.run.critical import critical
+from stabmap.systems.gyroscopes.scene import from_dict
 from systems import reference_args
 
 TOP = {"m": 1.0, "A": 0.02, "C": 0.03}
@@ -135,7 +135,7 @@ def test_plot_with_two_other_axes_asks_for_sel(tmp_path):
         "grid": {"c_1": {"values": [0.1, 0.2]}, "omega": {"start": 0.5, "stop": 60.0, "num": 10}, "m_1": {"values": [1.0, 2.0]}},
     })
     ds = critical(scene, "omega")
-    from stabmap.plot import plot_critical
+    from stabmap.read.plot import plot_critical
 
     with pytest.raises(stabmap.StabmapError, match="fix all but one with --sel"):
         plot_critical(ds, tmp_path / "x.png")
@@ -157,7 +157,7 @@ def test_boundary_at_exactly_zero_uses_the_absolute_floor(tmp_path):
     assert ds["c_1_stable_lower"].item() == -0.2 and np.isnan(ds["c_1_stable_lower_outer"].item())
     upper, outer = ds["c_1_stable_upper"].item(), ds["c_1_stable_upper_outer"].item()
     assert upper <= 0.0 < outer and outer - upper <= atol
-    from stabmap.plot import plot_critical
+    from stabmap.read.plot import plot_critical
 
     assert plot_critical(ds, tmp_path / "line.png").read_bytes()[:4] == b"\x89PNG"
 

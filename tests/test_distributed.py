@@ -15,11 +15,14 @@ import pytest
 import xarray as xr
 
 import stabmap
-from stabmap import atlas, cli, cluster
-from stabmap.atlas import compute, compute_to_file
-from stabmap.chunks import chunk_locations, chunk_shape, default_chunk_points
-from stabmap.io import open_atlas
-from stabmap.partial import partial_dir
+from stabmap.scene.grid import resample
+from stabmap import cli
+from stabmap.run import atlas
+from stabmap.run import runner as cluster
+from stabmap.run.atlas import compute, compute_to_file
+from stabmap.run.chunks import chunk_locations, chunk_shape, default_chunk_points
+from stabmap.store.files import open_atlas
+from stabmap.store.checkpoint import Checkpoint, partial_dir
 
 # Degree 18 (three bodies, four liquid modes each): about 0.1 ms a point, so a run lasts seconds and can be
 # interrupted or lose a worker while chunks are still pending.
@@ -140,11 +143,11 @@ def test_default_chunks_bounded_by_time_memory_and_balance(slow_scene_file):
     scene = stabmap.load_scene(slow_scene_file)
     small = default_chunk_points(scene, threads=2)
     assert 1024 <= small <= 38400 // 8  # at least four tasks a thread, never tiny ones
-    big = stabmap.scene.resample(scene, omega=4000, m_2=4000)
+    big = resample(scene, omega=4000, m_2=4000)
     # 16 M points of degree 18: the time bound (about half a second on a core) decides, not the grid.
     assert 256 <= default_chunk_points(big, threads=2) <= 16384
     dry = stabmap.example("paper-n1-fixed-dry")  # degree 2: over a million points a second; the cap decides
-    assert default_chunk_points(stabmap.scene.resample(dry, **{a.name: 4000 for a in dry.grid}), threads=2) == 1 << 18
+    assert default_chunk_points(resample(dry, **{a.name: 4000 for a in dry.grid}), threads=2) == 1 << 18
 
 
 def test_cluster_equals_in_process(loopback, slow_scene_file, slow_local):
@@ -158,7 +161,6 @@ def test_client_object_and_stream_to_zarr(loopback, slow_scene_file, slow_local,
     with Client(loopback.address, set_as_default=False) as client:
         report = compute_to_file(stabmap.load_scene(slow_scene_file), tmp_path / "a.zarr", client=client, progress=False)
     assert report.computed == report.chunks and report.reused == 0
-    assert report.counts == stabmap.summary(slow_local)
     _same_atlas(open_atlas(tmp_path / "a.zarr"), slow_local)
     assert not partial_dir(tmp_path / "a.zarr").exists()
 
@@ -172,6 +174,29 @@ def test_cli_scheduler_and_local_workers_give_the_in_process_file(loopback, slow
     _same_atlas(open_atlas(tmp_path / "remote.nc"), here)
     _same_atlas(open_atlas(tmp_path / "local.nc"), here)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["here.nc", "local.nc", "remote.nc"]
+
+
+def test_refine_and_critical_on_the_cluster_equal_in_process(loopback, tmp_path, capsys):
+    """One task runner for every kind of run: adaptive atlases and critical values on the loopback cluster and on
+    a local cluster give what they give in this process."""
+    scene = resample(stabmap.example("paper-n2-fixed"), omega=129, K_1=65)
+    here = stabmap.compute_refined(scene, coarse_stride=8, threads=2, progress=False)
+    there = stabmap.compute_refined(scene, coarse_stride=8, client=loopback.address, chunk_points=512, progress=False)
+    _same_atlas(there, here)
+    assert int(here.attrs["n_evaluated_points"]) < scene.shape[0] * scene.shape[1] / 2  # it did refine
+
+    scan = resample(stabmap.example("paper-n2-fixed"), omega=40, K_1=6)
+    here = stabmap.critical(scan, "omega", threads=2, progress=False)
+    there = stabmap.critical(scan, "omega", client=loopback.address, chunk_points=64, progress=False)
+    _same_atlas(there, here)
+    assert (here["n_stable_intervals"] > 0).any()
+
+    small = tmp_path / "scan.toml"
+    small.write_text(scan.to_toml())
+    assert cli.main(["critical", str(small), "-o", str(tmp_path / "local.nc"), "--workers", "2", "-q"]) == 0
+    assert cli.main(["atlas", str(small), "-o", str(tmp_path / "refined.nc"), "--refine", "--scheduler", loopback.address, "-q"]) == 0
+    _same_atlas(open_atlas(tmp_path / "local.nc"), here)
+    _same_atlas(open_atlas(tmp_path / "refined.nc"), stabmap.compute_refined(scan, threads=1, progress=False))
 
 
 def test_killed_worker_does_not_lose_the_atlas(tmp_path, slow_scene_file, slow_local):
@@ -192,12 +217,12 @@ def test_killed_worker_does_not_lose_the_atlas(tmp_path, slow_scene_file, slow_l
         t.start()
         saved = partial_dir(out)
         deadline = time.monotonic() + 120
-        while len(list(saved.glob("chunk-*.npy"))) < 4:
+        while len(_finished(saved)) < 4:
             assert time.monotonic() < deadline and t.is_alive(), result
             time.sleep(0.02)
         victim = c.workers[0]
         victim.send_signal(signal.SIGKILL)
-        done_at_kill = len(list(saved.glob("chunk-*.npy")))
+        done_at_kill = len(_finished(saved))
         t.join(300)
         assert victim.wait(10) == -signal.SIGKILL
         assert "error" not in result, result.get("error")
@@ -213,9 +238,14 @@ def _start_cli(args, **kw):
     return subprocess.Popen([sys.executable, "-m", "stabmap", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
 
 
+def _finished(saved) -> set[int]:
+    """The chunks a run has finished so far (its checkpoint is created whole, by a rename)."""
+    return Checkpoint.open(saved).done() if saved.exists() else set()
+
+
 def _wait_for_chunks(saved, proc, n):
     deadline = time.monotonic() + 120
-    while len(list(saved.glob("chunk-*.npy"))) < n:
+    while len(_finished(saved)) < n:
         assert proc.poll() is None, proc.communicate()
         assert time.monotonic() < deadline
         time.sleep(0.02)
@@ -237,7 +267,7 @@ def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(how, t
         assert "--resume" in stderr and str(saved) in stderr
     assert not out.exists()
     assert [p.name for p in tmp_path.iterdir()] == [saved.name]  # no temporary file left beside it
-    done = {p.name for p in saved.glob("chunk-*.npy")}
+    done = _finished(saved)
     total = len(chunk_locations((240, 160), chunk_shape((240, 160), SLOW_CHUNK)))
     assert 3 <= len(done) < total
 
@@ -246,8 +276,8 @@ def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(how, t
     assert "--resume" in capsys.readouterr().err
     # --resume computes exactly the missing chunks (counted at the task function itself).
     calls = []
-    task = atlas.atlas_chunk
-    monkeypatch.setattr(atlas, "atlas_chunk", lambda scene, loc: calls.append(loc) or task(scene, loc))
+    task = atlas.evaluate_block
+    monkeypatch.setattr(atlas, "evaluate_block", lambda scene, loc: calls.append(loc) or task(scene, loc))
     assert cli.main(args + ["--resume"]) == 0
     err = capsys.readouterr().err
     assert len(calls) == total - len(done)
@@ -275,11 +305,11 @@ def test_resume_refuses_another_scene_and_other_chunks(tmp_path, slow_scene_file
     "extra,message",
     [
         (["--scheduler", "tcp://127.0.0.1:9", "--workers", "2"], "not both"),
-        (["--workers", "0"], "--workers must be a whole number >= 1"),
-        (["--threads", "0"], "--threads must be a whole number >= 1"),
-        (["--workers", "2", "--threads", "2"], "--threads sets the threads of an in-process run"),
-        (["--workers", "2", "--refine"], "--refine runs in this process only"),
+        (["--workers", "0"], "workers must be a whole number >= 1"),
+        (["--threads", "0"], "threads must be a whole number >= 1"),
+        (["--workers", "2", "--threads", "2"], "(--threads) sets the threads of an in-process run"),
         (["--refine", "--resume"], "--resume applies to dense atlases"),
+        (["--margin", "1"], "--margin applies to adaptive atlases only"),
         (["--chunk-points", "0"], "--chunk-points must be a whole number >= 1"),
     ],
 )

@@ -7,7 +7,7 @@ import random
 
 import pytest
 
-from stabmap.decide import BY_EXACT, BY_STURM
+from stabmap.systems.gyroscopes.outputs import BY_EXACT, BY_STURM
 
 import reference as ref
 from systems import engine_enclosure, engine_point, random_system, reference_args
@@ -172,8 +172,8 @@ def test_reused_inertia_and_stiffness_give_the_same_labels():
     import numpy as np
 
     import kernels
-    from stabmap.points import point_arrays
-    from stabmap.scene import from_dict
+    from stabmap.systems.gyroscopes.points import point_arrays
+    from stabmap.systems.gyroscopes.scene import from_dict
 
     system = random_system(random.Random(5), 3, 1, "fixed")
     system["bodies"][0].pop("omega", None)

@@ -21,9 +21,12 @@ import xarray as xr
 
 import reference as ref
 from systems import random_system, reference_args
-from stabmap import atlas, example, paper
-from stabmap.points import block_arrays
-from stabmap.scene import from_dict, loads
+from stabmap import example
+from stabmap.run import atlas
+from stabmap.systems.gyroscopes import paper
+from stabmap.systems.gyroscopes.points import point_arrays
+from stabmap.systems.gyroscopes.scene import from_dict
+from stabmap.systems import loads_scene as loads
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).resolve().parent / "data"
@@ -32,7 +35,7 @@ CASES = {c.name: c for c in SCRIPT["CASES"]}
 
 
 def _chain(system: dict) -> paper.Chain:
-    pa = block_arrays(from_dict(system), [])
+    pa = point_arrays(from_dict(system), {})
     return paper.chain_from_arrays(pa.body[0], pa.joint[0], pa.g[0], pa.E[0], pa.kappa[0], pa.nmodes, pa.free)
 
 

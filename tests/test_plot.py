@@ -18,8 +18,8 @@ from matplotlib.colors import to_rgba
 
 import stabmap
 from stabmap.cli import main
-from stabmap.plot import atlas_figure, cell_edge_boundaries, class_label, colour, plan_figure, plot_atlas
-from stabmap.variables import ATTRS
+from stabmap.read.plot import atlas_figure, cell_edge_boundaries, class_label, colour, plan_figure, plot_atlas
+from stabmap.systems.gyroscopes.outputs import DECIDED_BY, N_COMPLEX_PAIRS
 
 COORD_ATTRS = {
     "omega": {"long_name": "common spin rate", "units": "rad s-1"},
@@ -36,8 +36,8 @@ def hand_atlas(axes: dict[str, tuple[np.ndarray, str]], nc: np.ndarray, decided_
     if decided_by is None:
         decided_by = np.zeros(nc.shape, dtype=np.int8)
     data = {
-        "n_complex_pairs": (dims, nc.astype(np.int16), ATTRS["n_complex_pairs"]),
-        "decided_by": (dims, decided_by.astype(np.int8), ATTRS["decided_by"]),
+        "n_complex_pairs": (dims, nc.astype(np.int16), N_COMPLEX_PAIRS.attrs()),
+        "decided_by": (dims, decided_by.astype(np.int8), DECIDED_BY.attrs()),
     }
     return xr.Dataset(data, coords=coords, attrs={"title": title, "stabmap_format_version": 3})
 

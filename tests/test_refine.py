@@ -14,8 +14,8 @@ import pytest
 
 import stabmap
 from stabmap.cli import main
-from stabmap.decide import BY_INFERRED
-from stabmap.scene import Axis, resample
+from stabmap.systems.gyroscopes.outputs import BY_INFERRED
+from stabmap.scene.grid import Axis, resample
 
 ALL_EXAMPLES = stabmap.example_names()
 
@@ -88,29 +88,19 @@ def test_cusp_missed_without_margin_found_with_it():
     assert not check_against_dense(refined(scene, margin=1), den).any()
 
 
-ONE_TOP = """
-support = "fixed"
-omega = 20.0
-[[bodies]]
-m = 1.0
-A = 0.02
-C = 0.03
-c = 0.10
-"""
-# This top is stable for omega above about 11.44 rad/s, so 5.0 marks one unstable point.
-STABLE, UNSTABLE = 20.0, 5.0
-
-
-def one_axis_scene(unstable_at: list[int], num: int = 33):
-    values = [UNSTABLE if i in unstable_at else STABLE + i for i in range(num)]
-    grid = (Axis("omega", tuple(values), "values"),)
-    return dataclasses.replace(stabmap.loads_scene(ONE_TOP), grid=grid)
+def striped_scene():
+    """33 sorted cavity heights of the liquid-filled top at 150 rad/s, where unstable bands of the cavity's modes
+    (Greenhill's bands) alternate with stable gaps: the points 4, 20 and 28..32 lie in bands, the rest in gaps."""
+    heights = [0.0110, 0.0115, 0.0120, 0.0125, 0.01315, *np.linspace(0.0185, 0.0265, 15), 0.0273,
+               *np.linspace(0.030, 0.050, 7), *np.linspace(0.055, 0.058, 5)]
+    grid = (Axis("half_height_1", tuple(heights), "values"),)
+    return dataclasses.replace(stabmap.example("top-cylinder-cavity"), omega=150.0, grid=grid)
 
 
 def test_feature_smaller_than_a_cell_is_the_documented_blind_spot():
     # Stride 8: cells [0,8] [8,16] [16,24] [24,32].  A real boundary in the last cell (28..32 unstable);
     # one-point features at 4 (inside a cell of agreeing corners, far from it) and 20 (next to it).
-    scene = one_axis_scene([4, 20, 28, 29, 30, 31, 32])
+    scene = striped_scene()
     den = dense(scene)
     assert list(np.flatnonzero(den["n_complex_pairs"].values)) == [4, 20, 28, 29, 30, 31, 32]
 

@@ -117,7 +117,7 @@ def _three_bodies(grid: str) -> str:
 
 
 def test_axes_for_every_body_and_every_joint():
-    from stabmap.points import point_arrays
+    from stabmap.systems.gyroscopes.points import point_arrays
 
     scene = loads_scene(_three_bodies("C = { values = [0.01, 0.05] }\nK = { values = [0.0, 9.0] }\nA_2 = { values = [0.5] }\n"))
     pa = point_arrays(scene, {"C": [0.05], "K": [9.0], "A_2": [0.5], "C_3": [0.07]})

@@ -19,11 +19,11 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from hypothesis.errors import InvalidArgument
 
-from stabmap import exact
-from stabmap.decide import BY_EXACT
-from stabmap.points import block_arrays
-from stabmap.scene import from_dict
-from stabmap.variables import DECIDED_BY, flag_meaning
+from stabmap.systems.gyroscopes import exact
+from stabmap.systems.gyroscopes.outputs import BY_EXACT
+from stabmap.systems.gyroscopes.points import point_arrays
+from stabmap.systems.gyroscopes.scene import from_dict
+from stabmap.systems.gyroscopes.outputs import DECIDED_BY
 
 import reference as ref
 from systems import engine_point, random_system, reference_args
@@ -77,7 +77,7 @@ def assert_engine_exact(system: dict) -> int:
     """The engine's N_c equals the reference count; returns how the engine decided."""
     nc, by = engine_point(system)
     assert nc == reference_pairs(system), system
-    _event(f"decided by {flag_meaning(DECIDED_BY, by)}")
+    _event(f"decided by {DECIDED_BY.meaning(by)}")
     return by
 
 
@@ -121,7 +121,7 @@ def test_liquid_terms_tiny_and_dominant(system):
 
 def _exact_pairs_at(system: dict, omega: float) -> int:
     s = dict(system, omega=omega)
-    args = block_arrays(from_dict(s), []).kernel_args()
+    args = point_arrays(from_dict(s), {}).kernel_args()
     return int(exact.decide_points(*args, [0])[0])
 
 

@@ -21,12 +21,15 @@ import sympy
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import kernels
+from stabmap import kernels
 import stabmap
-from stabmap import StabmapError, exact, loads_scene, topology
-from stabmap.decide import BY_EXACT
-from stabmap.points import PointArrays, block_arrays
-from stabmap.scene import fixed_values, from_dict
+from stabmap.scene.grid import resample
+from stabmap import StabmapError, loads_scene
+from stabmap.run.tasks import block_values
+from stabmap.systems.gyroscopes import exact, topology
+from stabmap.systems.gyroscopes.outputs import BY_EXACT
+from stabmap.systems.gyroscopes.points import PointArrays, point_arrays
+from stabmap.systems.gyroscopes.scene import fixed_values, from_dict
 
 import reference as ref
 from systems import engine_enclosure, engine_point
@@ -150,7 +153,7 @@ def test_arcs_that_are_not_a_tree():
 
 
 def test_kernels_reject_a_parent_that_is_not_a_regular_numbering():
-    pts = block_arrays(from_dict(_tree_system("fixed", (0, 1, 1), (0.0, 0.3, 0.3))), [])
+    pts = point_arrays(from_dict(_tree_system("fixed", (0, 1, 1), (0.0, 0.3, 0.3))), {})
     nc, st_ = np.empty(1, np.int16), np.empty(1, np.int8)
     for bad in ([-1, 2, 0], [-1, -1, 0], [0, 0, 1], [-1, 0]):
         with pytest.raises(ValueError, match="parent"):
@@ -342,7 +345,7 @@ def _reference_poly(system: dict) -> sympy.Poly:
 
 def _engine_poly(system: dict) -> sympy.Poly:
     """The engine's exact-path polynomial (stabmap.exact) for a grid-less scene dict."""
-    pa = block_arrays(from_dict(system), [])
+    pa = point_arrays(from_dict(system), {})
     p = exact.char_poly(pa.body[0], pa.joint[0], pa.g[0], pa.E[0], pa.kappa[0], pa.nmodes, pa.free, pa.parent, pa.at[0])
     return sympy.Poly([sympy.Rational(int(c.p), int(c.q)) for c in reversed(p.coeffs())] or [0], ref.lam)
 
@@ -402,7 +405,7 @@ def test_exact_fallback_decides_trees(carrier, h):
     p = _reference_poly(system)
     assert max(mult for _, mult in p.sqf_list()[1]) >= 2
     assert engine_point(system) == (ref.count_complex_pairs(p), BY_EXACT)
-    pa = block_arrays(from_dict(system), [])
+    pa = point_arrays(from_dict(system), {})
     as_chain = PointArrays(pa.body, pa.joint, pa.g, pa.E, pa.kappa, pa.nmodes, pa.free)
     assert exact.decide_points(*as_chain.kernel_args(), [0])[0] != ref.count_complex_pairs(p)
 
@@ -481,7 +484,7 @@ def test_chain_as_tree_gives_the_chain_atlas_exactly(support):
         assert a[var].dims == b[var].dims and np.array_equal(a[var].values, b[var].values)
     assert len(np.unique(a["n_complex_pairs"].values)) > 1
     # The kernels see the same numbers and return the same enclosures, bit for bit.
-    pa, pb = block_arrays(from_dict(chain), [(0, 25), (0, 7)]), block_arrays(from_dict(tree), [(0, 25), (0, 7)])
+    pa, pb = point_arrays(from_dict(chain), block_values(from_dict(chain), [(0, 25), (0, 7)])), point_arrays(from_dict(tree), block_values(from_dict(tree), [(0, 25), (0, 7)]))
     deg = from_dict(chain).degree
     ca, cb = np.zeros((175, deg + 1, 3)), np.zeros((175, deg + 1, 3))
     kernels.charpoly_block(*pa.kernel_args(), ca)
@@ -501,7 +504,7 @@ def test_example_scene_of_a_branched_system(tmp_path):
     for name in names:
         scene = stabmap.example(name)
         assert scene.topology is not None and not all(p == k for k, p in enumerate(scene.topology.parent))
-    scene = stabmap.scene.resample(stabmap.example(names[0]), **{a.name: 6 for a in stabmap.example(names[0]).grid})
+    scene = resample(stabmap.example(names[0]), **{a.name: 6 for a in stabmap.example(names[0]).grid})
     ds = stabmap.compute_atlas(scene, threads=1, progress=False)
     path = tmp_path / "tree.nc"
     stabmap.write_atlas(ds, path)
@@ -553,7 +556,7 @@ def test_cli_atlas_info_of_a_tree_on_a_cluster_and_here(tmp_path, capsys):
 
     scene = stabmap.example("tree-carrier-above-below")
     small = tmp_path / "tree.toml"
-    small.write_text(stabmap.scene.resample(scene, omega=40, at_3=30).to_toml())
+    small.write_text(resample(scene, omega=40, at_3=30).to_toml())
     assert cli.main(["atlas", str(small), "-o", str(tmp_path / "here.nc"), "-q"]) == 0
     assert cli.main(["atlas", str(small), "-o", str(tmp_path / "cluster.nc"), "--workers", "2", "--chunk-points", "300", "-q"]) == 0
     here, there = stabmap.open_atlas(tmp_path / "here.nc"), stabmap.open_atlas(tmp_path / "cluster.nc")

@@ -32,7 +32,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import StabmapError
+from ...errors import StabmapError
+from ...scene.values import check_value
+from .parameters import POSITION
 
 
 @dataclass(frozen=True)
@@ -49,9 +51,16 @@ class Topology:
     at: tuple[float, ...]
 
     def __post_init__(self):
-        check_parent(list(self.parent), "Topology.parent")
-        if len(self.at) != len(self.parent) or self.at[0] != 0.0:
-            raise StabmapError(f"Topology.at needs one position per body and at[0] = 0 (body 1's joint), got {self.at!r}")
+        object.__setattr__(self, "parent", check_parent(self.parent, "topology.parent"))
+        if isinstance(self.at, (str, bytes)) or not hasattr(self.at, "__len__") or len(self.at) != len(self.parent):
+            raise StabmapError(f"topology.at must be a list with one position per body ({len(self.parent)}), got {self.at!r}")
+        at = tuple(check_value(f"topology.at[{k + 1}]", v, POSITION) for k, v in enumerate(self.at))
+        if at[0] != 0.0:
+            raise StabmapError(
+                f"topology.at[1] must be 0, got {at[0]}: body 1's joint is the base point (or a free system's "
+                "reference point), not a place on another body"
+            )
+        object.__setattr__(self, "at", at)
 
     @property
     def n(self) -> int:

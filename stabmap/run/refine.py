@@ -3,7 +3,8 @@
 The result has the dense atlas's grid and values wherever the labels have no
 feature that hides inside a grid cell (docs/refine.md says exactly what that
 means).  Points that were filled from their cell's corners rather than computed
-carry ``decided_by = BY_INFERRED``: they are not proved.
+carry the provenance flag ``inferred_from_cell_corners`` (``decided_by`` of a gyroscope atlas): they are not
+proved.
 
 Algorithm, in index space of the final grid (any number of axes):
 
@@ -11,7 +12,7 @@ Algorithm, in index space of the final grid (any number of axes):
    the current stride plus its last index.  Consecutive nodes bound the cells,
    so a cell is a box with 2^d corners.  Every cell starts active.
 2. At each level the corners of the active cells that are not yet computed are
-   decided (in chunks on a thread pool).  A cell whose corners disagree, or
+   decided (in chunks, through the run's runner: threads here or a dask cluster).  A cell whose corners disagree, or
    one of whose corners turned out different from the value an earlier fill
    had given it, is *split*, and so is every cell within ``margin`` cells of
    it, whether active or filled before (a filled cell is re-opened).
@@ -30,19 +31,18 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import xarray as xr
 
-from .atlas import _dataset
-from .cluster import check_threads, run_tasks
-from .decide import BY_INFERRED, decide
-from .errors import StabmapError
-from .points import point_arrays, spin_axes_last
+from .. import systems
+from ..errors import StabmapError
+from ..store.dataset import atlas_dataset, empty_arrays
+from ..systems.base import SceneBase
+from . import runner
+from .chunks import check_chunk_points, default_chunk_points, spans
 from .progress import ProgressLine
-from .scene import Scene
+from .tasks import evaluate_grid_points, evaluate_points, point_order
 
 DEFAULT_MARGIN = 2  # cells split around a disagreeing cell; docs/refine.md has the measurements behind 2
 COARSE_CELLS = 64  # default: the coarsest lattice has 64 to 127 cells (65 to 128 nodes) per long axis
-CHUNK_POINTS = 32768
 
 
 def default_coarse_stride(n: int) -> int:
@@ -174,62 +174,70 @@ class _Progress(ProgressLine):
 
 
 class _Evaluator:
-    """Decides grid points on a thread pool and holds the state of the whole grid."""
+    """Decides grid points through the run's runner and holds the state of the whole grid."""
 
-    def __init__(self, scene: Scene, threads: int, chunk_points: int, progress: _Progress):
-        self.scene, self.threads, self.chunk_points, self.progress = scene, threads, chunk_points, progress
+    def __init__(self, scene: SceneBase, run: runner.Runner, chunk_points: int | None, progress: _Progress):
+        self.scene, self.run, self.chunk_points, self.progress = scene, run, chunk_points, progress
+        self.system = systems.of(scene)
         shape = scene.shape
-        self.nc = np.zeros(shape, dtype=np.int16)
-        self.by = np.full(shape, BY_INFERRED, dtype=np.int8)
+        self.arrays = empty_arrays(self.system, scene)
+        self.label = self.arrays[self.system.label]
+        self.label[...] = 0
         self.computed = np.zeros(shape, dtype=bool)
         self.filled = np.zeros(shape, dtype=bool)
         self.evaluated = 0
-        self.order = spin_axes_last(scene)
+        self.order = point_order(scene)
 
     def evaluate(self, points: tuple[np.ndarray, ...], stride: int) -> np.ndarray:
         """Decide the grid points ``points`` (index arrays per axis); True where an earlier fill had it wrong."""
         shape = self.scene.shape
         flat = np.ravel_multi_index(points, shape)
-        # Spin axes vary fastest, as in the dense path: the kernels then reuse M and K between points.
+        # Points in the order of a dense block (the system's fastest axes fastest), which its kernels may exploit.
         key = np.ravel_multi_index(tuple(points[d] for d in self.order), tuple(shape[d] for d in self.order))
         perm = np.argsort(key, kind="stable")
-        nc, by = np.empty(flat.size, np.int16), np.empty(flat.size, np.int8)
-        nc[perm], by[perm] = self._decide(flat[perm], stride)
-        nc_grid, by_grid = self.nc.reshape(-1), self.by.reshape(-1)
-        wrong = self.filled.reshape(-1)[flat] & (nc_grid[flat] != nc)
-        nc_grid[flat] = nc
-        by_grid[flat] = by
+        results = self._decide(flat[perm], stride)
+        label = results[self.system.label]
+        wrong = np.zeros(flat.size, dtype=bool)
+        wrong[perm] = self.filled.reshape(-1)[flat[perm]] & (self.label.reshape(-1)[flat[perm]] != label)
+        for k, v in results.items():
+            grid = self.arrays[k].reshape((-1,) + v.shape[1:])
+            grid[flat[perm]] = v
         self.computed.reshape(-1)[flat] = True
         self.evaluated += flat.size
         return wrong
 
     def evaluate_point(self) -> None:
         """A scene without grid axes: its one point."""
-        nc, by = decide(point_arrays(self.scene, {}))
-        self.nc[()], self.by[()], self.computed[()] = nc[0], by[0], True
+        for k, v in evaluate_points(self.scene, {}).items():
+            self.arrays[k][()] = v
+        self.computed[()] = True
         self.evaluated = 1
 
-    def _decide(self, flat: np.ndarray, stride: int) -> tuple[np.ndarray, np.ndarray]:
+    def finish(self) -> dict[str, np.ndarray]:
+        """Every variable on the grid, the points not computed given the values their label implies."""
+        rest = ~self.computed
+        for k, v in self.system.inferred(self.label[rest]).items():
+            self.arrays[k][rest] = v
+        return self.arrays
+
+    def _decide(self, flat: np.ndarray, stride: int) -> dict[str, np.ndarray]:
         npts = flat.size
-        size = min(self.chunk_points, max(1024, -(-npts // (4 * self.threads))))
-        bounds = [(a, min(a + size, npts)) for a in range(0, npts, size)]
-        nc = np.empty(npts, dtype=np.int16)
-        by = np.empty(npts, dtype=np.int8)
+        size = self.chunk_points or default_chunk_points(self.scene, self.run.threads, npts)
+        bounds = spans(npts, size)
+        out = {}
         done_points = [0]
 
         def keep(i, result):
             a, b = bounds[i]
-            nc[a:b], by[a:b] = result
+            for k, v in result.items():
+                if k not in out:
+                    out[k] = np.empty((npts,) + v.shape[1:], dtype=v.dtype)
+                out[k][a:b] = v
             done_points[0] += b - a
             self.progress.update(stride, done_points[0], npts, self.evaluated + done_points[0])
 
-        run_tasks(self._chunk, [(flat[a:b],) for a, b in bounds], list(range(len(bounds))), keep, threads=self.threads)
-        return nc, by
-
-    def _chunk(self, flat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        idx = np.unravel_index(flat, self.scene.shape)
-        values = {axis.name: axis.array[i] for axis, i in zip(self.scene.grid, idx)}
-        return decide(point_arrays(self.scene, values))
+        self.run.run(evaluate_grid_points, [(self.scene, flat[a:b]) for a, b in bounds], list(range(len(bounds))), keep)
+        return out
 
 
 def _step(ev: _Evaluator, level: _Level, active: np.ndarray, margin: int, box: tuple[slice, ...]) -> np.ndarray:
@@ -238,7 +246,7 @@ def _step(ev: _Evaluator, level: _Level, active: np.ndarray, margin: int, box: t
     Returns the cells to split: those whose corners disagree or include a point
     an earlier fill got wrong, grown by ``margin`` cells.
     """
-    computed, nc = ev.computed[box], ev.nc[box]
+    computed, nc = ev.computed[box], ev.label[box]
     need = np.zeros(tuple(idx.size for idx in level.nodes), dtype=bool)
     for sl in level.corners():
         need[sl] |= active
@@ -302,14 +310,16 @@ def _reopen(ev: _Evaluator, level: _Level, split: np.ndarray, margin: int) -> No
 
 
 def compute_refined(
-    scene: Scene,
+    scene: SceneBase,
     *,
     coarse_stride: int | None = None,
     margin: int = DEFAULT_MARGIN,
+    client=None,
+    workers: int | None = None,
     threads: int | None = None,
     progress: bool | None = None,
     chunk_points: int | None = None,
-) -> xr.Dataset:
+):
     """Compute the atlas of ``scene`` adaptively: coarse lattice first, refined where labels change.
 
     The Dataset has the same grid, variables and layout as ``compute_atlas``.
@@ -330,12 +340,9 @@ def compute_refined(
     margin : int, optional
         Cells around every disagreeing cell that are split too (default 2; 0 and
         1 are cheaper and miss more of the features smaller than a cell).
-    threads : int, optional
-        Threads (default: all cores).
-    progress : bool, optional
-        Progress line on stderr for runs over two seconds (default: when stderr is a terminal).
-    chunk_points : int, optional
-        Points per chunk handed to a thread (default: about 32768, fewer for small levels).
+    client, workers, threads, progress, chunk_points
+        As for ``compute_atlas``: each level's points are decided in tasks of about half a second on
+        threads here (default), a cluster (``client``) or a local cluster of ``workers`` processes.
 
     Returns
     -------
@@ -345,26 +352,26 @@ def compute_refined(
     """
     coarse_stride = check_coarse_stride(coarse_stride)
     margin = check_margin(margin)
-    threads = check_threads(threads)
-    chunk_points = CHUNK_POINTS if chunk_points is None else int(chunk_points)
-    if chunk_points < 1:
-        raise StabmapError(f"chunk_points must be >= 1, got {chunk_points}")
-    if progress is None:
-        progress = sys.stderr.isatty()
+    chunk_points = check_chunk_points(chunk_points)
+    runner.check_where(client, workers, threads)
+    system = systems.of(scene)
+    if system.inferred(np.zeros(0, dtype=np.int64)) is None:  # the system cannot say what a filled point holds
+        raise StabmapError(f"adaptive refinement (--refine) is not available for {system.name} atlases; compute a dense one")
     shape = scene.shape
     strides = tuple(coarse_stride or default_coarse_stride(n) for n in shape)
     total = math.prod(shape)
     t0 = time.perf_counter()
-    bar = _Progress(progress, total)
-    ev = _Evaluator(scene, threads, chunk_points, bar)
+    bar = _Progress(sys.stderr.isatty() if progress is None else progress, total)
     try:
-        if shape:
-            _run_levels(ev, strides, margin)
-        else:
-            ev.evaluate_point()
+        with runner.start(client, workers=workers, threads=threads, announce=bar.enabled) as run:
+            ev = _Evaluator(scene, run, chunk_points, bar)
+            if shape:
+                _run_levels(ev, strides, margin)
+            else:
+                ev.evaluate_point()
     finally:
         bar.close()
-    ds = _dataset(scene, ev.nc, ev.by)
+    ds = atlas_dataset(system, scene, ev.finish())
     ds.attrs["history"] += (
         f"; adaptive refinement (coarse stride {list(strides)}, margin {margin}): "
         f"{ev.evaluated} of {total} points evaluated in {time.perf_counter() - t0:.1f} s"

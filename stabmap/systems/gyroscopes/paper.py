@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import flint
 
-from .errors import StabmapError
+from ...errors import StabmapError
 
 T = flint.fmpq_poly([0, 1])  # the scanned variable t
 ZERO = flint.fmpq(0)

@@ -7,13 +7,10 @@ import shutil
 from pathlib import Path
 
 import dask
-import dask.array as da
 import netCDF4
-import numpy as np
 import xarray as xr
 
-from .errors import StabmapError
-from .variables import stability_from_pairs
+from ..errors import StabmapError
 
 ZARR_SUFFIX = ".zarr"
 NETCDF_CHUNK_CACHE = 4 << 20  # bytes, while streaming
@@ -33,20 +30,11 @@ def check_writable(path: str | Path) -> Path:
         raise StabmapError(f"cannot write {str(path)!r}: it is a directory; give a file name such as atlas.nc or atlas.zarr")
     if not os.access(parent, os.W_OK):
         raise StabmapError(f"cannot write {str(path)!r}: no write permission in {str(parent)!r}")
-    if is_zarr(path):
-        _need_zarr()
     return path
 
 
 def _is_zarr_store(path: Path) -> bool:
     return any((path / name).exists() for name in ("zarr.json", ".zgroup", ".zattrs"))
-
-
-def _need_zarr() -> None:
-    try:
-        import zarr  # noqa: F401
-    except ImportError:
-        raise StabmapError("Zarr atlases (.zarr) need the zarr package: pip install 'stabmap[zarr]', or write .nc") from None
 
 
 def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
@@ -95,68 +83,38 @@ def _remove(path: Path) -> None:
         path.unlink(missing_ok=True)
 
 
-def write_streamed(scene, partial, locations: list, path: Path) -> dict:
-    """Write the atlas whose chunks are in ``partial`` to ``path``, one chunk in memory at a time.
-
-    Returns the atlas' ``query.summary`` counts.
-    """
-    from .atlas import _dataset
-    from .query import Tally
-
-    tally = Tally()
-    for i in range(len(locations)):
-        block = partial.load(i)
-        tally.add(block[0], block[1])
-    shape = tuple(partial.shape)
-    chunks = da.core.normalize_chunks(tuple(partial.chunks), shape)
-    numblocks = tuple(len(c) for c in chunks)
-
-    def lazy(part):
-        """One variable, read chunk by chunk: each block read feeds one write and is freed at once."""
-        if not shape:
-            return part(partial.load(0))
-
-        def load(block_id=None):
-            return part(partial.load(int(np.ravel_multi_index(block_id, numblocks))))
-
-        dtype = part(np.zeros((2,), np.int16)).dtype
-        return da.map_blocks(load, chunks=chunks, dtype=dtype, meta=np.empty((0,) * len(shape), dtype))
-
-    ds = _dataset(
-        scene,
-        lazy(lambda b: b[0]),
-        lazy(lambda b: b[1].astype(np.int8)),
-        lazy(lambda b: stability_from_pairs(b[0])),
-    )
-    # Synchronous: the chunk files are on this machine, and one chunk at a time bounds the memory.
-    # Each netCDF chunk is written once, whole, so netCDF's chunk cache (64 MiB a variable by default,
-    # the largest use of memory here) only needs to hold one.
+def write_streamed(ds: xr.Dataset, path: Path) -> Path:
+    """Write ``ds``, whose variables are dask arrays read chunk by chunk, holding one chunk at a time."""
+    # Synchronous: the chunks are on this machine, and one chunk at a time bounds the memory. Each netCDF
+    # chunk is written once, whole, so netCDF's chunk cache (64 MiB a variable by default, the largest use of
+    # memory here) only needs to hold one.
     previous = netCDF4.get_chunk_cache()
     netCDF4.set_chunk_cache(NETCDF_CHUNK_CACHE)
     try:
         with dask.config.set(scheduler="synchronous"):
-            write_atlas(ds, path)
+            return write_atlas(ds, path)
     finally:
         netCDF4.set_chunk_cache(*previous)
-    return tally.summary()
 
 
-def open_atlas(path: str | Path) -> xr.Dataset:
-    """Open a saved atlas, netCDF or Zarr (loaded into memory; the file is closed on return)."""
+def open_atlas(path: str | Path, *, lazy: bool = False) -> xr.Dataset:
+    """Open a saved atlas, netCDF or Zarr.
+
+    By default it is loaded into memory and the file closed on return.  With ``lazy`` the variables are dask
+    arrays read chunk by chunk as they are used (bounded memory for any size); close the Dataset after use.
+    """
     path = Path(path)
     zarr = is_zarr(path) and path.is_dir()
     if not (path.is_file() or zarr):
         raise StabmapError(f"atlas file {str(path)!r} does not exist")
     try:
-        if zarr:
-            _need_zarr()
-            with xr.open_zarr(path, consolidated=False) as ds:
-                ds = ds.load()
-        else:
-            with xr.open_dataset(path, engine="netcdf4") as ds:
+        ds = xr.open_zarr(path, consolidated=False) if zarr else xr.open_dataset(path, engine="netcdf4", chunks={})
+        if not lazy:
+            with ds:
                 ds = ds.load()
     except (OSError, ValueError, KeyError) as exc:
         raise StabmapError(f"cannot read {str(path)!r} as a {'Zarr' if zarr else 'netCDF'} atlas: {exc}") from None
     if "stabmap_format_version" not in ds.attrs:
+        ds.close()
         raise StabmapError(f"{str(path)!r} is a netCDF file but not a stabmap atlas (no stabmap_format_version)")
     return ds

@@ -31,30 +31,37 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from .errors import StabmapError
-from .variables import ATTRS, DECIDED_BY, N_COMPLEX_PAIRS, STABILITY, flag_meaning
+from .. import systems
+from ..errors import StabmapError
+from ..store.variables import INFERRED
 
-_BY = dict(zip(ATTRS[DECIDED_BY]["flag_meanings"].split(), (int(v) for v in ATTRS[DECIDED_BY]["flag_values"])))
-INFERRED = _BY["inferred_from_cell_corners"]  # decided_by of points an adaptive atlas did not compute
-PAD_NC = -2  # N_c where there is no grid value (no unstable value below the first stable one), as in critical files
 CRITICAL_HINT = "'stabmap critical SCENE --along {along}' locates the ends to 1e-10 (docs/critical.md)"
 
 
 @dataclass(frozen=True)
 class Label:
-    """The atlas label at the grid point nearest to a requested point."""
+    """Every variable of an atlas at the grid point nearest to a requested point.
+
+    ``values`` holds each variable by name (a flag variable as its meaning), in the system's order; they are
+    also attributes: ``label.n_complex_pairs``, ``label.stability``, ...
+    """
 
     requested: dict[str, float]
     grid_point: dict[str, float]
-    n_complex_pairs: int
-    stability: str
-    decided_by: str
+    values: dict[str, object]
     outside: tuple[str, ...]  # axes on which the request lies outside the grid
+    provenance: str | None = None  # the name of the variable that says how the point was decided
+
+    def __getattr__(self, name: str):
+        values = self.__dict__.get("values", {})
+        if name in values:
+            return values[name]
+        raise AttributeError(name)
 
     @property
     def inferred(self) -> bool:
         """True when the point was not computed (adaptive atlas: inferred from its grid cell's corners)."""
-        return self.decided_by == "inferred_from_cell_corners"
+        return self.provenance is not None and self.values[self.provenance] == INFERRED
 
 
 @dataclass(frozen=True)
@@ -121,16 +128,26 @@ class StableFraction:
 # selection
 
 
-def _check_atlas(ds: xr.Dataset) -> list[str]:
+def grid_axes(ds: xr.Dataset) -> list[str]:
     """The grid axes of an atlas; a clear error for a critical-values Dataset or anything else."""
     if ds.attrs.get("stabmap_kind") == "critical values":
         raise StabmapError(
             "this Dataset holds critical values (stabmap critical), not an atlas; its intervals are in "
             f"{ds.attrs.get('critical_along', 'omega')}_stable_lower/upper ('stabmap info FILE' lists them)"
         )
-    if N_COMPLEX_PAIRS not in ds or DECIDED_BY not in ds:
-        raise StabmapError("this Dataset is not a stabmap atlas (no n_complex_pairs/decided_by); open one with stabmap.open_atlas")
-    return list(ds[N_COMPLEX_PAIRS].dims)
+    system = systems.of_atlas(ds.attrs)
+    missing = [v for v in (system.label, system.provenance) if v is not None and v not in ds]
+    if missing:
+        raise StabmapError(f"this Dataset is not a stabmap atlas (no {'/'.join(missing)}); open one with stabmap.open_atlas")
+    return list(ds[system.label].dims)
+
+
+def _inferred(ds: xr.Dataset, system) -> xr.DataArray | bool:
+    """Where points were not computed but inferred from their grid cell's corners (adaptive atlases)."""
+    if system.provenance is None or system.provenance not in ds:
+        return False
+    flags = system.variable(system.provenance)
+    return ds[system.provenance] == flags.value(INFERRED) if INFERRED in flags.meanings else False
 
 
 def _not_an_axis(ds: xr.Dataset, name: str, dims: list[str], role: str = "") -> StabmapError:
@@ -185,7 +202,7 @@ def select(ds: xr.Dataset, sel: dict, *, along: str | None = None) -> tuple[xr.D
     along : str, optional
         An axis that must stay an axis (boundaries, smallest_stable): a number for it is an error.
     """
-    dims = _check_atlas(ds)
+    dims = grid_axes(ds)
     index, axes = {}, {}
     for name, value in sel.items():
         if name not in dims:
@@ -239,7 +256,7 @@ def _selection_text(axes: dict[str, AxisSelection]) -> str:
 
 def label_at(ds: xr.Dataset, **point: float) -> Label:
     """Label of the grid point nearest to ``point`` (one value per grid axis)."""
-    dims = _check_atlas(ds)
+    dims = grid_axes(ds)
     unknown = [k for k in point if k not in dims]
     if unknown:
         raise StabmapError(f"{unknown[0]!r} is not an axis of this atlas; its axes are: {', '.join(dims) or '(none)'}")
@@ -255,18 +272,23 @@ def label_at(ds: xr.Dataset, **point: float) -> Label:
     outside = tuple(
         d for d in dims if not float(ds[d].min()) <= float(point[d]) <= float(ds[d].max())
     )
+    system = systems.of_atlas(ds.attrs)
+    values = {}
+    for v in system.variables:
+        if v.name in sel:
+            x = sel[v.name].values
+            values[v.name] = v.meaning(int(x)) if v.flags else (x.item() if x.ndim == 0 else x)
     return Label(
         requested={k: float(v) for k, v in point.items()},
         grid_point={d: float(sel[d]) for d in dims},
-        n_complex_pairs=int(sel[N_COMPLEX_PAIRS]),
-        stability=flag_meaning(STABILITY, int(sel[STABILITY])),
-        decided_by=flag_meaning(DECIDED_BY, int(sel[DECIDED_BY])),
+        values=values,
         outside=outside,
+        provenance=system.provenance if system.provenance in values else None,
     )
 
 
 def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
-    """The fraction of stable grid points (N_c = 0) in a slice of an atlas.
+    """The fraction of stable grid points (for gyroscopes N_c = 0) in a slice of an atlas.
 
     Parameters
     ----------
@@ -288,14 +310,15 @@ def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
     >>> stable_fraction(ds, omega=(20, 60))         # 20 <= omega <= 60, every K_1
     """
     sub, axes = select(ds, sel)
-    nc = np.asarray(sub[N_COMPLEX_PAIRS].values).ravel()
-    inferred = np.asarray(sub[DECIDED_BY].values).ravel() == INFERRED
-    stable = nc == 0
+    system = _stable_system(ds, "the stable fraction")
+    nc = np.asarray(sub[system.label].values).ravel()
+    inferred = np.asarray(_inferred(sub, system)).ravel() & np.ones(nc.size, dtype=bool)
+    stable = nc == system.stable_label
     return StableFraction(
         fraction=float(stable.mean()),
         stable=int(stable.sum()),
         points=int(nc.size),
-        unstable=int((nc > 0).sum()),
+        unstable=int((~stable & (nc >= 0)).sum()),
         degenerate=int((nc < 0).sum()),
         inferred=int(inferred.sum()),
         inferred_stable=int((inferred & stable).sum()),
@@ -309,12 +332,22 @@ def _along(ds: xr.Dataset, along, dims: list[str], role: str) -> str:
     return along
 
 
+def _stable_system(ds: xr.Dataset, question: str):
+    """The atlas's system, if it has a notion of stability."""
+    system = systems.of_atlas(ds.attrs)
+    if system.stable_label is None:
+        raise StabmapError(f"{question} needs stability; {system.name} atlases have none (ask about {system.label} instead)")
+    return system
+
+
 def _lines(sub: xr.Dataset, along: str) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray]:
-    """Other axes, the ascending grid of ``along``, and N_c and the inferred flag as (other axes..., along)."""
+    """Other axes, the ascending grid of ``along``, and the label and the inferred flag as (other axes..., along)."""
+    system = systems.of_atlas(sub.attrs)
     sub = sub.sortby(along)
-    others = [d for d in sub[N_COMPLEX_PAIRS].dims if d != along]
-    nc = sub[N_COMPLEX_PAIRS].transpose(*others, along).values
-    inferred = sub[DECIDED_BY].transpose(*others, along).values == INFERRED
+    others = [d for d in sub[system.label].dims if d != along]
+    nc = sub[system.label].transpose(*others, along).values
+    inferred = np.broadcast_to(_inferred(sub, system), sub[system.label].shape)
+    inferred = xr.DataArray(inferred, dims=sub[system.label].dims).transpose(*others, along).values
     return others, np.asarray(sub[along].values, dtype=np.float64), nc, inferred
 
 
@@ -366,10 +399,11 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
     >>> b.to_dataframe()                                            # one row per boundary
     >>> b.where(b.n_complex_pairs_above == 0, drop=True)            # only the changes to stable
     """
-    dims = _check_atlas(ds)
+    dims = grid_axes(ds)
     along = _along(ds, along, dims, "boundaries along")
     sub, axes = select(ds, sel, along=along)
     others, x, nc, inferred = _lines(sub, along)
+    lab = systems.of_atlas(ds.attrs).label
     shape = nc.shape[:-1]
     nc2, inf2 = nc.reshape(-1, x.size), inferred.reshape(-1, x.size)
     line, k = np.nonzero(nc2[:, 1:] != nc2[:, :-1])
@@ -383,10 +417,10 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
     coords.update(_fixed_coords(sub, axes))
     out = xr.Dataset(
         {
-            "boundary_lower": var(x[k], f"{along} at the grid value below the change of n_complex_pairs", units=units),
-            "boundary_upper": var(x[k + 1], f"{along} at the grid value above the change of n_complex_pairs", units=units),
-            "n_complex_pairs_below": var(nc2[line, k].astype(np.int16), "n_complex_pairs at boundary_lower", units="1"),
-            "n_complex_pairs_above": var(nc2[line, k + 1].astype(np.int16), "n_complex_pairs at boundary_upper", units="1"),
+            "boundary_lower": var(x[k], f"{along} at the grid value below the change of {lab}", units=units),
+            "boundary_upper": var(x[k + 1], f"{along} at the grid value above the change of {lab}", units=units),
+            f"{lab}_below": var(nc2[line, k], f"{lab} at boundary_lower", units="1"),
+            f"{lab}_above": var(nc2[line, k + 1], f"{lab} at boundary_upper", units="1"),
             "inferred_below": var(inf2[line, k], "boundary_lower was not computed (inferred from its grid cell's corners)"),
             "inferred_above": var(inf2[line, k + 1], "boundary_upper was not computed (inferred from its grid cell's corners)"),
         },
@@ -396,6 +430,8 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
     out.attrs = {
         "title": ds.attrs.get("title", ""),
         "stabmap_query": "boundaries",
+        "label": lab,
+        "label_symbol": systems.of_atlas(ds.attrs).label_symbol,
         "along": along,
         "along_units": units,
         "n_lines": n_lines,
@@ -404,9 +440,9 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
         "selection": _selection_text(axes),
         "fixed_axes": _fixed_names(axes),
         "comment": (
-            f"Each change of n_complex_pairs lies somewhere between boundary_lower and boundary_upper, two "
+            f"Each change of {lab} lies somewhere between boundary_lower and boundary_upper, two "
             f"neighbouring grid values of {along}; it is not located more finely. Changes hidden between two grid "
-            f"values with equal n_complex_pairs are not seen. {CRITICAL_HINT.format(along=along)}."
+            f"values with equal {lab} are not seen. {CRITICAL_HINT.format(along=along)}."
         ),
     }
     return out
@@ -447,10 +483,12 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
     >>> s = smallest_stable(ds, "omega", over="K_1")
     >>> s.smallest_stable.plot()                    # the smallest stable spin rate against K_1
     """
-    dims = _check_atlas(ds)
+    dims = grid_axes(ds)
     along = _along(ds, along, dims, "smallest_stable along")
     sub, axes = select(ds, sel, along=along)
     others, x, nc, inferred = _lines(sub, along)
+    system = _stable_system(ds, "smallest_stable")
+    label = system.variable(system.label)
     if over is not None:
         if over == along:
             raise StabmapError(f"over={over!r} is the axis searched along; choose another axis for over, e.g. {next((d for d in dims if d != along), 'K_1')}")
@@ -464,7 +502,7 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
                 f"smallest_stable over {over!r}: fix the other axes as well ({example}, or any grid value), "
                 "or leave out over to get one answer per point of every remaining axis"
             )
-    stable = nc == 0
+    stable = nc == system.stable_label
     has = stable.any(axis=-1)
     first = np.argmax(stable, axis=-1)
     below = np.maximum(first - 1, 0)
@@ -486,9 +524,9 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
         {
             "smallest_stable": var(np.where(has, x[first], np.nan), f"smallest stable {along}", units=units),
             "unstable_below": var(np.where(has_below, x[below], np.nan), f"unstable {along} just below the smallest stable one", units=units),
-            "n_complex_pairs_below": var(
-                np.where(has_below, at(nc, below), PAD_NC).astype(np.int16), "n_complex_pairs at unstable_below", units="1",
-                comment=f"{PAD_NC} where there is no unstable_below",
+            f"{label.name}_below": var(
+                np.where(has_below, at(nc, below), label.fill).astype(nc.dtype), f"{label.name} at unstable_below", units="1",
+                comment=f"{label.fill} where there is no unstable_below",
             ),
             "stable_to_scan_end": var(has & at(tail, first), f"stable at every grid value of {along} from smallest_stable to the end of the searched range"),
             "inferred": var(has & at(inferred, first), "smallest_stable was not computed (inferred from its grid cell's corners)"),
@@ -499,6 +537,9 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
     out.attrs = {
         "title": ds.attrs.get("title", ""),
         "stabmap_query": "smallest_stable",
+        "label": label.name,
+        "label_symbol": system.label_symbol,
+        "label_fill": label.fill,
         "along": along,
         "along_units": units,
         "along_range": [float(x.min()), float(x.max())],
@@ -515,32 +556,29 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
     return out
 
 
-def summary(ds: xr.Dataset) -> dict:
-    """Counts that describe an atlas: points, stable fraction, N_c histogram, who decided."""
-    return Tally().add(np.asarray(ds[N_COMPLEX_PAIRS]), np.asarray(ds[DECIDED_BY])).summary()
+def parse_selection(items: list[str], *, ranges: bool = True, option: str = "") -> dict:
+    """``NAME=VALUE`` (nearest grid value) and, with ``ranges``, ``NAME=LO:HI`` (LO: and :HI open) as a selection.
 
-
-class Tally:
-    """``summary`` accumulated block by block, for atlases streamed to a file without being held whole."""
-
-    def __init__(self):
-        self.nc: dict[int, int] = {}
-        self.by = {int(v): 0 for v in ATTRS[DECIDED_BY]["flag_values"]}
-
-    def add(self, nc: np.ndarray, decided_by: np.ndarray) -> Tally:
-        for table, values in ((self.nc, nc), (self.by, decided_by)):
-            for v, c in zip(*np.unique(values, return_counts=True)):
-                table[int(v)] = table.get(int(v), 0) + int(c)
-        return self
-
-    def summary(self) -> dict:
-        points = sum(self.nc.values())
-        stable = self.nc.get(0, 0)
-        return {
-            "points": points,
-            "stable": stable,
-            "degenerate": sum(c for v, c in self.nc.items() if v < 0),
-            "stable_fraction": stable / points if points else float("nan"),
-            "n_complex_pairs": dict(sorted(self.nc.items())),
-            "decided_by": {flag_meaning(DECIDED_BY, v): c for v, c in self.by.items()},
-        }
+    The selections of the command line; errors name the item and ``option`` (e.g. ``--sel``).
+    """
+    out = {}
+    prefix = f"{option} " if option else ""
+    for item in items:
+        key, sep, value = (part.strip() for part in item.partition("="))
+        if not sep or not key:
+            how = "NAME=VALUE (nearest grid value) or NAME=LO:HI (a range), e.g. omega=42.5 or K_1=0:10" if ranges else "NAME=VALUE, e.g. omega=42.5"
+            raise StabmapError(f"{prefix}{item!r}: write {how}")
+        if key in out:
+            raise StabmapError(f"{key} is given twice; give each axis once")
+        ends = value.split(":")
+        if len(ends) > 2 or (len(ends) == 2 and not ranges):
+            raise StabmapError(f"{prefix}{item!r}: a range is NAME=LO:HI, e.g. {key}=0:10" if ranges else f"{prefix}{item!r}: give one value, e.g. {key}=42.5")
+        try:
+            numbers = [float(e) if e.strip() else None for e in ends]
+        except ValueError:
+            what = "a number or a range LO:HI" if ranges else "a number"
+            raise StabmapError(f"{prefix}{item!r}: {value!r} is not {what}; write e.g. {key}=42.5" + (f" or {key}=0:10" if ranges else "")) from None
+        if len(numbers) == 1 and numbers[0] is None:
+            raise StabmapError(f"{prefix}{item!r}: no value; write e.g. {key}=42.5" + (f" or {key}=0:10" if ranges else ""))
+        out[key] = numbers[0] if len(numbers) == 1 else tuple(numbers)
+    return out

@@ -6,48 +6,38 @@ dimension names and the CLI query keys.
 
 from __future__ import annotations
 
-import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
-from .errors import StabmapError
-
-
-@dataclass(frozen=True)
-class ParameterInfo:
-    symbol: str
-    units: str
-    long_name: str
-    minimum: float | None  # None: any finite value
-    strict: bool  # minimum excluded
-
+from ...errors import StabmapError
+from ...scene.values import Parameter
 
 BODY = {
-    "m": ParameterInfo("m", "kg", "mass of body {k} (liquid included)", 0.0, True),
-    "A": ParameterInfo("A", "kg m2", "equatorial moment of inertia of body {k} about its centre of mass", 0.0, True),
-    "C": ParameterInfo("C", "kg m2", "axial moment of inertia of body {k}", 0.0, False),
-    "c": ParameterInfo("c", "m", "distance from the lower joint of body {k} to its centre of mass", None, False),
-    "s": ParameterInfo("s", "m", "distance between the lower and upper joints of body {k}", 0.0, False),
-    "omega": ParameterInfo("omega", "rad s-1", "spin rate of body {k}", None, False),
+    "m": Parameter("m", "kg", "mass of body {k} (liquid included)", 0.0, True),
+    "A": Parameter("A", "kg m2", "equatorial moment of inertia of body {k} about its centre of mass", 0.0, True),
+    "C": Parameter("C", "kg m2", "axial moment of inertia of body {k}", 0.0, False),
+    "c": Parameter("c", "m", "distance from the lower joint of body {k} to its centre of mass", None, False),
+    "s": Parameter("s", "m", "distance between the lower and upper joints of body {k}", 0.0, False),
+    "omega": Parameter("omega", "rad s-1", "spin rate of body {k}", None, False),
 }
 BODY_COLUMNS = ("m", "A", "C", "c", "s", "omega")  # column order of the kernels' body array
-JOINT = ParameterInfo("K", "N m rad-1", "stiffness of joint {k}", 0.0, False)
-BASE = ParameterInfo("K", "N m rad-1", "stiffness of the base joint", 0.0, False)
+JOINT = Parameter("K", "N m rad-1", "stiffness of joint {k}", 0.0, False)
+BASE = Parameter("K", "N m rad-1", "stiffness of the base joint", 0.0, False)
 # A tree (scene [topology]): where body k's joint sits on its parent's axis, up positive.
-POSITION = ParameterInfo("at", "m", "position of the joint of body {k} on its parent's axis", None, False)
+POSITION = Parameter("at", "m", "position of the joint of body {k} on its parent's axis", None, False)
 CAVITY = {
-    "radius": ParameterInfo("a", "m", "radius (equatorial semi-axis) of the cavity of body {k}", 0.0, True),
-    "half_height": ParameterInfo("c", "m", "half height (polar semi-axis) of the cavity of body {k}", 0.0, True),
-    "density": ParameterInfo("rho", "kg m-3", "density of the liquid in the cavity of body {k}", 0.0, True),
-    "centre": ParameterInfo("z", "m", "height of the cavity centre above the lower joint of body {k}", None, False),
-    "E": ParameterInfo("E", "kg m2", "inertia coefficient of a liquid mode", 0.0, True),
-    "kappa": ParameterInfo("kappa", "1", "frequency parameter of a liquid mode", None, False),
+    "radius": Parameter("a", "m", "radius (equatorial semi-axis) of the cavity of body {k}", 0.0, True),
+    "half_height": Parameter("c", "m", "half height (polar semi-axis) of the cavity of body {k}", 0.0, True),
+    "density": Parameter("rho", "kg m-3", "density of the liquid in the cavity of body {k}", 0.0, True),
+    "centre": Parameter("z", "m", "height of the cavity centre above the lower joint of body {k}", None, False),
+    "E": Parameter("E", "kg m2", "inertia coefficient of a liquid mode", 0.0, True),
+    "kappa": Parameter("kappa", "1", "frequency parameter of a liquid mode", None, False),
 }
 SCANNABLE_CAVITY = ("radius", "half_height", "density")
 EVERY_BODY = ("m", "A", "C", "c", "s")  # grid axes that set one parameter of every body at once (identical bodies)
 GLOBAL = {
-    "omega": ParameterInfo("omega", "rad s-1", "common spin rate", None, False),
-    "g": ParameterInfo("g", "m s-2", "gravitational acceleration", None, False),
+    "omega": Parameter("omega", "rad s-1", "common spin rate", None, False),
+    "g": Parameter("g", "m s-2", "gravitational acceleration", None, False),
 }
 
 _NAME = re.compile(r"^(m|A|C|c|s|omega|K|at|radius|half_height|density)_(\d+)$")
@@ -67,7 +57,7 @@ class Name:
     index: int
 
     @property
-    def info(self) -> ParameterInfo:
+    def info(self) -> Parameter:
         if self.kind == "global":
             return GLOBAL[self.symbol]
         if self.kind in ("joint", "every_joint"):
@@ -89,6 +79,11 @@ class Name:
         if self.kind == "every_joint":
             return "stiffness of every joint between bodies (K_1..K_n-1)"
         return self.info.long_name.format(k=self.index)
+
+    @property
+    def parameter(self) -> Parameter:
+        """The parameter of this name, its long name saying which body or joint."""
+        return replace(self.info, long_name=self.long_name)
 
 
 def parse_name(name: str, n_bodies: int, support: str) -> Name:
@@ -128,18 +123,3 @@ def parse_name(name: str, n_bodies: int, support: str) -> Name:
             raise StabmapError(f"{name!r}: body 1's joint is the base point (or a free system's reference point); it has no position to scan")
         return Name(name, "position", symbol, index)
     return Name(name, "cavity" if symbol in CAVITY else "body", symbol, index)
-
-
-def check_value(where: str, value, info: ParameterInfo) -> float:
-    """Return ``value`` as a float or raise a StabmapError naming ``where``."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise StabmapError(f"{where} must be a number, got {value!r}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise StabmapError(f"{where} must be finite, got {value}")
-    if info.minimum is not None:
-        if info.strict and value <= info.minimum:
-            raise StabmapError(f"{where} must be > {info.minimum:g}, got {value}")
-        if not info.strict and value < info.minimum:
-            raise StabmapError(f"{where} must be >= {info.minimum:g}, got {value}")
-    return value

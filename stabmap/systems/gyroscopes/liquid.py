@@ -13,14 +13,15 @@ from __future__ import annotations
 import csv
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from ...errors import StabmapError
+from ...scene.values import check_value
 from . import cavity
-from .errors import StabmapError
-from .parameters import CAVITY, check_value
+from .parameters import CAVITY
 
 _KEYS = {
     "spheroid": {"shape", "radius", "half_height", "density", "modes", "tail", "liquid_in_body", "centre"},
@@ -33,13 +34,16 @@ _scaled: dict[tuple[str, int, float], tuple[np.ndarray, np.ndarray, float]] = {}
 
 @dataclass(frozen=True)
 class Cavity:
-    """A liquid-filled cavity of one body; lengths [m], density [kg m^-3], inertias [kg m^2]."""
+    """A liquid-filled cavity of one body; lengths [m], density [kg m^-3], inertias [kg m^2].
+
+    Its values are checked by the scene that holds it (``check``), so errors name the body.
+    """
 
     shape: str  # "spheroid" | "cylinder" | "table"
     radius: float = 0.0  # equatorial semi-axis (spheroid) or radius (cylinder)
     half_height: float = 0.0  # polar semi-axis (spheroid) or half the height (cylinder)
     density: float = 0.0
-    modes: int = 0  # modes kept (largest E first)
+    modes: int | None = None  # modes kept (largest E first); None: the shape's default
     tail: bool = True  # lump the remaining modes into A (geometric shapes; a table with deficit)
     liquid_in_body: bool = True  # m, A, C of the body already include the frozen liquid
     centre: float = 0.0  # cavity centre above the lower joint O_k (liquid_in_body = false)
@@ -52,28 +56,20 @@ class Cavity:
     def geometric(self) -> bool:
         return self.shape != "table"
 
-    def to_toml(self) -> str:
+    def to_dict(self) -> dict:
+        """The ``cavity`` table of the body in a scene file."""
         if not self.geometric:
-            items = [("shape", '"table"'), ("E", _list(self.E)), ("kappa", _list(self.kappa))]
-            items += [(k, repr(v)) for k in ("inertia", "deficit") if (v := getattr(self, k)) is not None]
-        else:
-            items = [("shape", f'"{self.shape}"')] + [(k, repr(getattr(self, k))) for k in ("radius", "half_height", "density", "modes")]
-            items += [("tail", _bool(self.tail)), ("liquid_in_body", _bool(self.liquid_in_body))]
-            if not self.liquid_in_body:
-                items.append(("centre", repr(self.centre)))
-        return "cavity = { " + ", ".join(f"{k} = {v}" for k, v in items) + " }"
-
-
-def _list(xs) -> str:
-    return "[" + ", ".join(repr(float(x)) for x in xs) + "]"
-
-
-def _bool(b: bool) -> str:
-    return "true" if b else "false"
+            out = {"shape": "table", "E": list(self.E), "kappa": list(self.kappa)}
+            out.update({k: v for k in ("inertia", "deficit") if (v := getattr(self, k)) is not None})
+            return out
+        out = {k: getattr(self, k) for k in ("shape", "radius", "half_height", "density", "modes", "tail", "liquid_in_body")}
+        if not self.liquid_in_body:
+            out["centre"] = self.centre
+        return out
 
 
 def parse(raw, where: str, base_dir: Path | None) -> Cavity:
-    """Validate a body's ``cavity`` table; ``where`` names it in errors (e.g. ``bodies[2].cavity``)."""
+    """The Cavity of a body's ``cavity`` table (its layout checked here, its values by ``check``)."""
     if not isinstance(raw, dict):
         raise StabmapError(f"{where} must be a table such as {{ shape = \"cylinder\", radius = 0.05, half_height = 0.1, density = 1000 }}")
     shape = raw.get("shape")
@@ -84,24 +80,10 @@ def parse(raw, where: str, base_dir: Path | None) -> Cavity:
         raise StabmapError(f"{where}: unknown key {unknown[0]!r} for shape {shape!r}; allowed keys are {', '.join(sorted(_KEYS[shape]))}")
     if shape == "table":
         return _table(raw, where, base_dir)
-    sizes = {}
     for key in ("radius", "half_height", "density"):
         if key not in raw:
             raise StabmapError(f"{where}.{key} is missing [{CAVITY[key].units}]; a {shape} needs radius, half_height and density")
-        sizes[key] = check_value(f"{where}.{key}", raw[key], CAVITY[key])
-    try:
-        modes = cavity.check_shape(shape, raw.get("modes"))
-    except StabmapError as exc:
-        raise StabmapError(f"{where}.{exc}") from None
-    flags = {}
-    for key in ("tail", "liquid_in_body"):
-        flags[key] = raw.get(key, True)
-        if not isinstance(flags[key], bool):
-            raise StabmapError(f"{where}.{key} must be true or false, got {flags[key]!r}")
-    if "centre" in raw and flags["liquid_in_body"]:
-        raise StabmapError(f"{where}.centre is used only with liquid_in_body = false (the body's m, A, C, c already place the liquid); remove it")
-    centre = check_value(f"{where}.centre", raw.get("centre", 0.0), CAVITY["centre"])
-    return Cavity(shape=shape, modes=modes, centre=centre, **sizes, **flags)
+    return Cavity(**raw)
 
 
 def _table(raw: dict, where: str, base_dir: Path | None) -> Cavity:
@@ -119,25 +101,57 @@ def _table(raw: dict, where: str, base_dir: Path | None) -> Cavity:
     E, freq = columns["E"], columns[freq_key]
     if not isinstance(E, list) or not isinstance(freq, list) or not E:
         raise StabmapError(f"{where}: E and {freq_key} must be non-empty lists of numbers")
-    if len(E) != len(freq):
-        raise StabmapError(f"{where}: E has {len(E)} values but {freq_key} has {len(freq)}; give one per mode")
-    E = tuple(check_value(f"{where}.E[{i + 1}]", v, CAVITY["E"]) for i, v in enumerate(E))
-    freq = [check_value(f"{where}.{freq_key}[{i + 1}]", v, CAVITY["kappa"]) for i, v in enumerate(freq)]
     if freq_key == "lambda_over_omega":
+        if len(E) != len(freq):
+            raise StabmapError(f"{where}: E has {len(E)} values but {freq_key} has {len(freq)}; give one per mode")
+        freq = [check_value(f"{where}.{freq_key}[{i + 1}]", v, CAVITY["kappa"]) for i, v in enumerate(freq)]
         bad = [i for i, v in enumerate(freq) if v == 0.0 or abs(v) >= 2.0]
         if bad:
             raise StabmapError(f"{where}.lambda_over_omega[{bad[0] + 1}] = {freq[bad[0]]}: a cavity mode has 0 < |lambda/omega| < 2")
         freq = [2.0 / v for v in freq]
-    bad = [i for i, v in enumerate(freq) if abs(v) <= 1.0]
+    extra = {k: raw[k] for k in ("inertia", "deficit") if k in raw}
+    return Cavity(shape="table", E=tuple(E), kappa=tuple(freq), tail="deficit" in extra, **extra)
+
+
+def check(c: Cavity, where: str) -> Cavity:
+    """The cavity with its values checked and normalised; errors name ``where`` (e.g. ``bodies[2].cavity``)."""
+    if not isinstance(c, Cavity):
+        raise StabmapError(f"{where} must be a Cavity, got {c!r}")
+    if c.shape not in _KEYS:
+        raise StabmapError(f'{where}.shape must be "spheroid", "cylinder" or "table", got {c.shape!r}')
+    if not c.geometric:
+        return _check_table(c, where)
+    sizes = {key: check_value(f"{where}.{key}", getattr(c, key), CAVITY[key]) for key in ("radius", "half_height", "density")}
+    try:
+        modes = cavity.check_shape(c.shape, c.modes)
+    except StabmapError as exc:
+        raise StabmapError(f"{where}.{exc}") from None
+    for key in ("tail", "liquid_in_body"):
+        if not isinstance(getattr(c, key), bool):
+            raise StabmapError(f"{where}.{key} must be true or false, got {getattr(c, key)!r}")
+    if c.centre and c.liquid_in_body:
+        raise StabmapError(f"{where}.centre is used only with liquid_in_body = false (the body's m, A, C, c already place the liquid); remove it")
+    centre = check_value(f"{where}.centre", c.centre, CAVITY["centre"])
+    return replace(c, modes=modes, centre=centre, **sizes)
+
+
+def _check_table(c: Cavity, where: str) -> Cavity:
+    if not c.E:
+        raise StabmapError(f"{where}: E and kappa must be non-empty lists of numbers")
+    if len(c.E) != len(c.kappa):
+        raise StabmapError(f"{where}: E has {len(c.E)} values but kappa has {len(c.kappa)}; give one per mode")
+    E = tuple(check_value(f"{where}.E[{i + 1}]", v, CAVITY["E"]) for i, v in enumerate(c.E))
+    kappa = tuple(check_value(f"{where}.kappa[{i + 1}]", v, CAVITY["kappa"]) for i, v in enumerate(c.kappa))
+    bad = [i for i, v in enumerate(kappa) if abs(v) <= 1.0]
     if bad:
-        raise StabmapError(f"{where}.kappa[{bad[0] + 1}] = {freq[bad[0]]}: a cavity mode has |kappa| > 1")
-    extra = {k: check_value(f"{where}.{k}", raw[k], CAVITY["E"]) for k in ("inertia", "deficit") if k in raw}
+        raise StabmapError(f"{where}.kappa[{bad[0] + 1}] = {kappa[bad[0]]}: a cavity mode has |kappa| > 1")
+    extra = {k: check_value(f"{where}.{k}", v, CAVITY["E"]) for k in ("inertia", "deficit") if (v := getattr(c, k)) is not None}
     total = math.fsum(E)
     if "inertia" in extra and total > extra["inertia"]:
         raise StabmapError(f"{where}: sum(E) = {total:g} exceeds the frozen liquid's transverse inertia {extra['inertia']:g}; the modes cannot hold more than the liquid")
     if "deficit" in extra and total > extra["deficit"]:
         raise StabmapError(f"{where}: sum(E) = {total:g} exceeds deficit = {extra['deficit']:g} (the sum over all modes); check both")
-    return Cavity(shape="table", E=E, kappa=tuple(freq), tail="deficit" in extra, **extra)
+    return replace(c, E=E, kappa=kappa, tail="deficit" in extra, **extra)
 
 
 def _read_table(name, where: str, base_dir: Path | None) -> dict:

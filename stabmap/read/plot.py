@@ -1,4 +1,5 @@
-"""Pictures of an atlas: maps of N_c, the number of complex root pairs, with the boundaries between classes.
+"""Pictures of an atlas: maps of its label (for gyroscopes N_c, the number of complex root pairs), with the
+boundaries between classes.
 
 ``atlas_figure`` draws an atlas Dataset into a new matplotlib Figure and computes nothing: it reads
 ``n_complex_pairs`` and ``decided_by`` and their coordinates. ``plot_atlas`` saves that figure to PNG or PDF.
@@ -28,9 +29,10 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .errors import StabmapError
-from .io import check_writable
-from .variables import ATTRS, DECIDED_BY, N_COMPLEX_PAIRS
+from ..errors import StabmapError
+from .. import systems
+from ..store.files import check_writable
+from ..store.variables import INFERRED
 
 MAX_PANELS = 12  # default limit of small multiples
 _LEGEND_WIDTH = 2.5  # [inch] beside small multiples
@@ -45,29 +47,30 @@ _CLASS_EDGE = "#333333"
 _HATCH_INFERRED = "////"
 _HATCH_DEGENERATE = "xxxx"
 _HATCH_RUNS = 100_000  # more separate runs of inferred cells than this: a light veil instead of a hatch
-_INFERRED = int(ATTRS[DECIDED_BY]["flag_values"][ATTRS[DECIDED_BY]["flag_meanings"].split().index("inferred_from_cell_corners")])
 _VECTOR_RUNS = 20_000  # a panel with more runs of equal cells along x is filled as an image (lines and text stay vector)
 
 # Symbols of the scannable names (stabmap.parameters); names without one are shown as they are typed.
 _SYMBOLS = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho", "radius": "a"}
 
 
-def colour(n_c: int) -> str:
-    """The colour of the class N_c = ``n_c`` (-1: degenerate) in every stabmap figure."""
-    if n_c < 0:
+def colour(value: int, stable: int | None = 0) -> str:
+    """The colour of the label ``value`` (negative: degenerate; ``stable``: the stable class) in every figure."""
+    if value < 0:
         return _DEGENERATE
-    if n_c == 0:
+    if value == stable:
         return _STABLE
-    return _UNSTABLE[(n_c - 1) % len(_UNSTABLE)]
+    return _UNSTABLE[(value - 1 if stable is not None and value > stable else value) % len(_UNSTABLE)]
 
 
-def class_label(n_c: int) -> str:
-    """Legend text of the class N_c = ``n_c``."""
-    if n_c < 0:
-        return "degenerate (p \u2261 0)"
-    if n_c == 0:
-        return "stable (all roots real)"
-    return f"{n_c} complex pair{'s' if n_c > 1 else ''}"
+def class_label(value: int, system=None) -> str:
+    """Legend text of the label ``value`` of ``system`` (default: gyroscopes, where the label is N_c)."""
+    return (system or systems.get(systems.DEFAULT)).class_name(value)
+
+
+def _mathtext(symbol: str) -> str:
+    """'N_c' -> 'N$_c$' (a subscript), for legends."""
+    base, _, sub = symbol.partition("_")
+    return base if not sub else f"{base}$_{sub}$" if len(sub) == 1 else f"{base}$_{{{sub}}}$"
 
 
 # ---------------------------------------------------------------------------------------------------------- layout
@@ -120,11 +123,12 @@ def plan_figure(
     max_panels: int = MAX_PANELS,
 ) -> FigurePlan:
     """Check the options of :func:`atlas_figure` against ``ds`` and decide the layout (see there)."""
-    if N_COMPLEX_PAIRS not in ds:
-        raise StabmapError(f"not a stabmap atlas: the Dataset has no {N_COMPLEX_PAIRS!r} variable")
+    label = systems.of_atlas(ds.attrs).label
+    if label not in ds:
+        raise StabmapError(f"not a stabmap atlas: the Dataset has no {label!r} variable")
     if isinstance(max_panels, bool) or not isinstance(max_panels, (int, np.integer)) or max_panels < 1:
         raise StabmapError(f"--max-panels must be a whole number >= 1, got {max_panels!r}")
-    dims = list(ds[N_COMPLEX_PAIRS].dims)
+    dims = list(ds[label].dims)
     if not dims:
         raise StabmapError("this atlas has no axis to plot (a single point); use 'stabmap info' or 'stabmap query'")
     sel = dict(sel or {})
@@ -227,7 +231,7 @@ def _segments(mask_v: np.ndarray, mask_h: np.ndarray, xe: np.ndarray, ye: np.nda
     return np.concatenate([vertical.reshape(-1, 2, 2), horizontal.reshape(-1, 2, 2)])
 
 
-def cell_edge_boundaries(values: np.ndarray, xedges: np.ndarray, yedges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def cell_edge_boundaries(values: np.ndarray, xedges: np.ndarray, yedges: np.ndarray, stable: int | None = 0) -> tuple[np.ndarray, np.ndarray]:
     """Boundaries of a 2-D class map on the edges of its grid cells.
 
     Parameters
@@ -245,7 +249,7 @@ def cell_edge_boundaries(values: np.ndarray, xedges: np.ndarray, yedges: np.ndar
     """
     v = np.asarray(values)
     xe, ye = np.asarray(xedges, dtype=float), np.asarray(yedges, dtype=float)
-    stable = v == 0
+    stable = v == stable
     dv, dh = v[:, 1:] != v[:, :-1], v[1:, :] != v[:-1, :]
     sv, sh = stable[:, 1:] != stable[:, :-1], stable[1:, :] != stable[:-1, :]
     return _segments(sv, sh, xe, ye), _segments(dv & ~sv, dh & ~sh, xe, ye)
@@ -274,7 +278,7 @@ def _rectangles(mask: np.ndarray, xe: np.ndarray, ye: np.ndarray) -> list[np.nda
     return [np.array([[xe[a], ye[j0]], [xe[b], ye[j0]], [xe[b], ye[j1]], [xe[a], ye[j1]]]) for a, b, j0, j1 in done]
 
 
-def _fill(ax, values: np.ndarray, xe: np.ndarray, ye: np.ndarray, cmap, norm) -> None:
+def _fill(ax, values: np.ndarray, xe: np.ndarray, ye: np.ndarray, cmap, norm, stable: int | None) -> None:
     """Colour the cells: one vector rectangle per block of equal cells, or an image when the map is too busy.
 
     Rectangles are outlined in their own colour, so no hairline seams show between them in a PDF viewer.
@@ -287,7 +291,7 @@ def _fill(ax, values: np.ndarray, xe: np.ndarray, ye: np.ndarray, cmap, norm) ->
         ax.pcolormesh(xe, ye, values, cmap=cmap, norm=norm, shading="flat", rasterized=True)
         return
     for v in np.unique(values):
-        c = colour(int(v))
+        c = colour(int(v), stable)
         cells = PolyCollection(_rectangles(values == v, xe, ye), facecolors=c, edgecolors=c, linewidths=0.3, antialiaseds=False, zorder=1)
         cells.set_gid(f"cells-{int(v)}")
         ax.add_collection(cells, autolim=False)
@@ -417,8 +421,11 @@ def atlas_figure(
 
     plan = plan_figure(ds, x=x, y=y, sel=sel, facet=facet, max_panels=max_panels)
     fix = {k: i for k, (i, _) in plan.fixed.items()}
-    nc = ds[N_COMPLEX_PAIRS].isel(fix)
-    by = ds[DECIDED_BY].isel(fix) if DECIDED_BY in ds else None
+    system = systems.of_atlas(ds.attrs)
+    nc = ds[system.label].isel(fix)
+    by = ds[system.provenance].isel(fix) if system.provenance in ds else None
+    flags = system.variable(system.provenance) if by is not None else None
+    inferred_value = flags.value(INFERRED) if flags is not None and INFERRED in flags.meanings else None
     order = (plan.y, plan.x) if plan.y else (plan.x,)
     panels = [(r, c) for r in (plan.row_index or (None,)) for c in (plan.facet_index or (None,))]
 
@@ -432,11 +439,12 @@ def atlas_figure(
         return a if plan.y else a[None, :]
 
     data = [cut(nc, r, c) for r, c in panels]
-    inferred = [cut(by, r, c) == _INFERRED if by is not None else None for r, c in panels]
+    inferred = [cut(by, r, c) == inferred_value if inferred_value is not None else None for r, c in panels]
     everything = np.concatenate([d.ravel() for d in data])
     present = sorted(int(v) for v in np.unique(everything))
     top = max(1, present[-1])
-    cmap = ListedColormap([colour(v) for v in range(-1, top + 1)])
+    stable = system.stable_label
+    cmap = ListedColormap([colour(v, stable) for v in range(-1, top + 1)])
     norm = BoundaryNorm(np.arange(-1.5, top + 1.5), cmap.N)
 
     xs = np.asarray(ds[plan.x], dtype=float)
@@ -452,7 +460,7 @@ def atlas_figure(
     else:
         nrows = ncols = 1
     width = 7.5 if plan.facet is None else max(3.5, 2.6 * ncols + 0.9) + _LEGEND_WIDTH
-    title = _title(ds, plan, everything, 70 if plan.facet is None else int(12 * (width - _LEGEND_WIDTH)))
+    title = _title(ds, plan, everything == stable, 70 if plan.facet is None else int(12 * (width - _LEGEND_WIDTH)))
     lines = title.count("\n") + 1
     if plan.facet is None:
         size = (width, 5.2) if plan.y else (width, max(1.4 + 0.17 * lines, 0.22 * (len(present) + 4)) + 0.6)
@@ -470,12 +478,12 @@ def atlas_figure(
 
     drawn = {"stability": False, "classes": False, "inferred": False, "light": False}
     for ax, values, inf, (r, c) in zip(axes, data, inferred, panels):
-        _fill(ax, values, xe, ye, cmap, norm)
+        _fill(ax, values, xe, ye, cmap, norm, stable)
         for mask, gid in ((inf, "inferred-cells"), (values < 0, "degenerate-cells")):
             if mask is not None and mask.any():
                 drawn["inferred"] |= gid == "inferred-cells"
                 drawn["light"] |= _overlay(ax, mask, xe, ye, gid)
-        stab, other = cell_edge_boundaries(values, xe, ye)
+        stab, other = cell_edge_boundaries(values, xe, ye, stable)
         for segs, width, col, gid in ((other, 0.6, _CLASS_EDGE, "class-boundary"), (stab, 1.5, _BOUNDARY, "stability-boundary")):
             lines = LineCollection(segs, colors=col, linewidths=width, capstyle="projecting", joinstyle="miter", zorder=3 + (gid == "stability-boundary"))
             lines.set_gid(gid)
@@ -486,7 +494,7 @@ def atlas_figure(
             parts = [_value_text(ds, plan.facet, float(ds[plan.facet][c]))]
             if plan.row is not None:
                 parts.append(_value_text(ds, plan.row, float(ds[plan.row][r])))
-            parts.append(f"{100 * float(np.mean(values == 0)):.0f} % stable")
+            parts.append(f"{100 * float(np.mean(values == stable)):.0f} % stable")
             ax.set_title("\n".join([", ".join(parts[:-1]), parts[-1]]) if plan.row is not None else f"{parts[0]}  ({parts[1]})", fontsize=9)
 
     first = axes[0]
@@ -520,16 +528,16 @@ def atlas_figure(
     handles = []
     for v in present:
         hatch = _HATCH_DEGENERATE if v < 0 else None
-        handles.append(Patch(facecolor=colour(v), edgecolor="none", hatch=hatch, label=class_label(v)))
+        handles.append(Patch(facecolor=colour(v, stable), edgecolor="none", hatch=hatch, label=class_label(v, system)))
     if drawn["stability"]:
         handles.append(Line2D([], [], color=_BOUNDARY, lw=1.5, label="stability boundary"))
     if drawn["classes"]:
-        handles.append(Line2D([], [], color=_CLASS_EDGE, lw=0.6, label="N$_c$ changes"))
+        handles.append(Line2D([], [], color=_CLASS_EDGE, lw=0.6, label=f"{_mathtext(system.label_symbol)} changes"))
     if drawn["inferred"] and not drawn["light"]:
         handles.append(Patch(facecolor="white", edgecolor="#00000066", lw=0, hatch=_HATCH_INFERRED, label="inferred from cell\ncorners (not computed)"))
     elif drawn["inferred"]:
         handles.append(Patch(facecolor="#DDDDDD", edgecolor="none", label="lighter: inferred from cell\ncorners (not computed)"))
-    legend = {"frameon": False, "title": "complex root pairs N$_c$", "fontsize": 9, "title_fontsize": 9}
+    legend = {"frameon": False, "title": system.label_title, "fontsize": 9, "title_fontsize": 9}
     if plan.facet is None:
         fig.legend(handles=handles, loc="outside right upper", alignment="left", **legend)
     else:
@@ -542,11 +550,12 @@ def atlas_figure(
     return fig
 
 
-def _title(ds: xr.Dataset, plan: FigurePlan, shown: np.ndarray, chars: int) -> str:
-    """The atlas title, the stable fraction of the points shown, the fixed axes, the panels and the notes."""
+def _title(ds: xr.Dataset, plan: FigurePlan, stable: np.ndarray, chars: int) -> str:
+    """The atlas title, the stable fraction of the points shown (``stable``: a mask of them), the fixed axes,
+    the panels and the notes."""
     title = [textwrap.fill(ds.attrs.get("title", "") or "stabmap atlas", chars)]
     part = plan.facet is not None or bool(plan.fixed)
-    title.append(f"{100 * float(np.mean(shown == 0)):.1f} % of {'the ' if part else ''}{shown.size:,} grid points{' shown' if part else ''} stable")
+    title.append(f"{100 * float(np.mean(stable)):.1f} % of {'the ' if part else ''}{stable.size:,} grid points{' shown' if part else ''} stable")
     if plan.fixed:
         fixed = []
         for k, (i, asked) in plan.fixed.items():
@@ -575,13 +584,19 @@ def plot_atlas(
 
     Every check runs before anything is written, so bad options leave no file.
     """
+    path = check_figure_path(path)
+    return save_figure(atlas_figure(ds, x=x, y=y, sel=sel, facet=facet, max_panels=max_panels), path)
+
+
+def check_figure_path(path: str | Path) -> Path:
+    """A figure file that can be written: a .png or .pdf name in a writable directory."""
     path = check_writable(path)
     if path.suffix.lower() not in (".png", ".pdf"):
         raise StabmapError(f"plot file {str(path)!r}: use a .png or .pdf name")
-    return _save(atlas_figure(ds, x=x, y=y, sel=sel, facet=facet, max_panels=max_panels), path)
+    return path
 
 
-def _save(fig, path: Path) -> Path:
+def save_figure(fig, path: Path) -> Path:
     """Write the figure atomically (a temporary file renamed into place), then close it."""
     import matplotlib.pyplot as plt
 
@@ -602,9 +617,7 @@ def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | N
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    path = check_writable(path)
-    if path.suffix.lower() not in (".png", ".pdf"):
-        raise StabmapError(f"plot file {str(path)!r}: use a .png or .pdf name")
+    path = check_figure_path(path)
     along = ds.attrs["critical_along"]
     lower, upper = ds[f"{along}_stable_lower"], ds[f"{along}_stable_upper"]
     dims = [d for d in lower.dims if d != "interval"]
@@ -653,4 +666,4 @@ def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | N
     if chosen:
         title += "; " + ", ".join(f"{k} = {v:.4g}" for k, v in chosen.items())
     ax.set_title(title, fontsize=10)
-    return _save(fig, path)
+    return save_figure(fig, path)

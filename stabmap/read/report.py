@@ -10,8 +10,8 @@ import math
 import numpy as np
 import xarray as xr
 
-from .errors import StabmapError
-from .query import CRITICAL_HINT, PAD_NC, Label, StableFraction
+from ..errors import StabmapError
+from .query import CRITICAL_HINT, Label, StableFraction
 
 FORMATS = ("text", "csv", "json")
 
@@ -53,16 +53,24 @@ def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
     for k, v in label.requested.items():
         note = " (outside the grid: nearest edge)" if k in label.outside else ""
         lines.append(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g} {_units(atlas, k)}".rstrip() + note)
-    lines.append(f"n_complex_pairs = {label.n_complex_pairs}")
-    if label.inferred:
-        lines.append(f"stability = {label.stability} (not computed: inferred from the agreeing corners of its grid cell; docs/refine.md)")
-    else:
-        lines.append(f"stability = {label.stability} (decided by {label.decided_by.replace('_', ' ')})")
+    shown = [(k, v) for k, v in label.values.items() if k != label.provenance]
+    lines += [f"{k} = {_value(v)}" for k, v in shown]
+    if label.provenance is not None:
+        how = label.values[label.provenance]
+        lines[-1] += (
+            " (not computed: inferred from the agreeing corners of its grid cell; docs/refine.md)"
+            if label.inferred
+            else f" (decided by {how.replace('_', ' ')})"
+        )
     return "\n".join(lines)
 
 
+def _value(v) -> str:
+    return np.array2string(v, precision=8) if isinstance(v, np.ndarray) else str(v)
+
+
 def _label_record(label: Label) -> dict:
-    return {**label.grid_point, "n_complex_pairs": label.n_complex_pairs, "stability": label.stability, "decided_by": label.decided_by}
+    return {**label.grid_point, **{k: _plain(v) for k, v in label.values.items()}}
 
 
 def _label_csv(label: Label, atlas) -> str:
@@ -72,8 +80,7 @@ def _label_csv(label: Label, atlas) -> str:
 def _label_json(label: Label, atlas) -> str:
     return _json({
         "stabmap_query": "label_at", "requested": label.requested, "grid_point": label.grid_point,
-        "outside": list(label.outside), "n_complex_pairs": label.n_complex_pairs, "stability": label.stability,
-        "decided_by": label.decided_by, "inferred": label.inferred,
+        "outside": list(label.outside), **label.values, "inferred": label.inferred,
     })
 
 
@@ -161,28 +168,29 @@ def _more(n: int, limit: int) -> list[str]:
 
 def _boundaries_text(b: xr.Dataset, frame, limit: int) -> str:
     along, units = b.attrs["along"], b.attrs["along_units"]
+    lab, sym = b.attrs["label"], b.attrs["label_symbol"]
     u = f" [{units}]" if units else ""
     n, lines_total = b.sizes["boundary"], b.attrs["n_lines"]
     lines = [
-        f"boundaries along {along}{u}: {n} change{'s' if n != 1 else ''} of N_c on {b.attrs['n_lines_with_boundary']} "
+        f"boundaries along {along}{u}: {n} change{'s' if n != 1 else ''} of {sym} on {b.attrs['n_lines_with_boundary']} "
         f"of {lines_total} line{'s' if lines_total != 1 else ''}, each between two neighbouring grid values"
     ]
     lines += _head(b)
     others = [c for c in frame.columns if c in b.coords and b[c].ndim == 1]
     header = [f"{d} [{b[d].attrs['units']}]" if b[d].attrs.get("units") else d for d in others]
-    header += [f"{along} lower", f"{along} upper", "N_c below", "N_c above"]
+    header += [f"{along} lower", f"{along} upper", f"{sym} below", f"{sym} above"]
     rows = []
     shown = frame if not limit else frame.iloc[:limit]
     star = False
     for r in shown.to_dict(orient="records"):
-        nb = f"{r['n_complex_pairs_below']}" + ("*" if r["inferred_below"] else "")
-        na = f"{r['n_complex_pairs_above']}" + ("*" if r["inferred_above"] else "")
+        nb = f"{r[lab + '_below']}" + ("*" if r["inferred_below"] else "")
+        na = f"{r[lab + '_above']}" + ("*" if r["inferred_above"] else "")
         star |= bool(r["inferred_below"] or r["inferred_above"])
         rows.append([_g(r[d]) for d in others] + [_g(r["boundary_lower"]), _g(r["boundary_upper"]), nb, na])
     if rows:
         lines += _table(header, rows)
     else:
-        lines.append(f"N_c does not change between neighbouring grid values of {along} anywhere in this selection")
+        lines.append(f"{sym} does not change between neighbouring grid values of {along} anywhere in this selection")
     lines += _more(len(frame), limit)
     if star:
         lines.append("* not computed: inferred from the agreeing corners of its grid cell (docs/refine.md)")
@@ -192,13 +200,14 @@ def _boundaries_text(b: xr.Dataset, frame, limit: int) -> str:
 
 def _smallest_text(s: xr.Dataset, frame, limit: int) -> str:
     along, units = s.attrs["along"], s.attrs["along_units"]
+    lab, sym = s.attrs["label"], s.attrs["label_symbol"]
     u = f" [{units}]" if units else ""
     lo, hi = s.attrs["along_range"]
     lines = [f"smallest stable {along}{u}, searched upward over {s.attrs['along_grid_values']} grid values {lo:.8g} .. {hi:.8g}"]
     lines += _head(s)
     others = [d for d in s["smallest_stable"].dims]
     header = [f"{d} [{s[d].attrs['units']}]" if s[d].attrs.get("units") else d for d in others]
-    header += [f"smallest stable {along}", "unstable below", "N_c below", "stable to end"]
+    header += [f"smallest stable {along}", "unstable below", f"{sym} below", "stable to end"]
     rows = []
     shown = frame if not limit else frame.iloc[:limit]
     star = False
@@ -208,7 +217,8 @@ def _smallest_text(s: xr.Dataset, frame, limit: int) -> str:
         else:
             first = _g(r["smallest_stable"]) + ("*" if r["inferred"] else "")
             below = _g(r["unstable_below"]) if not np.isnan(r["unstable_below"]) else "(scan start)"
-            ncb = f"{r['n_complex_pairs_below']}" + ("*" if r["inferred_below"] else "") if r["n_complex_pairs_below"] != PAD_NC else "-"
+            below_label = r[lab + "_below"]
+            ncb = f"{below_label}" + ("*" if r["inferred_below"] else "") if below_label != s.attrs["label_fill"] else "-"
         star |= bool(r["inferred"] or r["inferred_below"])
         rows.append([_g(r[d]) for d in others] + [first, below, ncb, _g(r["stable_to_scan_end"]) if first != "none" else "-"])
     lines += _table(header, rows)

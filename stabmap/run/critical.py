@@ -8,14 +8,16 @@ point of the scene's other grid axes, without a dense grid along ``along``:
 2. **Brackets.** Every pair of adjacent scan values with different N_c is a
    bracket: a change of N_c certainly lies between its ends.
 3. **Bisection.** All brackets are halved together, one batch of certified
-   decisions per step (in chunks on a thread pool; the kernels release the
-   GIL), until hi - lo <= max(rtol * max(|lo|, |hi|), atol).  A midpoint whose
+   decisions per step (in tasks through the run's runner: threads here or a
+   dask cluster), until hi - lo <= max(rtol * max(|lo|, |hi|), atol).  A midpoint whose
    N_c differs from both ends reveals two changes; the bracket is split in two
    and both are followed.
 4. **Intervals.** The brackets and the scan values between them partition the
    scan range; each maximal piece with N_c = 0 is a stable interval.
 
-Every N_c involved is a proof (``stabmap.decide``), so each located boundary
+N_c stands for the system's label (``System.label``; for gyroscopes the number
+of complex root pairs), and "stable" for its ``stable_label``.  Every label
+involved is a proof (``System.evaluate``), so each located boundary
 lies certainly inside its final bracket, and each stable interval's stored ends
 are points proved stable (the *inner* bounds) next to points proved to have a
 different N_c (the *outer* bounds).  What is assumed is only that nothing
@@ -32,28 +34,27 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from .atlas import compute as compute_atlas
-from .atlas import coordinates, global_attrs
-from .cluster import check_threads
-from .decide import BY_EXACT, decide_values
-from .errors import StabmapError
-from .parameters import parse_name
-from .scene import Scene
-from .variables import DECIDED_BY, N_COMPLEX_PAIRS
+from .. import systems
+from ..errors import StabmapError
+from ..store.dataset import coordinates, global_attrs
+from ..systems.base import SceneBase
+from . import runner
+from .atlas import decide_grid
+from .chunks import check_chunk_points, default_chunk_points, spans
+from .tasks import evaluate_points
 
 KIND = "critical values"  # global attribute stabmap_kind of every critical-values Dataset
 DEFAULT_RTOL = 1e-10
 MIN_RTOL = 1e-15  # a few ulps: bisection in float64 cannot go finer anyway
 ATOL_FACTOR = 1e-6  # default atol = ATOL_FACTOR * rtol * max |scan value|, for boundaries at or near 0
 MAX_ITERATIONS = 2200  # bisection of float64 reaches adjacent floats long before (about 2100 halvings worst case)
-PAD_NC = -2  # n_complex_pairs_below/above where a point has fewer boundaries than the boundary dimension
 
 ASSUMPTION = (
-    "Changes of n_complex_pairs are searched for only between adjacent scan values whose n_complex_pairs differ. "
+    "Changes of {label} are searched for only between adjacent scan values whose {label} differ. "
     "Features narrower than the scan spacing are not found: a stable or unstable interval lying wholly between "
     "two adjacent scan values, or an even number of changes within one scan step, is invisible unless a "
     "bisection midpoint happens to land on it. Everything that is reported is proved: every located boundary "
-    "lies inside its bracket, whose two ends have certified, different n_complex_pairs."
+    "lies inside its bracket, whose two ends have certified, different {label}."
 )
 
 
@@ -85,10 +86,18 @@ class _Counts:
     scan_points: int = 0
     bisection_points: int = 0
     iterations: int = 0
-    exact: int = 0
+    provenance: dict = None  # flag value -> points it decided
+
+    def decided(self, system, results: dict) -> None:
+        if system.provenance is None:
+            return
+        values, n = np.unique(results[system.provenance], return_counts=True)
+        self.provenance = self.provenance or {}
+        for v, c in zip(values.tolist(), n.tolist()):
+            self.provenance[v] = self.provenance.get(v, 0) + c
 
 
-def check_along(scene: Scene, along: str) -> int:
+def check_along(scene: SceneBase, along: str) -> int:
     """Index of the grid axis ``along``; a StabmapError naming the axes if it is not one."""
     names = [a.name for a in scene.grid]
     if along not in names:
@@ -113,20 +122,23 @@ def check_rtol(rtol) -> float:
 
 
 def critical(
-    scene: Scene,
+    scene: SceneBase,
     along: str = "omega",
     *,
     rtol: float = DEFAULT_RTOL,
     atol: float | None = None,
+    client=None,
+    workers: int | None = None,
     threads: int | None = None,
     progress: bool | None = None,
+    chunk_points: int | None = None,
 ) -> xr.Dataset:
     """The intervals of ``along`` where the rotation is stable, ends located to ``rtol``.
 
     Parameters
     ----------
-    scene : Scene
-        Bodies, support and grid. ``along`` must be one of its grid axes; its
+    scene : a scene of any system
+        Its grid: ``along`` must be one of its grid axes; its
         values are the scan (so ``num`` sets how fine a feature can be found),
         and the other grid axes are the dimensions of the result.
     along : str
@@ -138,10 +150,9 @@ def critical(
         Absolute floor of the bracket width. It only matters for a boundary at
         or very near 0, where a relative width cannot be reached. Default:
         1e-6 * rtol * max |scan value|.
-    threads : int, optional
-        Threads (default: all cores).
-    progress : bool, optional
-        Progress bar on stderr for a scan over two seconds (default: when stderr is a terminal).
+    client, workers, threads, progress, chunk_points
+        As for ``compute_atlas``: the scan and every bisection step run in tasks of about half a second on
+        threads here (default), a cluster (``client``) or a local cluster of ``workers`` processes.
 
     Returns
     -------
@@ -151,7 +162,11 @@ def critical(
     """
     index = check_along(scene, along)
     rtol = check_rtol(rtol)
-    threads = check_threads(threads)
+    chunk_points = check_chunk_points(chunk_points)
+    runner.check_where(client, workers, threads)
+    system = systems.of(scene)
+    if system.stable_label is None:
+        raise StabmapError(f"critical values are the ends of stable intervals; {system.name} atlases have no stability")
     scan = np.sort(scene.grid[index].array)
     if atol is None:
         atol = ATOL_FACTOR * rtol * float(np.abs(scan).max())
@@ -160,22 +175,24 @@ def critical(
     others = tuple(a for d, a in enumerate(scene.grid) if d != index)
     counts = _Counts()
     t0 = time.perf_counter()
-    nc = _scan(scene, index, threads, progress, counts)
-    brackets = _bisect(scene, along, others, _initial_brackets(nc, scan), rtol, atol, threads, counts)
-    ds = _dataset(scene, along, others, scan, nc, brackets)
-    ds.attrs.update(_attrs(along, scan, rtol, atol, counts))
+    with runner.start(client, workers=workers, threads=threads, announce=bool(progress)) as run:
+        nc = _scan(run, scene, index, progress, chunk_points, counts)
+        brackets = _bisect(run, scene, along, others, _initial_brackets(nc, scan), rtol, atol, chunk_points, counts)
+    ds = _dataset(system, scene, along, others, scan, nc, brackets)
+    ds.attrs.update(_attrs(system, along, scan, rtol, atol, counts))
     ds.attrs["history"] += _history(along, counts, time.perf_counter() - t0)
     return ds
 
 
-def _scan(scene: Scene, index: int, threads: int, progress: bool | None, counts: _Counts) -> np.ndarray:
-    """N_c on the whole grid, as (other axes..., along) with the along values increasing."""
-    atlas = compute_atlas(scene, threads=threads, progress=progress)
-    nc = np.moveaxis(atlas[N_COMPLEX_PAIRS].values, index, -1)
+def _scan(run, scene, index: int, progress, chunk_points, counts: _Counts) -> np.ndarray:
+    """The label on the whole grid, as (other axes..., along) with the along values increasing."""
+    system = systems.of(scene)
+    arrays = decide_grid(run, scene, progress=progress, chunk_points=chunk_points)
+    nc = np.moveaxis(arrays[system.label], index, -1)
     if scene.grid[index].values[0] > scene.grid[index].values[-1]:
         nc = nc[..., ::-1]
     counts.scan_points = nc.size
-    counts.exact += int((atlas[DECIDED_BY].values == BY_EXACT).sum())
+    counts.decided(system, arrays)
     return np.ascontiguousarray(nc)
 
 
@@ -194,8 +211,9 @@ def _converged(b: _Brackets, rtol: float, atol: float) -> np.ndarray:
     return (width <= np.maximum(rtol * np.maximum(np.abs(b.lo), np.abs(b.hi)), atol)) | no_room
 
 
-def _bisect(scene, along, others, brackets: _Brackets, rtol, atol, threads, counts: _Counts) -> _Brackets:
-    """Halve every bracket until converged (one batched decision per step); returns all final brackets."""
+def _bisect(run, scene, along, others, brackets: _Brackets, rtol, atol, chunk_points, counts: _Counts) -> _Brackets:
+    """Halve every bracket until converged (one batch of tasks per step); returns all final brackets."""
+    system = systems.of(scene)
     shape = tuple(len(a.values) for a in others)
     done = []
     active = brackets
@@ -209,14 +227,30 @@ def _bisect(scene, along, others, brackets: _Brackets, rtol, atol, threads, coun
         idx = np.unravel_index(active.owner, shape) if shape else ()
         values = {a.name: a.array[i] for a, i in zip(others, idx)}
         values[along] = mid
-        nc_mid, by = decide_values(scene, values, threads=threads)
+        results = _decide_points(run, scene, values, chunk_points)
         counts.bisection_points += mid.size
-        counts.exact += int((by == BY_EXACT).sum())
+        counts.decided(system, results)
         counts.iterations += 1
-        active = _halve(active, mid, nc_mid)
+        active = _halve(active, mid, results[system.label])
     else:  # pragma: no cover - float64 bisection always reaches neighbouring doubles first
         raise RuntimeError("bisection did not converge")
     return _Brackets.concat(done)
+
+
+def _decide_points(run, scene, values: dict[str, np.ndarray], chunk_points: int | None) -> dict[str, np.ndarray]:
+    """Every variable at the points given by equal-length arrays of axis values, in tasks on ``run``."""
+    npts = len(next(iter(values.values())))
+    bounds = spans(npts, chunk_points or default_chunk_points(scene, run.threads, npts))
+    out = {}
+
+    def keep(i, result):
+        a, b = bounds[i]
+        for k, v in result.items():
+            out.setdefault(k, np.empty((npts,) + v.shape[1:], dtype=v.dtype))[a:b] = v
+
+    args = [(scene, {k: v[a:b] for k, v in values.items()}) for a, b in bounds]
+    run.run(evaluate_points, args, list(range(len(bounds))), keep)
+    return out
 
 
 def _halve(b: _Brackets, mid: np.ndarray, nc_mid: np.ndarray) -> _Brackets:
@@ -230,7 +264,7 @@ def _halve(b: _Brackets, mid: np.ndarray, nc_mid: np.ndarray) -> _Brackets:
 
 @dataclass
 class _Table:
-    """Per-point results, padded along the interval and boundary dimensions (NaN, or PAD_NC for counts)."""
+    """Per-point results, padded along the interval and boundary dimensions (NaN, or the label's fill value)."""
 
     n_intervals: np.ndarray
     lower: np.ndarray
@@ -243,13 +277,13 @@ class _Table:
     nc_above: np.ndarray
 
 
-def _table(nc: np.ndarray, scan: np.ndarray, b: _Brackets) -> _Table:
+def _table(nc: np.ndarray, scan: np.ndarray, b: _Brackets, stable: int, fill: int) -> _Table:
     """Stable intervals and boundaries of every point of the other axes."""
     flat = nc.reshape(-1, scan.size)
     npoints = flat.shape[0]
     b = b.take(np.lexsort((b.lo, b.owner)))
     starts = np.concatenate([[0], np.cumsum(np.bincount(b.owner, minlength=npoints))])
-    intervals = [_stable_intervals(flat[p, 0], scan, b.take(slice(starts[p], starts[p + 1]))) for p in range(npoints)]
+    intervals = [_stable_intervals(flat[p, 0], scan, b.take(slice(starts[p], starts[p + 1])), stable) for p in range(npoints)]
     n_int = np.array([len(i) for i in intervals], dtype=np.int16)
     ni = max(1, int(n_int.max(initial=0)))
     nb = max(1, int(np.diff(starts).max(initial=0)))
@@ -259,13 +293,13 @@ def _table(nc: np.ndarray, scan: np.ndarray, b: _Brackets) -> _Table:
             ends[:, p, i] = row
     slot = np.arange(len(b)) - starts[b.owner]
     bounds = np.full((2, npoints, nb), np.nan)
-    counts = np.full((2, npoints, nb), PAD_NC, dtype=np.int16)
+    counts = np.full((2, npoints, nb), fill, dtype=nc.dtype)
     bounds[0, b.owner, slot], bounds[1, b.owner, slot] = b.lo, b.hi
     counts[0, b.owner, slot], counts[1, b.owner, slot] = b.nc_lo, b.nc_hi
     return _Table(n_int, *ends, *bounds, *counts)
 
 
-def _stable_intervals(nc_start: int, scan: np.ndarray, b: _Brackets) -> list[tuple[float, float, float, float]]:
+def _stable_intervals(nc_start: int, scan: np.ndarray, b: _Brackets, stable: int) -> list[tuple[float, float, float, float]]:
     """(lower, upper, lower_outer, upper_outer) of each stable interval of one point; NaN outer: scan end.
 
     The sorted brackets and the scan steps between them partition the scan
@@ -276,7 +310,7 @@ def _stable_intervals(nc_start: int, scan: np.ndarray, b: _Brackets) -> list[tup
         raise AssertionError("brackets do not chain")
     out = []
     for i in range(k + 1):
-        if (nc_start if i == 0 else b.nc_hi[i - 1]) != 0:
+        if (nc_start if i == 0 else b.nc_hi[i - 1]) != stable:
             continue
         lower, lower_outer = (scan[0], np.nan) if i == 0 else (b.hi[i - 1], b.lo[i - 1])
         upper, upper_outer = (scan[-1], np.nan) if i == k else (b.lo[i], b.hi[i])
@@ -284,12 +318,14 @@ def _stable_intervals(nc_start: int, scan: np.ndarray, b: _Brackets) -> list[tup
     return out
 
 
-def _dataset(scene, along, others, scan, nc, brackets) -> xr.Dataset:
-    info = parse_name(along, scene.n, scene.support)
+def _dataset(system, scene, along, others, scan, nc, brackets) -> xr.Dataset:
+    info = system.parameter(scene, along)
+    label = system.variable(system.label)
     dims = tuple(a.name for a in others)
     shape = tuple(len(a.values) for a in others)
-    t = _table(nc, scan, brackets)
+    t = _table(nc, scan, brackets, system.stable_label, label.fill)
     iv, bd = dims + ("interval",), dims + ("boundary",)
+    lab = label.name
 
     def grid(a):
         return a.reshape(shape + a.shape[1:])
@@ -298,7 +334,7 @@ def _dataset(scene, along, others, scan, nc, brackets) -> xr.Dataset:
         return {"long_name": f"{long_name} ({info.long_name})", "units": info.units, "comment": comment}
 
     def count_attrs(long_name):
-        return {"long_name": long_name, "units": "1", "comment": f"-1: p vanishes identically; {PAD_NC}: fill (no boundary)"}
+        return {"long_name": long_name, "units": label.units or "1", "comment": f"{label.fill}: fill (no boundary); otherwise as {lab}"}
 
     data = {
         "n_stable_intervals": (dims, grid(t.n_intervals), {"long_name": "number of stable intervals in the scan range", "units": "1"}),
@@ -310,17 +346,17 @@ def _dataset(scene, along, others, scan, nc, brackets) -> xr.Dataset:
         f"{along}_stable_upper_outer": (iv, grid(t.upper_outer), along_attrs(
             "value just above a stable interval", "proved unstable; the boundary lies in [upper, upper_outer); "
             "NaN where the interval ends at the scan range end (it may continue above)")),
-        "boundary_lower": (bd, grid(t.b_lower), along_attrs("lower end of the bracket of a change of n_complex_pairs", "n_complex_pairs_below holds here, proved; NaN pads")),
-        "boundary_upper": (bd, grid(t.b_upper), along_attrs("upper end of the bracket of a change of n_complex_pairs", "n_complex_pairs_above holds here, proved; a change lies in (lower, upper]; NaN pads")),
-        "n_complex_pairs_below": (bd, grid(t.nc_below), count_attrs("n_complex_pairs at boundary_lower")),
-        "n_complex_pairs_above": (bd, grid(t.nc_above), count_attrs("n_complex_pairs at boundary_upper")),
+        "boundary_lower": (bd, grid(t.b_lower), along_attrs(f"lower end of the bracket of a change of {lab}", f"{lab}_below holds here, proved; NaN pads")),
+        "boundary_upper": (bd, grid(t.b_upper), along_attrs(f"upper end of the bracket of a change of {lab}", f"{lab}_above holds here, proved; a change lies in (lower, upper]; NaN pads")),
+        f"{lab}_below": (bd, grid(t.nc_below), count_attrs(f"{lab} at boundary_lower")),
+        f"{lab}_above": (bd, grid(t.nc_above), count_attrs(f"{lab} at boundary_upper")),
     }
-    attrs = global_attrs(scene, "stabmap critical values")
-    return xr.Dataset(data, coords=coordinates(scene, skip=(along,)), attrs=attrs)
+    attrs = global_attrs(system, scene, "stabmap critical values")
+    return xr.Dataset(data, coords=coordinates(system, scene, skip=(along,)), attrs=attrs)
 
 
-def _attrs(along, scan, rtol, atol, counts: _Counts) -> dict:
-    return {
+def _attrs(system, along, scan, rtol, atol, counts: _Counts) -> dict:
+    attrs = {
         "stabmap_kind": KIND,
         "critical_along": along,
         "critical_rtol": rtol,
@@ -330,10 +366,13 @@ def _attrs(along, scan, rtol, atol, counts: _Counts) -> dict:
         "critical_scan_max_step": float(np.diff(scan).max()),
         "critical_evaluated_points": np.int64(counts.scan_points + counts.bisection_points),
         "critical_bisection_steps": np.int64(counts.iterations),
-        "critical_decided_exactly": np.int64(counts.exact),
         "comment": "Ends are located until hi - lo <= max(rtol * max(|lo|, |hi|), atol), or lo and hi are neighbouring "
-        "doubles. " + ASSUMPTION,
+        "doubles. " + ASSUMPTION.format(label=system.label),
     }
+    if counts.provenance is not None:
+        flags = system.variable(system.provenance)
+        attrs[f"critical_{flags.name}"] = "; ".join(f"{m}: {counts.provenance.get(v, 0)}" for v, m in flags.flags)
+    return attrs
 
 
 def _history(along, counts: _Counts, seconds: float) -> str:

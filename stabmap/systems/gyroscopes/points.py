@@ -136,30 +136,3 @@ def point_arrays(scene: Scene, values: dict[str, np.ndarray]) -> PointArrays:
         parent=parent,
         at=kernel_order(at.reshape(npts, scene.n)),
     )
-
-
-def block_arrays(scene: Scene, location: list[tuple[int, int]], order: tuple[int, ...] | None = None) -> PointArrays:
-    """Per-point arrays for the block ``location`` = [(start, stop) per grid axis].
-
-    Points come in C order over the axes taken in ``order`` (default: the grid's
-    own order; the last axis listed varies fastest).
-    """
-    order = tuple(range(len(location))) if order is None else tuple(order)
-    values = {}
-    for pos, d in enumerate(order):
-        start, stop = location[d]
-        view = [None] * len(location)
-        view[pos] = slice(None)
-        values[scene.grid[d].name] = scene.grid[d].array[start:stop][tuple(view)]
-    return point_arrays(scene, values)
-
-
-def spin_axes_last(scene: Scene) -> tuple[int, ...]:
-    """Grid axes ordered so that spin-rate axes vary fastest.
-
-    The kernels rebuild the inertia and stiffness matrices only when a point's
-    masses, lengths or stiffnesses differ from the previous point's, so runs of
-    points that differ only in omega skip that work.
-    """
-    spin = [d for d, a in enumerate(scene.grid) if a.name == "omega" or a.name.startswith("omega_")]
-    return tuple(d for d in range(len(scene.grid)) if d not in spin) + tuple(spin)

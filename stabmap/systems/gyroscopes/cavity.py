@@ -15,7 +15,7 @@ import numpy as np
 from scipy import special
 from scipy.optimize import elementwise
 
-from .errors import StabmapError
+from ...errors import StabmapError
 
 SHAPES = ("spheroid", "cylinder")
 DEFAULT_MODES = 8  # cylinder modes kept with the tail: 1e-4 on the critical spin (scripts/bench_truncation.py, BENCHMARKS.md)

@@ -1,0 +1,263 @@
+"""What each ``stabmap`` command does, as a Python function: every check first, then the work.
+
+The CLI (``stabmap.cli``) only reads its options and calls these; each returns
+what the command reports (and a script may call them alike).  Every check that
+can fail runs before any work starts, so bad input leaves no file.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .errors import StabmapError
+
+
+@dataclass
+class Done:
+    """What a command reports: ``notes`` (files written, notes; standard error) and ``text`` (standard output)."""
+
+    notes: list[str] = field(default_factory=list)
+    text: str = ""
+
+
+def scene(path: str | Path | None = None, example: str | None = None):
+    """The scene of a command: a scene file or a bundled example, exactly one of the two."""
+    from .examples import example as bundled
+    from .systems import load_scene
+
+    if (path is None) == (example is None):
+        raise StabmapError("give a scene file or --example NAME (not both); see 'stabmap examples'")
+    return load_scene(path) if path is not None else bundled(example)
+
+
+def atlas(
+    scene,
+    output: str | Path,
+    *,
+    png: str | Path | None = None,
+    refine: bool = False,
+    coarse_stride: int | None = None,
+    margin: int | None = None,
+    resume: bool = False,
+    client=None,
+    workers: int | None = None,
+    threads: int | None = None,
+    chunk_points: int | None = None,
+    progress: bool | None = None,
+) -> Done:
+    """``stabmap atlas``: compute the atlas of ``scene`` into ``output`` (and draw it to ``png``)."""
+    from .read.plot import check_figure_path, plot_atlas
+    from .read.summary import summary
+    from .run import refine as refining
+    from .run import runner
+    from .run.atlas import compute_to_file
+    from .run.chunks import check_chunk_points
+    from .store.files import check_writable, open_atlas, write_atlas
+
+    check_writable(output)
+    if png is not None:
+        check_figure_path(png)
+    runner.check_where(client, workers, threads)
+    check_chunk_points(chunk_points, "--chunk-points")
+    if not refine:
+        given = [opt for opt, v in (("--coarse-stride", coarse_stride), ("--margin", margin)) if v is not None]
+        if given:
+            raise StabmapError(f"{given[0]} applies to adaptive atlases only; add --refine")
+    elif resume:
+        raise StabmapError("--resume applies to dense atlases; an adaptive atlas (--refine) has no checkpoint to resume")
+    t0 = time.perf_counter()
+    where = {"client": client, "workers": workers, "threads": threads, "progress": progress, "chunk_points": chunk_points}
+    if refine:
+        options = {"coarse_stride": refining.check_coarse_stride(coarse_stride, "--coarse-stride")}
+        options["margin"] = refining.check_margin(refining.DEFAULT_MARGIN if margin is None else margin, "--margin")
+        ds = refining.compute_refined(scene, **options, **where)
+        write_atlas(ds, output)
+        stats = summary_line(summary(ds), ds.attrs.get("n_evaluated_points"))
+    else:
+        report = compute_to_file(scene, output, resume=resume, **where)
+        with open_atlas(output, lazy=True) as ds:
+            stats = summary_line(summary(ds))
+        if report.reused:
+            stats += f"; resumed: {report.reused} of {report.chunks} chunks were already done, {report.computed} computed now"
+    lines = [f"wrote {output}: {stats} in {time.perf_counter() - t0:.1f} s"]
+    if png is not None:
+        with open_atlas(output) as ds:
+            plot_atlas(ds, png)
+        lines.append(f"wrote {png}")
+    return Done(lines)
+
+
+def summary_line(s: dict, evaluated=None) -> str:
+    """One line about a finished atlas: points, stable share, exact decisions, the saving of refinement."""
+    line = f"{s['points']} points, {100 * s['stable_fraction']:.1f} % stable"
+    exact = s.get("decided_by", {}).get("exact_rational_arithmetic")
+    if exact is not None:
+        line += f", {exact} decided in exact arithmetic"
+    if evaluated is not None:
+        evaluated = int(evaluated)
+        line += (
+            f"; refined: {evaluated:,} polynomials evaluated instead of {s['points']:,} "
+            f"({s['points'] / max(1, evaluated):.1f}x fewer), the other points inferred from cell corners"
+        )
+    return line
+
+
+def critical(
+    scene,
+    output: str | Path,
+    *,
+    along: str = "omega",
+    rtol: float | None = None,
+    png: str | Path | None = None,
+    client=None,
+    workers: int | None = None,
+    threads: int | None = None,
+    chunk_points: int | None = None,
+    progress: bool | None = None,
+    listing: bool = True,
+) -> Done:
+    """``stabmap critical``: the stable intervals of ``along`` into ``output`` (and drawn to ``png``)."""
+    from .read.info import intervals
+    from .read.plot import check_figure_path, plot_critical
+    from .run import critical as located
+    from .run import runner
+    from .store.files import check_writable, write_atlas
+
+    check_writable(output)
+    runner.check_where(client, workers, threads)
+    if png is not None:
+        check_figure_path(png)
+        others = [a.name for a in scene.grid if a.name != along]
+        if len(others) > 1 and along in {a.name for a in scene.grid}:
+            # A picture shows one other axis; fail before the work rather than after it.
+            raise StabmapError(
+                f"--png draws one other axis, but this scene has {len(others)} ({', '.join(others)}); drop --png and draw "
+                f"the file afterwards with 'stabmap plot {output} -o PNG --sel {others[-1]}=VALUE'"
+            )
+    t0 = time.perf_counter()
+    rtol = located.DEFAULT_RTOL if rtol is None else rtol
+    ds = located.critical(scene, along, rtol=rtol, client=client, workers=workers, threads=threads, progress=progress, chunk_points=chunk_points)
+    write_atlas(ds, output)
+    lines = [f"wrote {output} in {time.perf_counter() - t0:.1f} s"]
+    if png is not None:
+        plot_critical(ds, png)
+        lines.append(f"wrote {png}")
+    return Done(lines, "\n".join(intervals(ds)) if listing else "")
+
+
+def info(path: str | Path) -> str:
+    """``stabmap info``: what an atlas file holds."""
+    from .read.info import describe
+    from .store.files import open_atlas
+
+    with open_atlas(path, lazy=True) as ds:
+        return describe(ds, str(path))
+
+
+def query(
+    path: str | Path,
+    items: list[str] = (),
+    *,
+    fraction: bool = False,
+    boundaries: str | None = None,
+    smallest_stable: str | None = None,
+    over: str | None = None,
+    fmt: str = "text",
+    limit: int = 40,
+) -> str:
+    """``stabmap query``: the label at a point, or the answer to one question about a slice (docs/query.md).
+
+    ``items`` are ``NAME=VALUE`` or ``NAME=LO:HI``; a question's axis may also come first among them.
+    """
+    from .read import query as q
+    from .read.report import render
+    from .store.files import open_atlas
+
+    items = list(items)
+    asked = [opt for opt, v in (("--fraction", fraction or None), ("--boundaries", boundaries), ("--smallest-stable", smallest_stable)) if v]
+    if len(asked) > 1:
+        raise StabmapError(f"ask one question at a time: {' and '.join(asked)} were both given")
+    if limit < 0:
+        raise StabmapError(f"--limit must be >= 0 (0 shows every row), got {limit}")
+    if over is not None and smallest_stable is None:
+        raise StabmapError("--over applies to --smallest-stable only, e.g. --smallest-stable omega --over K_1")
+    for option, axis in (("--boundaries", boundaries), ("--smallest-stable", smallest_stable)):
+        if axis is not None and "=" in axis:  # NAME=VALUE right after the option: the axis was left out
+            if option == "--boundaries":
+                raise StabmapError(f"{option}: name the axis to search along first, e.g. {option} omega K_1=3")
+            items.insert(0, axis)
+            smallest_stable = "omega"
+    ds = open_atlas(path)
+    if ds.attrs.get("stabmap_kind") == "critical values":
+        raise StabmapError(f"{path} holds critical values, not an atlas; 'stabmap info {path}' lists its intervals")
+    sel = q.parse_selection(items)
+    if boundaries is not None:
+        result = q.boundaries(ds, boundaries, **sel)
+    elif smallest_stable is not None:
+        result = q.smallest_stable(ds, smallest_stable, over, **sel)
+    elif fraction:
+        result = q.stable_fraction(ds, **sel)
+    else:
+        if not items:
+            axes = " ".join(f"{d}=VALUE" for d in q.grid_axes(ds))
+            raise StabmapError(
+                f"give the point: {axes} (nearest grid point), or ask --fraction, --boundaries AXIS or "
+                "--smallest-stable [AXIS]; see 'stabmap query --help'"
+            )
+        result = q.label_at(ds, **sel)
+    return render(result, fmt, limit=limit, atlas=ds)
+
+
+def plot(
+    path: str | Path,
+    output: str | Path,
+    *,
+    x: str | None = None,
+    y: str | None = None,
+    sel: list[str] = (),
+    facet: str | None = None,
+    max_panels: int | None = None,
+) -> Done:
+    """``stabmap plot``: draw an atlas (or critical values) to a PNG or PDF file."""
+    from .read import plot as figures
+    from .read.query import parse_selection
+    from .store.files import open_atlas
+
+    ds = open_atlas(path)
+    chosen = parse_selection(list(sel), ranges=False, option="--sel")
+    if ds.attrs.get("stabmap_kind") == "critical values":
+        given = [opt for opt, v in (("--x", x), ("--y", y), ("--facet", facet), ("--max-panels", max_panels)) if v is not None]
+        if given:
+            raise StabmapError(f"{given[0]} applies to atlases; {path} holds critical values (fix other axes with --sel)")
+        figures.plot_critical(ds, output, sel=chosen)
+        return Done([f"wrote {output}"])
+    options = {"x": x, "y": y, "sel": chosen, "facet": facet, "max_panels": figures.MAX_PANELS if max_panels is None else max_panels}
+    figures.plot_atlas(ds, output, **options)
+    return Done([f"note: {note}" for note in figures.plan_figure(ds, **options).notes] + [f"wrote {output}"])
+
+
+def examples() -> list[str]:
+    """``stabmap examples``: the bundled scenes and their titles."""
+    from .examples import example, example_names
+
+    names = example_names()
+    width = max(map(len, names))
+    return [f"{name:<{width}}  {example(name).title}" for name in names]
+
+
+def interrupted(output: str | Path | None) -> str:
+    """What an interrupted command leaves: no output file, and the finished chunks a --resume will use."""
+    from .store.checkpoint import Checkpoint, partial_dir
+
+    if output is None:
+        return "no output file was written"
+    saved = partial_dir(output)
+    if not saved.is_dir():
+        return f"{output} was not written"
+    try:
+        chunks = len(Checkpoint.open(saved).done())
+    except StabmapError:
+        return f"{output} was not written"
+    return f"{output} was not written; {chunks} finished chunks are saved in {saved}: run the same command with --resume to finish"

@@ -1,0 +1,122 @@
+"""The grid of a scan: one axis per scanned parameter, read from a scene's ``[grid]`` table.
+
+An axis is named exactly like the parameter it scans (the name becomes the
+Dataset dimension) and holds its values, sorted and distinct.  In TOML it is
+``name = { start = .., stop = .., num = .., scale = "linear" | "log" }`` or
+``name = { values = [...] }``.  Which names exist and what values they may take
+is the system's (``parameter``, a function of the name).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..errors import StabmapError
+from .values import Parameter, check_value, no_unknown
+
+SCALES = ("linear", "log", "values")
+_AXIS_KEYS = {"start", "stop", "num", "scale", "values"}
+_NUMBER = Parameter("", "", "")  # any finite number: the limits are the system's (check_axes)
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One scanned parameter: its name (the Dataset dimension) and its values, sorted and distinct."""
+
+    name: str
+    values: tuple[float, ...]
+    scale: str = "linear"  # "linear" | "log" | "values" (listed explicitly)
+
+    def __post_init__(self):
+        where = f"grid.{self.name}"
+        if isinstance(self.values, (str, bytes)) or not hasattr(self.values, "__len__") or not len(self.values):
+            raise StabmapError(f"{where}.values must be a non-empty list of numbers")
+        object.__setattr__(self, "values", tuple(check_value(f"{where}.values[{i + 1}]", v, _NUMBER) for i, v in enumerate(self.values)))
+        if self.scale not in SCALES:
+            raise StabmapError(f'{where}.scale must be "linear", "log" or "values", got {self.scale!r}')
+        diffs = np.diff(self.values)
+        if len(self.values) > 1 and not (np.all(diffs > 0) or np.all(diffs < 0)):
+            raise StabmapError(f"{where}: values must be distinct and sorted (increasing or decreasing)")
+        if self.scale == "log" and min(self.values) <= 0:
+            raise StabmapError(f'{where}: scale = "log" needs values > 0, got {min(self.values)}')
+
+    @property
+    def array(self) -> np.ndarray:
+        return np.asarray(self.values, dtype=np.float64)
+
+    def to_dict(self) -> dict:
+        """The TOML table of the axis: start/stop/num where that gives these very values, else the values."""
+        n = len(self.values)
+        if self.scale in ("linear", "log") and n > 2:
+            spaced = np.geomspace if self.scale == "log" else np.linspace
+            if np.array_equal(spaced(self.values[0], self.values[-1], n), self.array):
+                return {"start": self.values[0], "stop": self.values[-1], "num": n, "scale": self.scale}
+        return {"values": list(self.values), "scale": self.scale}
+
+
+def check_axes(axes: tuple[Axis, ...], parameter: Callable[[str], Parameter]) -> None:
+    """Every axis names a parameter (``parameter`` raises for other names) and holds values it may take."""
+    names = [a.name for a in axes]
+    for a in axes:
+        if names.count(a.name) > 1:
+            raise StabmapError(f"grid axis {a.name!r} is given twice; give each axis once")
+        info = parameter(a.name)
+        for i, v in enumerate(a.values):
+            check_value(f"grid.{a.name}.values[{i + 1}]", v, info)
+
+
+def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
+    """The axes of a ``[grid]`` table; errors name the key (``grid.omega.num``) and the fix."""
+    if not isinstance(raw, dict):
+        raise StabmapError(f"grid must be a table of axes, got {raw!r}")
+    axes = []
+    for name, spec in raw.items():
+        info = parameter(name)
+        where = f"grid.{name}"
+        no_unknown(spec, _AXIS_KEYS, where)
+        if "values" in spec:
+            extra = set(spec) - {"values", "scale"}
+            if extra:
+                raise StabmapError(f"{where}: give either values or start/stop/num, not both (remove {sorted(extra)[0]!r})")
+            values = spec["values"]
+            if not isinstance(values, list) or not values:
+                raise StabmapError(f"{where}.values must be a non-empty list of numbers")
+            axes.append(Axis(name, tuple(values), spec.get("scale", "values")))
+            continue
+        for key in ("start", "stop", "num"):
+            if key not in spec:
+                raise StabmapError(f"{where}.{key} is missing (or give values = [...])")
+        num = spec["num"]
+        if isinstance(num, bool) or not isinstance(num, int) or num < 1:
+            raise StabmapError(f"{where}.num must be a whole number >= 1, got {num!r}")
+        start = check_value(f"{where}.start", spec["start"], info)
+        stop = check_value(f"{where}.stop", spec["stop"], info)
+        scale = spec.get("scale", "linear")
+        if scale == "linear":
+            values = np.linspace(start, stop, num)
+        elif scale == "log":
+            if start <= 0 or stop <= 0:
+                raise StabmapError(f'{where}: scale = "log" needs start > 0 and stop > 0, got {start} and {stop}')
+            values = np.geomspace(start, stop, num)
+        else:
+            raise StabmapError(f'{where}.scale must be "linear" or "log", got {scale!r}')
+        axes.append(Axis(name, tuple(float(v) for v in values), scale))
+    return tuple(axes)
+
+
+def resample(scene, **nums: int):
+    """The scene with the named grid axes resampled to ``nums[name]`` points over the same range and scale."""
+    unknown = set(nums) - {a.name for a in scene.grid}
+    if unknown:
+        raise StabmapError(f"resample: {sorted(unknown)[0]!r} is not a grid axis of this scene")
+    axes = []
+    for a in scene.grid:
+        if a.name in nums:
+            lo, hi = a.values[0], a.values[-1]
+            values = np.geomspace(lo, hi, nums[a.name]) if a.scale == "log" else np.linspace(lo, hi, nums[a.name])
+            a = Axis(a.name, tuple(float(v) for v in values), a.scale)
+        axes.append(a)
+    return replace(scene, grid=tuple(axes))

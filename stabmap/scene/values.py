@@ -1,0 +1,43 @@
+"""A scannable parameter's units and limits, and the one check every number of a scene goes through."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..errors import StabmapError
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """What a parameter name means: symbol, CF units, a long name (``{k}`` for the body or joint) and its limits."""
+
+    symbol: str
+    units: str
+    long_name: str
+    minimum: float | None = None  # None: any finite value
+    strict: bool = False  # minimum excluded
+
+
+def check_value(where: str, value, info: Parameter) -> float:
+    """Return ``value`` as a float or raise a StabmapError naming ``where``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise StabmapError(f"{where} must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise StabmapError(f"{where} must be finite, got {value}")
+    if info.minimum is not None:
+        if info.strict and value <= info.minimum:
+            raise StabmapError(f"{where} must be > {info.minimum:g}, got {value}")
+        if not info.strict and value < info.minimum:
+            raise StabmapError(f"{where} must be >= {info.minimum:g}, got {value}")
+    return value
+
+
+def no_unknown(table, allowed, where: str) -> None:
+    """A TOML table with only ``allowed`` keys, or a StabmapError naming the first other one."""
+    if not isinstance(table, dict):
+        raise StabmapError(f"{where} must be a table, got {table!r}")
+    unknown = sorted(set(table) - set(allowed))
+    if unknown:
+        raise StabmapError(f"{where}: unknown key {unknown[0]!r}; allowed keys are {', '.join(sorted(allowed))}")

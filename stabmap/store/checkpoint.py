@@ -1,0 +1,105 @@
+"""The finished chunks of a run, kept in a Zarr store beside the output, so an interrupted run resumes.
+
+``atlas.nc`` is computed into the Zarr store ``atlas.nc.partial/``, which xarray
+creates with the atlas's coordinates, attributes and empty variables, chunked
+like the tasks (``to_zarr(compute=False)``).  Each finished task is written into
+its region (``to_zarr(region=...)``), and then its flag in ``chunk_done``.  Zarr
+writes every chunk by an atomic rename, so a run killed at any instant leaves
+whole chunks, and a chunk counts as finished only once its flag is set: resuming
+computes the chunks whose flag is not.  The store itself is created under a
+temporary name and renamed into place, so it is complete or absent.  The final
+file is written from it chunk by chunk (bounded memory), and then it is deleted.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import StabmapError
+from .dataset import atlas_dataset
+
+FORMAT = 2  # 1: .npy files and a manifest.json (stabmap 0.1 before the Zarr checkpoint)
+DONE = "chunk_done"
+
+
+def partial_dir(output: str | Path) -> Path:
+    output = Path(output)
+    return output.with_name(output.name + ".partial")
+
+
+class Checkpoint:
+    """Finished chunks of one atlas run: the scene (TOML), the grid's shape and the chunk sizes fix its layout."""
+
+    def __init__(self, path: Path, scene_toml: str, shape: tuple[int, ...], chunks: tuple[int, ...], dims: dict[str, tuple]):
+        self.path, self.scene_toml = Path(path), scene_toml
+        self.shape, self.chunks = tuple(shape), tuple(chunks)
+        self.dims = dims  # the dimensions of every variable, the grid's first
+        self.grid_dims = next(iter(dims.values()))[: len(self.shape)]
+
+    @classmethod
+    def create(cls, path: Path, system, scene, chunks: tuple[int, ...]) -> Checkpoint:
+        """A new, empty checkpoint for ``scene`` cut into ``chunks``, created atomically at ``path``."""
+        import dask.array as da
+
+        nchunks = int(np.prod([-(-n // c) for n, c in zip(scene.shape, chunks)], dtype=np.int64))
+        extra = system.dims(scene)
+        lazy = {}
+        for v in system.variables:
+            sizes = tuple(extra[d] for d in v.dims)
+            lazy[v.name] = da.zeros(scene.shape + sizes, chunks=tuple(chunks) + sizes, dtype=v.dtype)
+        ds = atlas_dataset(system, scene, lazy)
+        ds[DONE] = ("chunk", da.zeros((nchunks,), chunks=1, dtype=np.int8))
+        ds.attrs.update({"stabmap_checkpoint_format": FORMAT, "stabmap_checkpoint_shape": list(scene.shape),
+                         "stabmap_checkpoint_chunks": list(chunks)})
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+        try:
+            ds.to_zarr(tmp, mode="w-", compute=False, consolidated=False)
+            os.replace(tmp, path)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+        return cls.open(path)
+
+    @classmethod
+    def open(cls, path: Path) -> Checkpoint:
+        """The checkpoint at ``path``; a StabmapError if it is not one this version can resume."""
+        import xarray as xr
+
+        try:
+            with xr.open_zarr(path, consolidated=False) as ds:
+                a = ds.attrs
+                if a.get("stabmap_checkpoint_format") != FORMAT:
+                    raise ValueError(f"format {a.get('stabmap_checkpoint_format')!r}, expected {FORMAT}")
+                dims = {k: ds[k].dims for k in ds.data_vars if k != DONE}
+                return cls(path, a["scene"], tuple(a["stabmap_checkpoint_shape"]), tuple(a["stabmap_checkpoint_chunks"]), dims)
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise StabmapError(f"{str(path)!r} is not a readable partial stabmap run ({exc}); delete it to start over") from None
+
+    def done(self) -> set[int]:
+        """The chunks (C order of the chunk grid) whose every variable is written."""
+        import xarray as xr
+
+        with xr.open_zarr(self.path, consolidated=False) as ds:
+            return set(np.flatnonzero(ds[DONE].values == 1).tolist())
+
+    def save(self, index: int, location: tuple[tuple[int, int], ...], block: dict[str, np.ndarray]) -> None:
+        """Write chunk ``index``, the grid region ``location`` ((start, stop) per axis), then mark it finished."""
+        import xarray as xr
+
+        region = {d: slice(a, b) for d, (a, b) in zip(self.grid_dims, location)}
+        data = xr.Dataset({k: (self.dims[k], v) for k, v in block.items()})
+        data.to_zarr(self.path, region=region, consolidated=False)
+        xr.Dataset({DONE: ("chunk", np.ones(1, np.int8))}).to_zarr(self.path, region={"chunk": slice(index, index + 1)}, consolidated=False)
+
+    def arrays(self):
+        """Every variable as a dask array read chunk by chunk, and the open Dataset to close after use."""
+        import xarray as xr
+
+        ds = xr.open_zarr(self.path, consolidated=False)
+        return {k: ds[k].data for k in self.dims}, ds
+
+    def remove(self) -> None:
+        shutil.rmtree(self.path, ignore_errors=True)

@@ -1,0 +1,57 @@
+"""An atlas as a labelled Dataset: the grid axes and fixed parameters as CF coordinates, every variable
+with its declared attributes, and global attributes that carry the scene that made it."""
+
+from __future__ import annotations
+
+import datetime as dt
+
+import numpy as np
+import xarray as xr
+
+from ..version import __version__
+
+FORMAT_VERSION = 4  # 4: stabmap_system; every variable of the system written as declared
+
+
+def coordinates(system, scene, skip: tuple[str, ...] = ()) -> dict:
+    """The grid axes (except ``skip``) and every fixed parameter as CF coordinates with units."""
+    coords = {}
+    for axis in scene.grid:
+        if axis.name in skip:
+            continue
+        info = system.parameter(scene, axis.name)
+        coords[axis.name] = (axis.name, axis.array, {"units": info.units, "long_name": info.long_name, "scale": axis.scale})
+    for key, value in system.fixed_values(scene).items():
+        info = system.parameter(scene, key)
+        coords[key] = ((), np.float64(value), {"units": info.units, "long_name": info.long_name})
+    return coords
+
+
+def global_attrs(system, scene, kind: str) -> dict:
+    """CF global attributes of every file stabmap writes, with the scene that made it."""
+    now = dt.datetime.now(dt.timezone.utc).replace(microsecond=0).isoformat()
+    return {
+        "Conventions": "CF-1.10",
+        "title": scene.title or kind,
+        "source": f"stabmap {__version__}",
+        "history": f"{now} computed by stabmap {__version__}",
+        "references": system.references,
+        "stabmap_format_version": FORMAT_VERSION,
+        "stabmap_system": system.name,
+        **system.attrs(scene),
+        "scene": scene.to_toml(),
+    }
+
+
+def atlas_dataset(system, scene, arrays: dict) -> xr.Dataset:
+    """The atlas Dataset of ``scene`` from one array (numpy or dask) per declared variable, in grid shape."""
+    dims = tuple(a.name for a in scene.grid)
+    data = {v.name: (dims + v.dims, arrays[v.name], v.attrs()) for v in system.variables}
+    return xr.Dataset(data, coords=coordinates(system, scene), attrs=global_attrs(system, scene, "stabmap atlas"))
+
+
+def empty_arrays(system, scene, shape: tuple[int, ...] | None = None) -> dict[str, np.ndarray]:
+    """Uninitialised arrays of every variable for ``shape`` (default: the grid's)."""
+    shape = scene.shape if shape is None else shape
+    extra = system.dims(scene)
+    return {v.name: np.empty(shape + tuple(extra[d] for d in v.dims), dtype=v.dtype) for v in system.variables}

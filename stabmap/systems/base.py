@@ -1,0 +1,155 @@
+"""What a system provides to the pipeline: the plug-in contract (docs/systems.md).
+
+The pipeline is scene -> points -> decide -> store -> read.  The grid,
+chunking, running (threads or a dask cluster), checkpoints, files, ``info``,
+``query`` and ``plot`` are written once; a system fills in the parts that
+belong to its physics:
+
+- its **scene**: a frozen dataclass with ``title`` and ``grid`` fields (plus
+  its own), validated in ``__post_init__`` (one place for scenes built in
+  Python and read from TOML), and ``to_dict`` giving the TOML table back;
+- ``scene_from_dict``: the TOML table of a scene file -> that dataclass;
+- ``parameter``: units, long name and limits of every name its grid may scan;
+- ``evaluate``: the decision at a block of points, as plain arrays;
+- ``variables``: its outputs, declared once with CF metadata and flags.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+
+from ..scene import text
+from ..scene.grid import Axis
+from ..scene.values import Parameter
+from ..store.variables import Variable
+
+
+class SceneBase:
+    """What every system's scene dataclass shares (its own fields: ``title: str`` and ``grid: tuple[Axis, ...]``)."""
+
+    system: ClassVar[str]  # the name of its System
+    title: str
+    grid: tuple[Axis, ...]
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(a.values) for a in self.grid)
+
+    def to_dict(self) -> dict:
+        """The scene's TOML table, without the ``system`` key."""
+        raise NotImplementedError
+
+    def to_toml(self) -> str:
+        """The scene as TOML text that ``stabmap.loads_scene`` reads back to an equal scene."""
+        return text.dumps({"system": self.system, **self.to_dict()})
+
+
+@dataclass(frozen=True)
+class Cost:
+    """What one point costs, for sizing the tasks: seconds on one core, and bytes of its inputs."""
+
+    seconds: float
+    bytes: int
+
+
+class System:
+    """A system: one subpackage of ``stabmap.systems`` holds a subclass and registers its instance.
+
+    Attributes
+    ----------
+    name : str
+        The scene files' ``system = "..."`` and the atlases' ``stabmap_system``.
+    title : str
+        One line saying what the system is.
+    references : str
+        The atlases' CF ``references``.
+    variables : tuple of Variable
+        Every output of ``evaluate``, in file order.
+    label : str
+        The integer class that maps are coloured by and that refinement, critical values and the
+        queries follow. Negative values mean "no class" (degenerate points, drawn grey).
+    label_symbol : str
+        The label's short name in text, e.g. ``"N_c"``.
+    label_title : str
+        The legend's title for the label, e.g. ``"complex root pairs N$_c$"``.
+    stable_label : int or None
+        The label value of a stable point; None for a system without a notion of stability.
+    provenance : str or None
+        A flag variable saying how each point was decided. A system that allows adaptive
+        refinement (``inferred``) has ``store.variables.INFERRED`` among its meanings.
+    """
+
+    name: str
+    title: str
+    references: str
+    variables: tuple[Variable, ...]
+    label: str
+    label_symbol: str
+    label_title: str
+    stable_label: int | None = None
+    provenance: str | None = None
+
+    # ------------------------------------------------------------------ scenes
+    def scene_from_dict(self, table: dict, base_dir: Path | None = None) -> SceneBase:
+        """The scene of a TOML table (without its ``system`` key); errors name the key and the fix."""
+        raise NotImplementedError
+
+    def parameter(self, scene: SceneBase, name: str) -> Parameter:
+        """Units, long name and limits of the scannable ``name``; a StabmapError for a name this scene cannot scan."""
+        raise NotImplementedError
+
+    def fixed_values(self, scene: SceneBase) -> dict[str, float]:
+        """The scene's scalar parameters that are not grid axes, by their scannable names (scalar coordinates)."""
+        return {}
+
+    def attrs(self, scene: SceneBase) -> dict:
+        """Global attributes that describe the scene beyond its TOML (netCDF-safe values)."""
+        return {}
+
+    def describe(self, attrs: dict) -> list[str]:
+        """Lines that ``stabmap info`` prints about an atlas of this system, from its global attributes."""
+        return []
+
+    # ------------------------------------------------------------------ points
+    def dims(self, scene: SceneBase) -> dict[str, int]:
+        """Sizes of the dimensions of ``variables`` beyond the grid's."""
+        return {}
+
+    def fastest_axes(self, scene: SceneBase) -> tuple[int, ...]:
+        """Grid axes that should vary fastest within a block (e.g. those that leave the expensive set-up alone)."""
+        return ()
+
+    def cost(self, scene: SceneBase) -> Cost:
+        """The cost of one point, for the default task size."""
+        raise NotImplementedError
+
+    def evaluate(self, scene: SceneBase, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Decide points: ``values`` maps grid-axis names to arrays that broadcast to the points' shape S.
+
+        Returns every variable of ``variables``, each an array of shape S + its own ``dims``.
+        Axes not in ``values`` take the scene's fixed values.
+        """
+        raise NotImplementedError
+
+    def inferred(self, label: np.ndarray) -> dict[str, np.ndarray] | None:
+        """The other variables of points given ``label`` without being computed (adaptive refinement).
+
+        None (the default): the system does not allow refinement.
+        """
+        return None
+
+    # ------------------------------------------------------------------ outputs
+    def variable(self, name: str) -> Variable:
+        for v in self.variables:
+            if v.name == name:
+                return v
+        raise KeyError(f"the {self.name} system has no variable {name!r}")
+
+    def class_name(self, value: int) -> str:
+        """Legend text of one label value."""
+        var = self.variable(self.label)
+        return var.meaning(value).replace("_", " ") if var.flags else f"{self.label} = {value}"

@@ -1,0 +1,109 @@
+"""Chains and trees of Lagrange gyroscopes with liquid-filled cavities (docs/model.md): the first system.
+
+The pipeline's part of this system is the ``System`` below; the physics is in
+the modules beside it:
+
+- ``scene``, ``parameters``, ``topology``, ``liquid``, ``cavity``: what a scene holds and how it is checked;
+- ``points``: a scene and a block of its grid -> the kernels' per-point arrays;
+- ``decide`` (with ``stabmap.kernels``) and ``exact``: N_c of each point, proved;
+- ``outputs``: the variables written;
+- ``paper``: the source paper's printed equations, restated exactly, to compare with.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..base import Cost, System
+from . import scene as _scene
+from .outputs import BY_INFERRED, N_COMPLEX_PAIRS, VARIABLES, stability_from_pairs
+from .scene import Body, Scene
+
+REFERENCES = (
+    "Yu. N. Kononov, On the motion of a system of coupled rigid bodies with cavities containing "
+    "liquid (in Russian), Donetsk State University, received 22.11.1999: equations (22)-(34)"
+)
+
+
+def points_per_second(degree: int) -> float:
+    """Rough single-core speed of the certified kernels by polynomial degree (fit to BENCHMARKS.md).
+
+    Degree 16 and up are slower per point: the Sturm sequence loses sign
+    certainty more often and the root-inclusion step runs.
+    """
+    degree = max(2, degree)
+    if degree <= 12:
+        return 3.0e6 / degree**1.3
+    return 4.0e7 / degree**2.8
+
+
+class Gyroscopes(System):
+    name = "gyroscopes"
+    title = "chains and trees of Lagrange gyroscopes with liquid-filled cavities"
+    references = REFERENCES
+    variables = VARIABLES
+    label = N_COMPLEX_PAIRS.name
+    label_symbol = "N_c"
+    label_title = "complex root pairs N$_c$"
+    stable_label = 0
+    provenance = "decided_by"
+
+    def scene_from_dict(self, table, base_dir=None) -> Scene:
+        return _scene.from_dict(table, base_dir)
+
+    def parameter(self, scene: Scene, name: str):
+        return scene.parameter(name)
+
+    def fixed_values(self, scene: Scene) -> dict[str, float]:
+        return _scene.fixed_values(scene)
+
+    def attrs(self, scene: Scene) -> dict:
+        attrs = {"support": scene.support, "n_bodies": scene.n, "polynomial_degree_bound": scene.degree}
+        if scene.topology is not None:
+            attrs["topology_parent"] = np.array(scene.topology.parent, dtype=np.int32)
+        return attrs
+
+    def describe(self, attrs: dict) -> list[str]:
+        lines = [
+            f"support {attrs.get('support')}, {attrs.get('n_bodies')} bodies, characteristic polynomial of degree "
+            f"<= {attrs.get('polynomial_degree_bound')}"
+        ]
+        if "topology_parent" in attrs:
+            lines.append(f"a tree: parent = {[int(p) for p in np.atleast_1d(attrs['topology_parent'])]} (0: the base; docs/trees.md)")
+        return lines
+
+    def fastest_axes(self, scene: Scene) -> tuple[int, ...]:
+        # The kernels rebuild the inertia and stiffness matrices only when a point's masses, lengths or
+        # stiffnesses differ from the previous point's: runs of points that differ only in spin skip that work.
+        return tuple(d for d, a in enumerate(scene.grid) if a.name == "omega" or a.name.startswith("omega_"))
+
+    def cost(self, scene: Scene) -> Cost:
+        from .points import point_arrays
+
+        one = point_arrays(scene, {})
+        inputs = sum(a.nbytes for a in (one.body, one.joint, one.g, one.E, one.kappa, one.at)) + 8
+        return Cost(seconds=1.0 / points_per_second(scene.degree), bytes=inputs)
+
+    def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        from .decide import decide
+        from .points import point_arrays
+
+        shape = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()
+        nc, by = decide(point_arrays(scene, values))
+        nc = nc.reshape(shape)
+        return {"n_complex_pairs": nc, "stability": stability_from_pairs(nc), "decided_by": by.reshape(shape)}
+
+    def class_name(self, value: int) -> str:
+        if value < 0:
+            return "degenerate (p \u2261 0)"
+        if value == 0:
+            return "stable (all roots real)"
+        return f"{value} complex pair{'s' if value > 1 else ''}"
+
+    def inferred(self, label: np.ndarray) -> dict[str, np.ndarray]:
+        return {"stability": stability_from_pairs(label), "decided_by": np.full(np.shape(label), BY_INFERRED, dtype=np.int8)}
+
+
+SYSTEM = Gyroscopes()
+
+__all__ = ["SYSTEM", "Body", "Scene"]

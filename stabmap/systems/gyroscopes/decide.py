@@ -1,0 +1,28 @@
+"""Decide N_c for a block of points: the certified kernel first, exact arithmetic for the rest."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ... import kernels
+from . import exact
+from .outputs import BY_EXACT, BY_INCLUSION, BY_STURM
+from .points import PointArrays
+
+
+def decided_by_from_status(status: np.ndarray) -> np.ndarray:
+    """The ``decided_by`` flag from the kernels' status codes (UNDECIDED points are those decided exactly)."""
+    by = np.where(status == kernels.DECIDED_INCLUSION, BY_INCLUSION, BY_STURM)
+    return np.where(status == kernels.UNDECIDED, BY_EXACT, by).astype(np.int8)
+
+
+def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
+    """Return (n_complex_pairs int16, decided_by int8) for every point; -1 marks p identically zero."""
+    npts = points.body.shape[0]
+    nc = np.empty(npts, dtype=np.int16)
+    status = np.empty(npts, dtype=np.int8)
+    kernels.count_block(*points.kernel_args(), nc, status)
+    undecided = np.flatnonzero(status == kernels.UNDECIDED)
+    if undecided.size:
+        nc[undecided] = exact.decide_points(*points.kernel_args(), undecided)
+    return nc, decided_by_from_status(status)
