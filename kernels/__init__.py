@@ -2,7 +2,9 @@
 
 Nothing here imports stabmap, xarray, dask or matplotlib; the labelled layer
 (`stabmap`) owns scenes, grids and files.  Coefficient order is ascending powers
-of lambda everywhere (as ``numpy.polynomial``).
+of lambda everywhere (as ``numpy.polynomial``).  This folder is installed as
+``stabmap.kernels`` (PyPI has an unrelated top-level ``kernels`` package); its
+modules import each other relatively, so they work under either name.
 """
 
 from .block import charpoly_block, count_block

@@ -1,6 +1,6 @@
 """Characteristic polynomial of one parameter point, in rigorous interval arithmetic.
 
-MODEL.md: p(lambda) = det Phi(lambda) * prod_k Q_k(lambda) with
+docs/model.md: p(lambda) = det Phi(lambda) * prod_k Q_k(lambda) with
 Phi = lambda^2 M + lambda G - K - diag(liquid_k) and Q_k = prod_l (lambda + beta_kl),
 beta_kl = omega_k - lambda_kl = omega_k (kappa_kl - 2) / kappa_kl.
 
@@ -66,7 +66,7 @@ def path_matrix(parent, T):
 
 @kernel
 def _lever_arms(body, at, parent, free, J):
-    """Write the lever-arm matrix J (MODEL.md, docs/trees.md) into J (n, n, 3).
+    """Write the lever-arm matrix J (docs/model.md, docs/trees.md) into J (n, n, 3).
 
     J[k, k] = c_k; for every body i on the path below body k, J[k, i] is the
     position on the axis of i of the joint through which the path leaves i.
@@ -290,7 +290,7 @@ def diagonal_blocks(P, starts):
     columns < s holds only exact zeros, so det P = det P[:s, :s] det P[s:, s:]
     (and the sub-blocks inherit the zero rectangles).  Block b is
     starts[b]:starts[b + 1]; starts needs n + 1 entries.  A chain whose upper
-    bodies have a_k = 0 and ideal joints splits into n blocks (MODEL.md).
+    bodies have a_k = 0 and ideal joints splits into n blocks (docs/model.md).
     """
     n = P.shape[0]
     nb = 0

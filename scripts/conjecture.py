@@ -94,7 +94,7 @@ LAM = flint.fmpq_poly([0, 1])
 
 
 def gram_matrix(n: int) -> flint.fmpq_mat:
-    """S / (m c^2) for n identical free bodies (c_k = c, s_k = 2c), built from J as MODEL.md defines it."""
+    """S / (m c^2) for n identical free bodies (c_k = c, s_k = 2c), built from J as docs/model.md defines it."""
     # Fixed-frame lever arms in units of c: y_k = c (theta_k + 2 sum_{i<k} theta_i).
     J = [[2 if i < k else (1 if i == k else 0) for i in range(n)] for k in range(n)]
     # Free support, equal masses: subtract every column's plain mean so the centre of mass stays put.
@@ -142,7 +142,7 @@ def single_poly(A, C, omega, E=(), kappa=()) -> flint.fmpq_poly:
 
 
 def chain_poly(n: int, m, c, A, C, omega, E=(), kappa=(), joints=()) -> flint.fmpq_poly:
-    """Exact p(lam) = det(diag(Q) Phi) of n identical free bodies (c_k = c, s_k = 2c), MODEL.md.
+    """Exact p(lam) = det(diag(Q) Phi) of n identical free bodies (c_k = c, s_k = 2c), docs/model.md.
 
     ``joints`` are K_1..K_{n-1} (padded with zeros). Built here from J, M, G, K directly, with a
     fraction-free determinant, so that it shares no code with the engine's exact path

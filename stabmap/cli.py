@@ -54,7 +54,7 @@ def _options(options):
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 110})
-@click.version_option(__version__, prog_name="stabmap")
+@click.version_option(__version__, prog_name="stabmap", message="%(prog)s %(version)s")
 def cli() -> None:
     """Stability atlases of spinning multibody systems, every label proved."""
 

@@ -1,12 +1,12 @@
 """Exact (sympy, rational) reference for the characteristic polynomial.
 
-This module is a test oracle only. It restates ``../shared/MODEL.md`` (the project's physics brief)
+This module is a test oracle only. It restates ``docs/model.md`` (the physics stabmap computes)
 literally, in exact rational arithmetic, so the numeric engine can be checked
 against it. It deliberately imports nothing from ``stabmap`` or ``kernels``:
 an oracle that shares code with the thing it checks cannot catch that code's
 mistakes.
 
-Conventions (all from MODEL.md):
+Conventions (all from docs/model.md):
 
 * ``theta_k`` is the complex tilt of body ``k`` (body 1 at the bottom) and the
   solutions go as ``exp(i lam t)``.
@@ -165,7 +165,7 @@ def system_matrices(bodies, support, g=0, joints=(), K0=0):
     Returns
     -------
     M, G, K : sympy.Matrix
-        Exact rational ``n x n`` matrices of MODEL.md.
+        Exact rational ``n x n`` matrices of docs/model.md.
     """
     bs, joints, g, K0 = _normalise(bodies, support, g, joints, K0)
     n = len(bs)
@@ -254,7 +254,7 @@ def paper_F(A_prime, C, omega, E=(), kappa=(), restoring=0):
 
 
 def char_poly(bodies, support, g=0, joints=(), K0=0):
-    """Exact characteristic polynomial ``p(lam)`` of MODEL.md.
+    """Exact characteristic polynomial ``p(lam)`` of docs/model.md.
 
     Parameters
     ----------
@@ -320,7 +320,7 @@ def _det_poly(bs, M, G, K):
 def tree_matrices(bodies, parent, at, support, g=0, stiffness=None):
     """``(M, G, K)`` of bodies joined as a tree, from the Lagrangian of the geometry.
 
-    Deliberately not MODEL.md's lever-arm formula: every body is placed in a
+    Deliberately not docs/model.md's lever-arm formula: every body is placed in a
     vertical plane with exact trigonometry, the kinetic and potential energies are
     written out literally, and ``M`` and ``K`` are their Hessians at the upright
     state (for a free system after eliminating the translation of the whole system

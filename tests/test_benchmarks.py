@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 import runpy
 import pathlib
 
@@ -15,6 +17,7 @@ def test_bench_kernel_quick(capsys):
     assert "| n | modes |" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_bench_atlas_quick(capsys):
     out = runpy.run_path(str(SCRIPTS / "bench_atlas.py"))["main"](["--quick"])
     assert out["cold_cached_s"] > 0
@@ -60,6 +63,7 @@ def test_bench_truncation_quick(capsys):
     assert "| scene | N | tail |" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_bench_cluster_quick(capsys):
     out = runpy.run_path(str(SCRIPTS / "bench_cluster.py"))["main"](["--quick"])
     assert [(r["where"], r["n"]) for r in out["scaling"]] == [("threads", 1), ("threads", 2), ("local cluster", 1), ("local cluster", 2)]

@@ -1,4 +1,4 @@
-"""stabmap.cavity against numerics that share none of its formulas (CAVITIES.md is the spec).
+"""stabmap.cavity against numerics that share none of its formulas (docs/model.md is the spec).
 
 Reference: each mode's velocity is built from its pressure by solving the linearised rotating-frame
 equations i sigma v + 2 Omega z x v = -grad p, div v = 0 (modes ~ exp(i sigma t + i phi)), and

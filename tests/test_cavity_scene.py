@@ -1,7 +1,7 @@
 """Cavities in scenes: parsing, validation, the engine's use of the modes, and the physical limits.
 
 The closed forms themselves are checked against quadrature in test_cavity_modes.py;
-here the references are the paper-independent limits of CAVITIES.md (Greenhill's
+here the references are the paper-independent limits of docs/model.md (Greenhill's
 spinning shell, the sphere) worked out in sympy, and scenes written out by hand.
 """
 
@@ -43,7 +43,7 @@ def top(cavity_line=CYLINDER, grid="") -> scene.Scene:
 
 def test_greenhill_closed_form_from_the_spheroid_formulas():
     # Massless shell, fixed point at the centre, no gravity: p / lam must be
-    # proportional to lam^2 + omega lam + 2 omega^2 a^2 / (c^2 - a^2) (CAVITIES.md).
+    # proportional to lam^2 + omega lam + 2 omega^2 a^2 / (c^2 - a^2) (docs/model.md).
     a, c, rho, w, lam = sp.symbols("a c rho omega lam", positive=True)
     m_f = sp.Rational(4, 3) * sp.pi * rho * a**2 * c
     A, C = m_f * (a**2 + c**2) / 5, 2 * m_f * a**2 / 5

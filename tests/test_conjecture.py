@@ -1,7 +1,7 @@
 """The paper's conjecture for identical free chains (docs/conjecture.md), against exact references.
 
 Everything exact here comes from ``tests/reference.py`` (sympy, a literal restatement of
-MODEL.md), not from ``scripts/conjecture.py``; the script's own exact builder is itself
+docs/model.md), not from ``scripts/conjecture.py``; the script's own exact builder is itself
 checked against the reference, and its quick mode is run once.
 """
 
@@ -152,7 +152,7 @@ def test_counterexample_engine(n):
 
 
 def test_script_exact_builder_matches_reference():
-    """The script's engine-independent builder (used for its exact rechecks) is MODEL.md's p."""
+    """The script's engine-independent builder (used for its exact rechecks) is docs/model.md's p."""
     mod = runpy.run_path(str(SCRIPT))
     E, kappa = MODES[2]
     joints = [Fraction("0.3"), Fraction("1.7"), Fraction("0")]
@@ -164,6 +164,7 @@ def test_script_exact_builder_matches_reference():
     assert mod["complex_pairs"](single) == R.count_complex_pairs(R.char_poly(chain(1, BODY, E, kappa), "free"))
 
 
+@pytest.mark.slow
 def test_script_quick(capsys):
     out = runpy.run_path(str(SCRIPT))["main"](["--quick"])
     assert [r["n"] for r in out["gram"]] == list(range(2, 11)) and all(r["exact"] for r in out["gram"])

@@ -173,7 +173,7 @@ _DYADIC = {
 
 
 def _bivariate(joints: list[float]):
-    """p(lam, w) of the dyadic pair at spin rate w: total degree <= 6 in (lam, w) (MODEL.md), so 7 nodes fix it."""
+    """p(lam, w) of the dyadic pair at spin rate w: total degree <= 6 in (lam, w) (docs/model.md), so 7 nodes fix it."""
     import sympy
 
     w = sympy.Symbol("w")

@@ -155,6 +155,7 @@ def test_cluster_equals_in_process(loopback, slow_scene_file, slow_local):
     _same_atlas(ds, slow_local)
 
 
+@pytest.mark.slow
 def test_client_object_and_stream_to_zarr(loopback, slow_scene_file, slow_local, tmp_path):
     from distributed import Client
 
@@ -165,6 +166,7 @@ def test_client_object_and_stream_to_zarr(loopback, slow_scene_file, slow_local,
     assert not partial_dir(tmp_path / "a.zarr").exists()
 
 
+@pytest.mark.slow
 def test_cli_scheduler_and_local_workers_give_the_in_process_file(loopback, slow_scene_file, tmp_path, capsys):
     base = ["atlas", str(slow_scene_file), "-q"]
     assert cli.main(base + ["-o", str(tmp_path / "here.nc"), "--threads", "2"]) == 0
@@ -199,6 +201,7 @@ def test_refine_and_critical_on_the_cluster_equal_in_process(loopback, tmp_path,
     _same_atlas(open_atlas(tmp_path / "refined.nc"), stabmap.compute_refined(scan, threads=1, progress=False))
 
 
+@pytest.mark.slow
 def test_killed_worker_does_not_lose_the_atlas(tmp_path, slow_scene_file, slow_local):
     c = LoopbackCluster(tmp_path, workers=2)
     try:
@@ -251,6 +254,7 @@ def _wait_for_chunks(saved, proc, n):
         time.sleep(0.02)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", [signal.SIGKILL, signal.SIGINT, signal.SIGTERM])
 def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(how, tmp_path, slow_scene_file, slow_local, monkeypatch, capsys):
     out = tmp_path / "a.nc"
@@ -286,6 +290,7 @@ def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(how, t
     _same_atlas(open_atlas(out), slow_local)
 
 
+@pytest.mark.slow
 def test_resume_refuses_another_scene_and_other_chunks(tmp_path, slow_scene_file, capsys):
     out = tmp_path / "a.nc"
     proc = _start_cli(["atlas", str(slow_scene_file), "-o", str(out), "--threads", "1", "--chunk-points", str(SLOW_CHUNK), "-q"])

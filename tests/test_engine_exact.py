@@ -1,4 +1,4 @@
-"""The engine against the independent sympy reference of MODEL.md, on random and special systems."""
+"""The engine against the independent sympy reference of docs/model.md, on random and special systems."""
 
 from __future__ import annotations
 
@@ -148,7 +148,7 @@ def test_reversed_free_chain_keeps_the_count():
 
 @pytest.mark.parametrize("omega", [-40.0, 3.0, 25.0])
 def test_split_chain_is_counted_factor_by_factor(omega):
-    # Upper bodies with c = s = 0 and ideal joints: a_k = 0 for k >= 2, so p = F_1 F_2^3 (MODEL.md).  The
+    # Upper bodies with c = s = 0 and ideal joints: a_k = 0 for k >= 2, so p = F_1 F_2^3 (docs/model.md).  The
     # repeated factor F_2^3 defeats any count on p itself; block by block, the Sturm sequence proves it.
     body = {"m": 1.0, "A": 0.1, "C": 0.05, "c": 0.5, "s": 1.0, "fluid": {"E": [0.01], "kappa": [3.0]}}
     upper = dict(body, c=0.0, s=0.0)
@@ -166,6 +166,7 @@ def test_block_triangular_detection_needs_exact_zeros():
     assert engine_point(system)[0] == ref.count_complex_pairs(p)
 
 
+@pytest.mark.slow
 def test_reused_inertia_and_stiffness_give_the_same_labels():
     # count_block skips rebuilding M and K when only omega or the liquid changed since the previous point;
     # every point must get the label it gets alone.

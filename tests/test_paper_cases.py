@@ -1,7 +1,7 @@
 """The paper's cases n = 1, 2, 3: stabmap.paper against the sympy oracle, golden atlases, scripts/paper_cases.py.
 
 stabmap.paper restates the paper's printed determinants and closed forms in python-flint; here it is
-checked against tests/reference.py (MODEL.md in sympy, sharing no code with stabmap), and then used
+checked against tests/reference.py (docs/model.md in sympy, sharing no code with stabmap), and then used
 to check the golden atlases under tests/data point by point, in exact arithmetic.
 """
 
@@ -185,6 +185,7 @@ def test_golden_atlas_matches_the_paper_exactly(path):
 
 # ---------------------------------------------------------------- the script
 
+@pytest.mark.slow
 def test_paper_cases_quick_check_agrees(tmp_path, capsys):
     out = SCRIPT["main"](["--check", "--quick", "--out", str(tmp_path)])
     assert out["problems"] == []

@@ -1,7 +1,7 @@
 """Check the exact reference (tests/reference.py) against the paper's closed forms.
 
-The paper is seeds/003_83aba3711f19c37e.txt, equations (22)-(34); the physics
-is MODEL.md, which wins where the two disagree. Every comparison is exact
+The paper is Kononov 1999 (docs/model.md, References), equations (22)-(34); the physics
+is docs/model.md, which wins where the two disagree. Every comparison is exact
 (rational arithmetic, ``Poly`` equality), with random rational parameters from
 seeded generators, so a wrong sign, a missing factor or a wrong lever arm
 shows up as a hard failure.
@@ -12,7 +12,7 @@ and its determinant is taken with a different routine (sympy ``Matrix``
 Berkowitz on expression entries) from the one in ``char_poly``
 (``DomainMatrix`` over ``QQ[lam]``).
 
-Discrepancies found between the paper as printed and MODEL.md / the
+Discrepancies found between the paper as printed and docs/model.md / the
 mechanics, and how they are resolved here (each has a test that pins it):
 
 1. (29), fixed n = 3: ``A'_1 = A_1 + m_2 s_1^2`` is printed; the mechanics (and
@@ -20,15 +20,15 @@ mechanics, and how they are resolved here (each has a test that pins it):
    The n = 2 formula seems to have been copied. Corrected form used; the
    printed one is shown to be different.
 2. (28), identical free bodies: ``mu_ij = mu (2i-1) a_i`` is printed; it must
-   be ``mu (2i-1) a_j`` (i < j), as MODEL.md says and as (27) itself uses.
+   be ``mu (2i-1) a_j`` (i < j), as docs/model.md says and as (27) itself uses.
    Corrected form used; the printed one is shown to be different.
-3. Split (23)/(24): the text says "a_2 = a_3 = ... = a_n", and MODEL.md repeats
+3. Split (23)/(24): the text says "a_2 = a_3 = ... = a_n", and docs/model.md repeats
    it, but the split F_1 ... F_n = 0 needs a_2 = ... = a_n = 0 (each upper
    joint at the centre of mass of its "enlarged" body, as the paper's own
    words say; then every off-diagonal s_i a_j vanishes). Merely equal nonzero
    a_k do NOT split the determinant; a test shows that.
-4. Free case: the paper's c_1 is the distance C_1 O_2 = s_1 - c_1 in MODEL.md
-   terms (as MODEL.md notes); its A_k there are central moments, while in the
+4. Free case: the paper's c_1 is the distance C_1 O_2 = s_1 - c_1 in docs/model.md
+   terms (as docs/model.md notes); its A_k there are central moments, while in the
    fixed case its A_k are about the joint, A_k + m_k c_k^2.
 5. (27), last equation: the printed ``mu sum_{i=2}^n a_i u_i''`` for body n
    should read ``mu a_n sum_{i=1}^{n-1} (2i-1) u_i''``; only (28) is used.
@@ -392,7 +392,7 @@ def test_free_two_bodies_eq32(seed):
     bodies, joints, bs = _free_setup(2, 500 + seed)
     b1, b2 = bs
     m = b1["m"] + b2["m"]
-    c1 = b1["s"] - b1["c"]           # paper's c_1 = C_1 O_2 (MODEL.md)
+    c1 = b1["s"] - b1["c"]           # paper's c_1 = C_1 O_2 (docs/model.md)
     c2 = b2["c"]
     A_prime = [b1["A"] + b1["m"] * b2["m"] / m * c1**2,
                b2["A"] + b2["m"] * b1["m"] / m * c2**2]

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import stabmap
 from stabmap import StabmapError, loads_scene
@@ -144,3 +148,69 @@ def test_common_axis_equals_setting_every_body():
 def test_every_joint_axis_needs_joints():
     with pytest.raises(StabmapError, match="grid axis 'K' \\(every joint\\) needs two or more bodies"):
         loads_scene('support = "fixed"\nomega = 1.0\n[[bodies]]\nm = 1.0\nA = 0.02\nC = 0.03\nc = 0.1\n[grid]\nK = { values = [1.0] }\n')
+
+
+# --- one place for the checks ------------------------------------------------------------------------------
+
+_TOP = {"m": 1.0, "A": 0.02, "C": 0.03, "c": 0.1}
+
+
+def _python_and_toml(change_python, change_toml):
+    """The message of a bad scene built in Python, and of the same scene read from TOML."""
+    from stabmap.scene.grid import Axis
+    from stabmap.systems.gyroscopes.liquid import Cavity
+    from stabmap.systems.gyroscopes.scene import Body, Scene
+    from stabmap.systems.gyroscopes.topology import Topology
+
+    kw = {"bodies": (Body(**_TOP, s=0.25), Body(**_TOP)), "omega": 50.0, "joints": (120.0,), "grid": (Axis("omega", (1.0, 2.0)),)}
+    with pytest.raises(StabmapError) as python:  # a part (an Axis, a Topology) may refuse itself already
+        change_python(kw, Body, Axis, Cavity, Topology)
+        Scene(**kw)
+    text = GOOD
+    for old, new in change_toml:
+        assert old in text
+        text = text.replace(old, new, 1)
+    with pytest.raises(StabmapError) as toml:
+        loads_scene(text)
+    return str(python.value), str(toml.value)
+
+
+SAME = [
+    (lambda kw, Body, *_: kw.update(bodies=(kw["bodies"][0], Body(**{**_TOP, "m": -1.0}))), [("m = 0.5", "m = -1.0")]),
+    (lambda kw, *_: kw.update(support="floating"), [('support = "fixed"', 'support = "floating"')]),
+    (lambda kw, *_: kw.update(joints=(1.0, 2.0)), [("joints = [120.0]", "joints = [1.0, 2.0]")]),
+    (lambda kw, *_: kw.update(joints=(-3.0,)), [("joints = [120.0]", "joints = [-3.0]")]),
+    (lambda kw, Body, *_: kw.update(bodies=(Body(**_TOP, s=0.25, E=(1e-4,), kappa=(0.0,)), kw["bodies"][1])),
+     [("kappa = [1.31, 2.7]", "kappa = [0.0, 2.7]")]),
+    (lambda kw, Body, *_: kw.update(bodies=(Body(**_TOP, s=0.25, E=(1e-4, 2e-5), kappa=(1.31,)), kw["bodies"][1])),
+     [("kappa = [1.31, 2.7]", "kappa = [1.31]")]),
+    (lambda kw, _, Axis, *__: kw.update(grid=(Axis("m_9", (1.0,)),)), [("m_2 = {", "m_9 = {")]),
+    (lambda kw, _, Axis, *__: kw.update(grid=(Axis("K_1", (0.0, 10.0, 5.0)),)), [("K_1 = { values = [0.0, 10.0, 100.0] }", "K_1 = { values = [0.0, 10.0, 5.0] }")]),
+    (lambda kw, _, Axis, *__: kw.update(grid=(Axis("K_1", (-1.0, 10.0)),)), [("K_1 = { values = [0.0, 10.0, 100.0] }", "K_1 = { values = [-1.0, 10.0] }")]),
+    (lambda kw, *_: kw.update(K_0=1.0, support="free"), [('support = "fixed"', 'support = "free"'), ("g = 9.81", "K_0 = 1.0")]),
+    (lambda kw, Body, Axis, Cavity, _: kw.update(bodies=(Body(**_TOP, s=0.25, cavity=Cavity("cylinder", 0.0, 0.05, 1000.0)), kw["bodies"][1])),
+     [("fluid = { E = [1e-4, 2e-5], kappa = [1.31, 2.7] }", 'cavity = { shape = "cylinder", radius = 0.0, half_height = 0.05, density = 1000.0 }')]),
+    (lambda kw, Body, Axis, Cavity, Topology: kw.update(topology=Topology((0, 2), (0.0, 0.3))),
+     [("[[bodies]]", "[topology]\nparent = [0, 2]\nat = [0.0, 0.3]\n\n[[bodies]]")]),
+]
+
+
+@pytest.mark.parametrize("change_python,change_toml", SAME, ids=[str(i) for i in range(len(SAME))])
+def test_a_scene_built_in_python_gets_the_checks_and_messages_of_toml(change_python, change_toml):
+    python, toml = _python_and_toml(change_python, change_toml)
+    assert python == toml
+
+
+@given(st.text(max_size=40))
+@settings(max_examples=200, deadline=None)
+def test_any_title_survives_the_trip_through_the_atlas_toml(title):
+    scene = dataclasses.replace(loads_scene(GOOD), title=title)
+    assert loads_scene(scene.to_toml()) == scene
+
+
+def test_the_stored_scene_names_its_system_and_old_files_default_to_gyroscopes():
+    scene = loads_scene(GOOD)
+    assert scene.to_toml().startswith('system = "gyroscopes"\n')
+    assert loads_scene(scene.to_toml()) == scene == loads_scene('system = "gyroscopes"\n' + GOOD)
+    with pytest.raises(StabmapError, match="system = 'closed' is not a system stabmap knows; choose one of: gyroscopes"):
+        loads_scene('system = "closed"\n' + GOOD)

@@ -1,11 +1,11 @@
 """Numerical stress suite: engine labels against the independent exact count of tests/reference.py.
 
 Every property compares the engine's N_c, whichever path decided it, with the
-count of the sympy restatement of MODEL.md.  Hypothesis draws the parameters
+count of the sympy restatement of docs/model.md.  Hypothesis draws the parameters
 over the ranges users reach: spin 1e-3..1e5 rad/s, mass ratios to 1e6,
 stiffness 0..1e9, liquid from negligible to dominant; points within 1e-12 of a
 boundary; exactly repeated roots; degree 60; a vanishing leading coefficient;
-the symmetries of MODEL.md.
+the symmetries of docs/model.md.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ STRESS = settings(max_examples=25, deadline=None, suppress_health_check=[HealthC
 
 
 def reference_pairs(system: dict) -> int:
-    """N_c of the sympy polynomial of MODEL.md; root counting by the fastest exact method for its degree."""
+    """N_c of the sympy polynomial of docs/model.md; root counting by the fastest exact method for its degree."""
     p = ref.char_poly(**reference_args(system))
     if p.degree() <= 12:
         return ref.count_complex_pairs(p)
@@ -222,6 +222,7 @@ def test_free_chains_with_zero_roots(system):
 # --- degree 60 --------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("n,modes,support,seed", [(12, 3, "fixed", 1), (12, 3, "free", 2), (10, 2, "fixed", 3)])
 def test_high_degree(n, modes, support, seed):
     system = random_system(random.Random(seed), n, modes, support)
@@ -229,6 +230,7 @@ def test_high_degree(n, modes, support, seed):
     assert_engine_exact(system)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("n,modes", [(6, 2), (8, 2)])
 def test_degree_24_to_32_decided_by_floats_and_right(n, modes):
     rng = random.Random(10 * n + modes)
@@ -259,7 +261,7 @@ def test_vanishing_leading_coefficient(delta):
     assert_engine_exact(system)
 
 
-# --- symmetries of MODEL.md as properties -----------------------------------------------------
+# --- symmetries of docs/model.md as properties -----------------------------------------------------
 
 
 @STRESS

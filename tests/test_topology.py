@@ -320,7 +320,7 @@ def test_hand_derived_gyroscopes_above_and_below_a_free_carrier():
 
 @pytest.mark.parametrize("support", ["fixed", "free"])
 def test_lagrangian_reference_restates_model_for_chains(support):
-    """The tree oracle, given a chain, is MODEL.md's chain (ref.char_poly), which the paper's determinants check."""
+    """The tree oracle, given a chain, is docs/model.md's chain (ref.char_poly), which the paper's determinants check."""
     rng = random.Random(3 if support == "fixed" else 4)
     for n in (1, 2, 3):
         bodies = [dict(b, s=Fraction(rng.randint(1, 20), 32), E=[Fraction(1, 500)], kappa=[Fraction(27, 10)])
@@ -550,6 +550,7 @@ def _scene_point(scene, point: dict) -> dict:
     return system
 
 
+@pytest.mark.slow
 def test_cli_atlas_info_of_a_tree_on_a_cluster_and_here(tmp_path, capsys):
     """The branched example through the CLI: streamed on a local cluster and in-process, the same file; info says tree."""
     from stabmap import cli

@@ -9,8 +9,6 @@ interrupted run resumes where it stopped.
 from __future__ import annotations
 
 import math
-import sys
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +21,7 @@ from ..store.files import check_writable, write_streamed
 from ..systems.base import SceneBase
 from . import runner
 from .chunks import check_chunk_points, chunk_locations, chunk_shape, default_chunk_points
-from .progress import ProgressLine
+from .progress import ProgressLine, wanted
 from .tasks import evaluate_block
 
 
@@ -55,7 +53,7 @@ def compute(
         Points per task (default: about half a second of work, see ``stabmap.run.chunks``).
     """
     chunk_points = check_chunk_points(chunk_points)
-    with runner.start(client, workers=workers, threads=threads, announce=_wants(progress)) as run:
+    with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run:
         arrays = decide_grid(run, scene, progress=progress, chunk_points=chunk_points)
     return atlas_dataset(systems.of(scene), scene, arrays)
 
@@ -69,7 +67,7 @@ def decide_grid(run: runner.Runner, scene: SceneBase, *, progress: bool | None =
         for k, v in block.items():
             arrays[k][where] = v
 
-    with _layout(run, scene, progress, chunk_points) as layout:
+    with _Layout(run, scene, progress, chunk_points) as layout:
         layout.run(list(range(len(layout.locations))), keep)
     return arrays
 
@@ -127,7 +125,7 @@ def compute_to_file(
                 f"resume it, or delete {str(where)!r} to start over"
             )
     chunk_points = check_chunk_points(chunk_points)
-    with runner.start(client, workers=workers, threads=threads, announce=_wants(progress)) as run, _layout(
+    with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run, _Layout(
         run, scene, progress, chunk_points, checkpoint
     ) as layout:
         if checkpoint is None:
@@ -152,12 +150,29 @@ def compute_to_file(
 
 
 class _Layout:
-    """The chunk layout of one run, where its tasks go, and its progress line."""
+    """The blocks of one run's grid (a resumed run keeps its checkpoint's), where their tasks go, and the run's
+    progress line (closed on leaving the ``with``)."""
 
-    def __init__(self, scene, runner_, chunks, progress: ProgressLine):
-        self.scene, self.runner, self.chunks, self.progress = scene, runner_, chunks, progress
+    def __init__(self, run: runner.Runner, scene, progress, chunk_points: int | None, checkpoint: Checkpoint | None = None):
+        if checkpoint is not None:
+            chunks = checkpoint.chunks
+            if chunk_points is not None and chunk_shape(scene.shape, chunk_points) != chunks:
+                raise StabmapError(
+                    f"chunk_points {chunk_points} gives other chunks than the interrupted run's {list(chunks)}; "
+                    "leave chunk_points (--chunk-points) out to resume"
+                )
+        else:
+            chunks = chunk_shape(scene.shape, chunk_points or default_chunk_points(scene, run.threads))
+        self.scene, self.runner, self.chunks = scene, run, chunks
         self.locations = chunk_locations(scene.shape, chunks)
+        self.progress = ProgressLine(wanted(progress))
         self.done_before = 0
+
+    def __enter__(self) -> _Layout:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.progress.close()
 
     def run(self, todo: list[int], on_result) -> None:
         total, per = len(self.locations), max(1, math.prod(self.chunks))
@@ -176,29 +191,6 @@ class _Layout:
 
         args = [(self.scene, location) for location in self.locations]
         self.runner.run(evaluate_block, args, todo, handle)
-
-
-def _wants(progress: bool | None) -> bool:
-    return sys.stderr.isatty() if progress is None else progress
-
-
-@contextmanager
-def _layout(run: runner.Runner, scene, progress, chunk_points: int | None, checkpoint: Checkpoint | None = None):
-    """The chunks of a run on ``run`` (a resumed run keeps its checkpoint's) and its progress line."""
-    bar = ProgressLine(_wants(progress))
-    try:
-        if checkpoint is not None:
-            chunks = checkpoint.chunks
-            if chunk_points is not None and chunk_shape(scene.shape, chunk_points) != chunks:
-                raise StabmapError(
-                    f"chunk_points {chunk_points} gives other chunks than the interrupted run's {list(chunks)}; "
-                    "leave chunk_points (--chunk-points) out to resume"
-                )
-        else:
-            chunks = chunk_shape(scene.shape, chunk_points or default_chunk_points(scene, run.threads))
-        yield _Layout(scene, run, chunks, bar)
-    finally:
-        bar.close()
 
 
 __all__ = ["FileReport", "compute", "compute_to_file", "decide_grid"]

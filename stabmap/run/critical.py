@@ -41,6 +41,7 @@ from ..systems.base import SceneBase
 from . import runner
 from .atlas import decide_grid
 from .chunks import check_chunk_points, default_chunk_points, spans
+from .progress import wanted
 from .tasks import evaluate_points
 
 KIND = "critical values"  # global attribute stabmap_kind of every critical-values Dataset
@@ -175,7 +176,7 @@ def critical(
     others = tuple(a for d, a in enumerate(scene.grid) if d != index)
     counts = _Counts()
     t0 = time.perf_counter()
-    with runner.start(client, workers=workers, threads=threads, announce=bool(progress)) as run:
+    with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run:
         nc = _scan(run, scene, index, progress, chunk_points, counts)
         brackets = _bisect(run, scene, along, others, _initial_brackets(nc, scan), rtol, atol, chunk_points, counts)
     ds = _dataset(system, scene, along, others, scan, nc, brackets)

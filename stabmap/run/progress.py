@@ -6,6 +6,11 @@ import sys
 import time
 
 
+def wanted(progress: bool | None) -> bool:
+    """A run's ``progress`` option: None means "when stderr is a terminal"."""
+    return sys.stderr.isatty() if progress is None else progress
+
+
 class ProgressLine:
     """Shows ``text`` at most every ``dt`` seconds, from ``minimum`` seconds after the start.
 

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import sys
 import time
 from dataclasses import dataclass
 
@@ -38,7 +37,7 @@ from ..store.dataset import atlas_dataset, empty_arrays
 from ..systems.base import SceneBase
 from . import runner
 from .chunks import check_chunk_points, default_chunk_points, spans
-from .progress import ProgressLine
+from .progress import ProgressLine, wanted
 from .tasks import evaluate_grid_points, evaluate_points, point_order
 
 DEFAULT_MARGIN = 2  # cells split around a disagreeing cell; docs/refine.md has the measurements behind 2
@@ -361,7 +360,7 @@ def compute_refined(
     strides = tuple(coarse_stride or default_coarse_stride(n) for n in shape)
     total = math.prod(shape)
     t0 = time.perf_counter()
-    bar = _Progress(sys.stderr.isatty() if progress is None else progress, total)
+    bar = _Progress(wanted(progress), total)
     try:
         with runner.start(client, workers=workers, threads=threads, announce=bar.enabled) as run:
             ev = _Evaluator(scene, run, chunk_points, bar)

@@ -147,9 +147,17 @@ def local_cluster(workers: int) -> Iterator:
     from distributed import Client, LocalCluster
 
     workers = check_threads(workers, "workers")
-    with LocalCluster(
-        n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
-    ) as cluster, Client(cluster, set_as_default=False) as client:
+    try:
+        cluster = LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+        )
+    except RuntimeError as exc:
+        raise StabmapError(
+            f"could not start a local cluster of {workers} worker processes ({exc}); from a Python script, run it "
+            "under 'if __name__ == \"__main__\":' (the workers import the script), or start 'dask scheduler' and "
+            "'dask worker' yourself and pass their address (client=, --scheduler)"
+        ) from None
+    with cluster, Client(cluster, set_as_default=False) as client:
         yield client
 
 

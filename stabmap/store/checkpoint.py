@@ -68,6 +68,11 @@ class Checkpoint:
         """The checkpoint at ``path``; a StabmapError if it is not one this version can resume."""
         import xarray as xr
 
+        if (path / "manifest.json").exists():
+            raise StabmapError(
+                f"{str(path)!r} was saved by an older stabmap (chunk files and a manifest, before Zarr checkpoints) and "
+                "cannot be resumed by this one; delete it and run again"
+            )
         try:
             with xr.open_zarr(path, consolidated=False) as ds:
                 a = ds.attrs

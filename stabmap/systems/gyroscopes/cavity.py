@@ -1,6 +1,6 @@
 """Liquid modes (E_l, kappa_l) of a cavity from its shape, size and density.
 
-Conventions and closed forms: ``CAVITIES.md``. E_l has units of a moment of
+Conventions and closed forms: docs/model.md (liquid modes). E_l has units of a moment of
 inertia; kappa_l is dimensionless, |kappa_l| > 1, negative on the prograde
 branch of the cylinder. Every E scales as density * radius**5 at a fixed aspect
 ratio half_height / radius and every kappa depends on that ratio alone, so the
@@ -88,7 +88,7 @@ def scaled_deficit(shape: str, q: np.ndarray) -> np.ndarray:
     q = np.asarray(q, dtype=np.float64)
     if shape == "spheroid":
         return _spheroid_e(q)
-    # CAVITIES.md's axial series; its terms fall like x^-4, so a finite sum plus
+    # docs/model.md's axial series; its terms fall like x^-4, so a finite sum plus
     # the asymptotic expansion x^-4 - 2 x^-5 - x^-6 summed by Hurwitz zeta.
     n_terms = 64 + int(np.ceil(16.0 * q.max(initial=0.0)))
     n = np.arange(1, n_terms + 1)

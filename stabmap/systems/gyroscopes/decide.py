@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import kernels
+from ...kernels import DECIDED_INCLUSION, UNDECIDED, count_block
 from . import exact
 from .outputs import BY_EXACT, BY_INCLUSION, BY_STURM
 from .points import PointArrays
@@ -12,8 +12,8 @@ from .points import PointArrays
 
 def decided_by_from_status(status: np.ndarray) -> np.ndarray:
     """The ``decided_by`` flag from the kernels' status codes (UNDECIDED points are those decided exactly)."""
-    by = np.where(status == kernels.DECIDED_INCLUSION, BY_INCLUSION, BY_STURM)
-    return np.where(status == kernels.UNDECIDED, BY_EXACT, by).astype(np.int8)
+    by = np.where(status == DECIDED_INCLUSION, BY_INCLUSION, BY_STURM)
+    return np.where(status == UNDECIDED, BY_EXACT, by).astype(np.int8)
 
 
 def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
@@ -21,8 +21,8 @@ def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
     npts = points.body.shape[0]
     nc = np.empty(npts, dtype=np.int16)
     status = np.empty(npts, dtype=np.int8)
-    kernels.count_block(*points.kernel_args(), nc, status)
-    undecided = np.flatnonzero(status == kernels.UNDECIDED)
+    count_block(*points.kernel_args(), nc, status)
+    undecided = np.flatnonzero(status == UNDECIDED)
     if undecided.size:
         nc[undecided] = exact.decide_points(*points.kernel_args(), undecided)
     return nc, decided_by_from_status(status)

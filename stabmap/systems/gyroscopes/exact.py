@@ -19,7 +19,7 @@ def _q(x: float) -> flint.fmpq:
 
 
 def char_poly(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=None) -> flint.fmpq_poly:
-    """p(lambda) of MODEL.md for one point, exactly (ascending coefficients via ``.coeffs()``).
+    """p(lambda) of docs/model.md for one point, exactly (ascending coefficients via ``.coeffs()``).
 
     ``parent`` and ``at`` as for the kernels (a regular numbering, parent[0] = -1); None: a chain.
     The matrices come from Wittenburg's S and T (``stabmap.topology``, docs/trees.md), not from

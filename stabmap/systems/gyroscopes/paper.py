@@ -1,14 +1,14 @@
 """The source paper's printed equations, in exact rational arithmetic (python-flint).
 
-Kononov's paper (shared/seeds/003, equations 22-34) writes the characteristic equation of a chain
+Kononov's paper (docs/model.md, References; equations 22-34) writes the characteristic equation of a chain
 through the functions F_k on the diagonal of a determinant, and for a few cases factors it into
 single-body equations whose stability has a closed form.  This module restates those printed
-formulas independently of the kernels and of MODEL.md's matrices (M, G, K), so that the engine can
+formulas independently of the kernels and of docs/model.md's matrices (M, G, K), so that the engine can
 be checked against the paper:
 
 - ``paper_polynomial``: p(lambda) from the printed determinants (22)/(29)/(31) (fixed support, any n)
-  and (30)/(32) (free support, n = 2, 3) or (28) (free identical bodies, any n; with MODEL.md's
-  correction mu_ij = mu (2i-1) a_j).  Rows are multiplied by lambda^2 Q_k, which gives MODEL.md's p.
+  and (30)/(32) (free support, n = 2, 3) or (28) (free identical bodies, any n; with docs/model.md's
+  correction mu_ij = mu (2i-1) a_j).  Rows are multiplied by lambda^2 Q_k, which gives docs/model.md's p.
 - ``factors``: the single-body factors of the cases the paper solves in closed form: one top (23),
   one free body (24), identical free bodies (34) and (33) without joint stiffness, and the split of
   a fixed chain into (23) and (24) when a_2 = ... = a_n = 0.  Each factor has degree <= 3 in
@@ -49,7 +49,7 @@ class Chain:
 
     Values are ``fmpq`` or, for the scanned parameter, ``T``-polynomials.  ``A`` is the equatorial
     inertia about the body's own centre of mass and ``c`` the distance from the lower joint to it
-    (MODEL.md's convention; the paper's fixed-support A_k about the joint is A + m c^2).
+    (docs/model.md's convention; the paper's fixed-support A_k about the joint is A + m c^2).
     """
 
     m: list
@@ -142,7 +142,7 @@ def _free_inertia_and_mu(ch: Chain):
     n, m = ch.n, ch.m
     mt = sum(m, ZERO)
     if n == 2:
-        c1, c2 = ch.s[0] - ch.c[0], ch.c[1]  # the paper's c_1 is C_1 O_2 (MODEL.md)
+        c1, c2 = ch.s[0] - ch.c[0], ch.c[1]  # the paper's c_1 is C_1 O_2 (docs/model.md)
         return [ch.A[0] + m[0] * m[1] / mt * c1**2, ch.A[1] + m[1] * m[0] / mt * c2**2], {(0, 1): m[0] * c1 / mt * m[1] * c2}
     if n == 3:
         c1, c2, c3, s2 = ch.s[0] - ch.c[0], ch.c[1], ch.c[2], ch.s[1]

@@ -1,6 +1,6 @@
 """Bodies joined as a tree: Wittenburg's directed graph, incidence matrix S and path matrix T.
 
-Wittenburg, *Dynamics of Systems of Rigid Bodies*, 5.2.1 (``seeds/002_9b4ea331a4794cd2.txt``);
+Wittenburg, *Dynamics of Systems of Rigid Bodies*, 5.2.1 (docs/model.md, References);
 the formalism and the lever arms it gives are derived in ``docs/trees.md``.
 
 The bodies 1..n and the base, body 0, are the vertices of a tree; arc (joint) a
