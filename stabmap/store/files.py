@@ -47,7 +47,7 @@ def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         if is_zarr(path):
-            ds.to_zarr(tmp, mode="w", consolidated=False)
+            ds.to_zarr(tmp, mode="w", consolidated=True)
         else:
             encoding = {name: {"zlib": True, "complevel": 4, **_chunksizes(ds[name])} for name in ds.data_vars}
             ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=encoding)
@@ -108,7 +108,8 @@ def open_atlas(path: str | Path, *, lazy: bool = False) -> xr.Dataset:
     if not (path.is_file() or zarr):
         raise StabmapError(f"atlas file {str(path)!r} does not exist")
     try:
-        ds = xr.open_zarr(path, consolidated=False) if zarr else xr.open_dataset(path, engine="netcdf4", chunks={})
+        chunks = {} if lazy else None  # {}: dask arrays in the file's own chunks
+        ds = xr.open_zarr(path, consolidated=False, chunks=chunks) if zarr else xr.open_dataset(path, engine="netcdf4", chunks=chunks)
         if not lazy:
             with ds:
                 ds = ds.load()
