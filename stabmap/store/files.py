@@ -47,7 +47,7 @@ def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         if is_zarr(path):
-            ds.to_zarr(tmp, mode="w", consolidated=True)
+            ds.to_zarr(tmp, mode="w", consolidated=False)
         else:
             encoding = {name: {"zlib": True, "complevel": 4, **_chunksizes(ds[name])} for name in ds.data_vars}
             ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=encoding)
