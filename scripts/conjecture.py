@@ -146,7 +146,7 @@ def chain_poly(n: int, m, c, A, C, omega, E=(), kappa=(), joints=()) -> flint.fm
 
     ``joints`` are K_1..K_{n-1} (padded with zeros). Built here from J, M, G, K directly, with a
     fraction-free determinant, so that it shares no code with the engine's exact path
-    (stabmap/exact.py interpolates determinants at integer points instead; stabmap.paper's Bareiss
+    (stabmap/systems/gyroscopes/exact.py interpolates determinants at integer points instead; stabmap.systems.gyroscopes.paper's Bareiss
     determinant is shared with the paper's printed forms, which start from other matrices).
     """
     Kj = [_q(k) for k in joints] + [flint.fmpq(0)] * (n - 1 - len(joints))

@@ -48,6 +48,7 @@ def atlas(
     progress: bool | None = None,
 ) -> Done:
     """``stabmap atlas``: compute the atlas of ``scene`` into ``output`` (and draw it to ``png``)."""
+    from . import systems
     from .read.plot import check_figure_path, plot_atlas
     from .read.summary import summary
     from .run import refine as refining
@@ -67,6 +68,7 @@ def atlas(
             raise StabmapError(f"{given[0]} applies to adaptive atlases only; add --refine")
     elif resume:
         raise StabmapError("--resume applies to dense atlases; an adaptive atlas (--refine) has no checkpoint to resume")
+    system = systems.of(scene)
     t0 = time.perf_counter()
     where = {"client": client, "workers": workers, "threads": threads, "progress": progress, "chunk_points": chunk_points}
     if refine:
@@ -74,14 +76,14 @@ def atlas(
         options["margin"] = refining.check_margin(refining.DEFAULT_MARGIN if margin is None else margin, "--margin")
         ds = refining.compute_refined(scene, **options, **where)
         write_atlas(ds, output)
-        stats = summary_line(summary(ds), ds.attrs.get("n_evaluated_points"))
+        stats = summary_line(system, summary(ds), ds.attrs.get("n_evaluated_points"))
     else:
         report = compute_to_file(scene, output, resume=resume, **where)
         with open_atlas(output, lazy=True) as ds:
-            stats = summary_line(summary(ds))
+            stats = summary_line(system, summary(ds))
         if report.reused:
             stats += f"; resumed: {report.reused} of {report.chunks} chunks were already done, {report.computed} computed now"
-    lines = [f"wrote {output}: {stats} in {time.perf_counter() - t0:.1f} s"]
+    lines = [f"wrote {output} in {time.perf_counter() - t0:.1f} s: {stats}"]
     if png is not None:
         with open_atlas(output) as ds:
             plot_atlas(ds, png)
@@ -89,12 +91,11 @@ def atlas(
     return Done(lines)
 
 
-def summary_line(s: dict, evaluated=None) -> str:
-    """One line about a finished atlas: points, stable share, exact decisions, the saving of refinement."""
+def summary_line(system, s: dict, evaluated=None) -> str:
+    """One line about a finished atlas: points, stable share, who decided, the saving of refinement."""
     line = f"{s['points']} points, {100 * s['stable_fraction']:.1f} % stable"
-    exact = s.get("decided_by", {}).get("exact_rational_arithmetic")
-    if exact is not None:
-        line += f", {exact} decided in exact arithmetic"
+    if system.provenance in s:
+        line += "; decided by " + ", ".join(f"{m.replace('_', ' ')} {c}" for m, c in s[system.provenance].items() if c)
     if evaluated is not None:
         evaluated = int(evaluated)
         line += (

@@ -1,6 +1,6 @@
-"""The paper's cases n = 1, 2, 3: stabmap.paper against the sympy oracle, golden atlases, scripts/paper_cases.py.
+"""The paper's cases n = 1, 2, 3: stabmap.systems.gyroscopes.paper against the sympy oracle, golden atlases, scripts/paper_cases.py.
 
-stabmap.paper restates the paper's printed determinants and closed forms in python-flint; here it is
+stabmap.systems.gyroscopes.paper restates the paper's printed determinants and closed forms in python-flint; here it is
 checked against tests/reference.py (docs/model.md in sympy, sharing no code with stabmap), and then used
 to check the golden atlases under tests/data point by point, in exact arithmetic.
 """

@@ -1,4 +1,4 @@
-"""Pictures of atlases (stabmap.plot): boundaries on cell edges, facets, axes, legend, files and bad options.
+"""Pictures of atlases (stabmap.read.plot): boundaries on cell edges, facets, axes, legend, files and bad options.
 
 The boundary tests compare the segments actually drawn with a brute-force list of the grid-cell edges
 between neighbouring points whose N_c differ, on hand-made maps with log and irregular axes.

@@ -1,4 +1,4 @@
-"""Questions asked of a saved atlas (stabmap.query, ds.stabmap, stabmap query) against Maievskii's closed form.
+"""Questions asked of a saved atlas (stabmap.read.query, ds.stabmap, stabmap query) against Maievskii's closed form.
 
 A single top on a fixed point without liquid is stable (all characteristic roots real) exactly when
 C^2 omega^2 >= 4 (A + m c^2) m c g. The tests decide that in exact rational arithmetic on the binary values of

@@ -1,4 +1,4 @@
-"""Adaptive atlases (stabmap.refine): equal to the dense atlas cell for cell, far fewer evaluations.
+"""Adaptive atlases (stabmap.run.refine): equal to the dense atlas cell for cell, far fewer evaluations.
 
 Also pins down the documented assumption (docs/refine.md): a feature that hides
 inside a cell whose corners agree, more than ``margin`` cells from any

@@ -344,7 +344,7 @@ def _reference_poly(system: dict) -> sympy.Poly:
 
 
 def _engine_poly(system: dict) -> sympy.Poly:
-    """The engine's exact-path polynomial (stabmap.exact) for a grid-less scene dict."""
+    """The engine's exact-path polynomial (systems/gyroscopes/exact.py) for a grid-less scene dict."""
     pa = point_arrays(from_dict(system), {})
     p = exact.char_poly(pa.body[0], pa.joint[0], pa.g[0], pa.E[0], pa.kappa[0], pa.nmodes, pa.free, pa.parent, pa.at[0])
     return sympy.Poly([sympy.Rational(int(c.p), int(c.q)) for c in reversed(p.coeffs())] or [0], ref.lam)
@@ -398,7 +398,7 @@ def test_exact_fallback_decides_trees(carrier, h):
     """Two identical rotors at one joint, each exactly at Maievskii's boundary: a double root no interval proves.
 
     The antisymmetric motion of the rotors decouples with p = (lam + 2)^2 / 4, so the point goes to
-    stabmap.exact, which must build the same tree (read as a chain, these bodies give another N_c).
+    the exact path (systems/gyroscopes/exact.py), which must build the same tree (read as a chain, these bodies give another N_c).
     """
     rotor = {"m": 1.0, "A": 0.1875, "C": 1.0, "c": 0.25}  # A + m c^2 = 1/4, C^2 omega^2 = 4 (A + m c^2) m c g
     system = _tree_system("fixed", (0, 1, 1), (0.0, h, h), [carrier, rotor, rotor], g=4.0, omega=1.0)

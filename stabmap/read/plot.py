@@ -49,8 +49,6 @@ _HATCH_DEGENERATE = "xxxx"
 _HATCH_RUNS = 100_000  # more separate runs of inferred cells than this: a light veil instead of a hatch
 _VECTOR_RUNS = 20_000  # a panel with more runs of equal cells along x is filled as an image (lines and text stay vector)
 
-# Symbols of the scannable names (stabmap.parameters); names without one are shown as they are typed.
-_SYMBOLS = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho", "radius": "a"}
 
 
 def colour(value: int, stable: int | None = 0) -> str:
@@ -340,12 +338,13 @@ def _units(units: str) -> str:
     return "\u00a0".join(words)
 
 
-def _symbol(name: str) -> str:
-    """'omega' -> '$\\omega$', 'm_2' -> '$m_{2}$'; names without a symbol are returned as they are."""
+def _symbol(ds: xr.Dataset, name: str) -> str:
+    """'omega' -> '$\\omega$', 'm_2' -> '$m_{2}$' (the system's ``symbols``); other names are returned as they are."""
+    symbols = systems.of_atlas(ds.attrs).symbols
     m = re.fullmatch(r"([A-Za-z]+)(?:_(\d+))?", name)
-    if not m or m.group(1) not in _SYMBOLS:
+    if not m or m.group(1) not in symbols:
         return name
-    base, k = _SYMBOLS[m.group(1)], m.group(2)
+    base, k = symbols[m.group(1)], m.group(2)
     return f"${base}_{{{k}}}$" if k else f"${base}$"
 
 
@@ -353,7 +352,7 @@ def axis_label(ds: xr.Dataset, dim: str, width: int = 60) -> str:
     """'common spin rate ω [rad s⁻¹]': the coordinate's long_name (parentheses dropped), symbol and units."""
     attrs = ds[dim].attrs
     name = re.sub(r"\s*\([^)]*\)", "", attrs.get("long_name", "")).replace(" about its centre of mass", "").strip()
-    sym = _symbol(dim)
+    sym = _symbol(ds, dim)
     if not name:
         text = sym
     elif sym == dim:
@@ -368,7 +367,7 @@ def axis_label(ds: xr.Dataset, dim: str, width: int = 60) -> str:
 
 def _value_text(ds: xr.Dataset, dim: str, value: float) -> str:
     units = _units(str(ds[dim].attrs.get("units", "")))
-    return f"{_symbol(dim)} = {value:.4g}" + (f" {units}" if units else "")
+    return f"{_symbol(ds, dim)} = {value:.4g}" + (f" {units}" if units else "")
 
 
 def _log_axis(ds: xr.Dataset, dim: str) -> bool:
@@ -660,7 +659,7 @@ def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | N
         ax.set_xticks([])
     ax.set_ylim(float(scan[0]), float(scan[-1]))
     units = lower.attrs.get("units", "")
-    ax.set_ylabel(f"{_symbol(along)} [{_units(units)}]" if _units(units) else _symbol(along))
+    ax.set_ylabel(f"{_symbol(ds, along)} [{_units(units)}]" if _units(units) else _symbol(ds, along))
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     title = textwrap.fill(ds.attrs.get("title", "stabmap critical values"), 70) + f"\nstable {along} (white: unstable); ends to rtol {ds.attrs['critical_rtol']:g}"
     if chosen:

@@ -20,7 +20,7 @@ locates such ends to 1e-10 with proof (docs/critical.md). In an adaptive atlas (
 points were not computed but inferred from their grid cell's corners (``decided_by`` = inferred_from_cell_corners);
 every answer counts or flags them.
 
-``stabmap.report.render`` turns any answer into the text, CSV or JSON that ``stabmap query`` prints.
+``stabmap.read.report.render`` turns any answer into the text, CSV or JSON that ``stabmap query`` prints.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Answers of stabmap.query as the text, CSV or JSON that ``stabmap query`` prints."""
+"""Answers of stabmap.read.query as the text, CSV or JSON that ``stabmap query`` prints."""
 
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ def render(result, fmt: str = "text", *, limit: int = 40, atlas: xr.Dataset | No
         return {"text": _fraction_text, "csv": _fraction_csv, "json": _fraction_json}[fmt](result)
     kind = result.attrs.get("stabmap_query") if isinstance(result, xr.Dataset) else None
     if kind not in ("boundaries", "smallest_stable"):
-        raise StabmapError(f"cannot render {type(result).__name__}: not an answer of stabmap.query")
+        raise StabmapError(f"cannot render {type(result).__name__}: not an answer of stabmap.read.query")
     frame = _frame(result)
     if fmt == "csv":
         buf = io.StringIO()

@@ -81,6 +81,8 @@ class System:
     provenance : str or None
         A flag variable saying how each point was decided. A system that allows adaptive
         refinement (``inferred``) has ``store.variables.INFERRED`` among its meanings.
+    symbols : dict
+        Mathtext symbols of parameter names for figures (``{"omega": r"\\omega"}``; ``m_2`` -> ``$m_{2}$``).
     """
 
     name: str
@@ -92,6 +94,7 @@ class System:
     label_title: str
     stable_label: int | None = None
     provenance: str | None = None
+    symbols: dict[str, str] = {}
 
     # ------------------------------------------------------------------ scenes
     def scene_from_dict(self, table: dict, base_dir: Path | None = None) -> SceneBase:

@@ -47,6 +47,7 @@ class Gyroscopes(System):
     label_title = "complex root pairs N$_c$"
     stable_label = 0
     provenance = "decided_by"
+    symbols = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho", "radius": "a"}
 
     def scene_from_dict(self, table, base_dir=None) -> Scene:
         return _scene.from_dict(table, base_dir)

@@ -22,7 +22,7 @@ def char_poly(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=None
     """p(lambda) of docs/model.md for one point, exactly (ascending coefficients via ``.coeffs()``).
 
     ``parent`` and ``at`` as for the kernels (a regular numbering, parent[0] = -1); None: a chain.
-    The matrices come from Wittenburg's S and T (``stabmap.topology``, docs/trees.md), not from
+    The matrices come from Wittenburg's S and T (``topology``, docs/trees.md), not from
     the kernels' walk along each path.
     """
     n = len(body)

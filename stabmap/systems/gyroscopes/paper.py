@@ -71,7 +71,7 @@ class Chain:
 
 
 def chain_from_arrays(body, joint, g, E, kappa, nmodes, free: bool) -> Chain:
-    """A ``Chain`` of exact values from one point of the kernels' per-point layout (``stabmap.points``)."""
+    """A ``Chain`` of exact values from one point of the kernels' per-point layout (``points``)."""
     n = len(body)
     col = [[q(body[k][j]) for k in range(n)] for j in range(6)]
     return Chain(

@@ -15,7 +15,7 @@ from .scene import Scene
 class PointArrays:
     """Arguments of ``kernels.count_block`` for npts points (layout: kernels/charpoly.py).
 
-    Bodies are in the kernels' regular numbering (``stabmap.topology.kernel_layout``).
+    Bodies are in the kernels' regular numbering (``topology.kernel_layout``).
     Without ``parent`` and ``at`` the bodies form a chain: parent[k] = k - 1 and
     at[:, k] = s of body k - 1.
     """
