@@ -52,7 +52,6 @@ def atlas(
     from .read.plot import check_figure_path, plot_atlas
     from .read.summary import summary
     from .run import refine as refining
-    from .run import runner
     from .run.atlas import compute_to_file
     from .run.chunks import check_chunk_points
     from .store.files import check_writable, open_atlas, write_atlas
@@ -60,7 +59,6 @@ def atlas(
     check_writable(output)
     if png is not None:
         check_figure_path(png)
-    runner.check_where(client, workers, threads)
     check_chunk_points(chunk_points, "--chunk-points")
     if not refine:
         given = [opt for opt, v in (("--coarse-stride", coarse_stride), ("--margin", margin)) if v is not None]
@@ -123,11 +121,9 @@ def critical(
     from .read.info import intervals
     from .read.plot import check_figure_path, plot_critical
     from .run import critical as located
-    from .run import runner
     from .store.files import check_writable, write_atlas
 
     check_writable(output)
-    runner.check_where(client, workers, threads)
     if png is not None:
         check_figure_path(png)
         others = [a.name for a in scene.grid if a.name != along]

@@ -142,12 +142,12 @@ def grid_axes(ds: xr.Dataset) -> list[str]:
     return list(ds[system.label].dims)
 
 
-def _inferred(ds: xr.Dataset, system) -> xr.DataArray | bool:
-    """Where points were not computed but inferred from their grid cell's corners (adaptive atlases)."""
-    if system.provenance is None or system.provenance not in ds:
-        return False
-    flags = system.variable(system.provenance)
-    return ds[system.provenance] == flags.value(INFERRED) if INFERRED in flags.meanings else False
+def _inferred(ds: xr.Dataset, system) -> xr.DataArray:
+    """Where points were not computed but inferred from their grid cell's corners (adaptive atlases), on the grid."""
+    flags = system.variable(system.provenance) if system.provenance is not None else None
+    if flags is None or INFERRED not in flags.meanings:
+        return xr.zeros_like(ds[system.label], dtype=bool)
+    return ds[system.provenance] == flags.value(INFERRED)
 
 
 def _not_an_axis(ds: xr.Dataset, name: str, dims: list[str], role: str = "") -> StabmapError:
@@ -312,7 +312,7 @@ def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
     sub, axes = select(ds, sel)
     system = _stable_system(ds, "the stable fraction")
     nc = np.asarray(sub[system.label].values).ravel()
-    inferred = np.asarray(_inferred(sub, system)).ravel() & np.ones(nc.size, dtype=bool)
+    inferred = _inferred(sub, system).values.ravel()
     stable = nc == system.stable_label
     return StableFraction(
         fraction=float(stable.mean()),
@@ -346,8 +346,7 @@ def _lines(sub: xr.Dataset, along: str) -> tuple[list[str], np.ndarray, np.ndarr
     sub = sub.sortby(along)
     others = [d for d in sub[system.label].dims if d != along]
     nc = sub[system.label].transpose(*others, along).values
-    inferred = np.broadcast_to(_inferred(sub, system), sub[system.label].shape)
-    inferred = xr.DataArray(inferred, dims=sub[system.label].dims).transpose(*others, along).values
+    inferred = _inferred(sub, system).transpose(*others, along).values
     return others, np.asarray(sub[along].values, dtype=np.float64), nc, inferred
 
 

@@ -108,7 +108,6 @@ def compute_to_file(
         ``PATH.partial/`` is an error, so that no finished work is thrown away unasked.
     """
     path = check_writable(path)
-    runner.check_where(client, workers, threads)
     where = partial_dir(path)
     system = systems.of(scene)
     checkpoint = None

@@ -164,7 +164,6 @@ def critical(
     index = check_along(scene, along)
     rtol = check_rtol(rtol)
     chunk_points = check_chunk_points(chunk_points)
-    runner.check_where(client, workers, threads)
     system = systems.of(scene)
     if system.stable_label is None:
         raise StabmapError(f"critical values are the ends of stable intervals; {system.name} atlases have no stability")

@@ -352,7 +352,6 @@ def compute_refined(
     coarse_stride = check_coarse_stride(coarse_stride)
     margin = check_margin(margin)
     chunk_points = check_chunk_points(chunk_points)
-    runner.check_where(client, workers, threads)
     system = systems.of(scene)
     if system.inferred(np.zeros(0, dtype=np.int64)) is None:  # the system cannot say what a filled point holds
         raise StabmapError(f"adaptive refinement (--refine) is not available for {system.name} atlases; compute a dense one")
