@@ -12,6 +12,8 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 
 from .. import systems
 from ..errors import StabmapError
@@ -20,9 +22,9 @@ from ..store.dataset import atlas_dataset, empty_arrays
 from ..store.files import check_writable, write_streamed
 from ..systems.base import SceneBase
 from . import runner
-from .chunks import check_chunk_points, chunk_locations, chunk_shape, default_chunk_points
+from .chunks import check_chunk_points, chunk_locations, chunk_shape, default_chunk_points, spans
 from .progress import ProgressLine, wanted
-from .tasks import evaluate_block
+from .tasks import evaluate_block, evaluate_points
 
 
 def compute(
@@ -70,6 +72,30 @@ def decide_grid(run: runner.Runner, scene: SceneBase, *, progress: bool | None =
     with _Layout(run, scene, progress, chunk_points) as layout:
         layout.run(list(range(len(layout.locations))), keep)
     return arrays
+
+
+def decide_points(run: runner.Runner, scene: SceneBase, values: dict[str, np.ndarray], *, chunk_points: int | None = None,
+                  on_progress=None) -> dict[str, np.ndarray]:
+    """Every variable at points given by equal-length 1-D arrays of grid-axis values, in tasks on ``run``.
+
+    ``on_progress(points_done)`` is called as tasks finish (refinement's progress line).
+    """
+    npts = len(next(iter(values.values())))
+    bounds = spans(npts, chunk_points or default_chunk_points(scene, run.threads, npts))
+    out = {}
+    done = [0]
+
+    def keep(i, result):
+        a, b = bounds[i]
+        for k, v in result.items():
+            out.setdefault(k, np.empty((npts,) + v.shape[1:], dtype=v.dtype))[a:b] = v
+        done[0] += b - a
+        if on_progress is not None:
+            on_progress(done[0])
+
+    args = [(scene, {k: v[a:b] for k, v in values.items()}) for a, b in bounds]
+    run.run(evaluate_points, args, list(range(len(bounds))), keep)
+    return out
 
 
 @dataclass
@@ -192,4 +218,4 @@ class _Layout:
         self.runner.run(evaluate_block, args, todo, handle)
 
 
-__all__ = ["FileReport", "compute", "compute_to_file", "decide_grid"]
+__all__ = ["FileReport", "compute", "compute_to_file", "decide_grid", "decide_points"]

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import xarray as xr
@@ -39,10 +39,9 @@ from ..errors import StabmapError
 from ..store.dataset import coordinates, global_attrs
 from ..systems.base import SceneBase
 from . import runner
-from .atlas import decide_grid
-from .chunks import check_chunk_points, default_chunk_points, spans
+from .atlas import decide_grid, decide_points
+from .chunks import check_chunk_points
 from .progress import wanted
-from .tasks import evaluate_points
 
 KIND = "critical values"  # global attribute stabmap_kind of every critical-values Dataset
 DEFAULT_RTOL = 1e-10
@@ -87,13 +86,12 @@ class _Counts:
     scan_points: int = 0
     bisection_points: int = 0
     iterations: int = 0
-    provenance: dict = None  # flag value -> points it decided
+    provenance: dict = field(default_factory=dict)  # flag value -> points it decided
 
     def decided(self, system, results: dict) -> None:
         if system.provenance is None:
             return
         values, n = np.unique(results[system.provenance], return_counts=True)
-        self.provenance = self.provenance or {}
         for v, c in zip(values.tolist(), n.tolist()):
             self.provenance[v] = self.provenance.get(v, 0) + c
 
@@ -227,7 +225,7 @@ def _bisect(run, scene, along, others, brackets: _Brackets, rtol, atol, chunk_po
         idx = np.unravel_index(active.owner, shape) if shape else ()
         values = {a.name: a.array[i] for a, i in zip(others, idx)}
         values[along] = mid
-        results = _decide_points(run, scene, values, chunk_points)
+        results = decide_points(run, scene, values, chunk_points=chunk_points)
         counts.bisection_points += mid.size
         counts.decided(system, results)
         counts.iterations += 1
@@ -235,22 +233,6 @@ def _bisect(run, scene, along, others, brackets: _Brackets, rtol, atol, chunk_po
     else:  # pragma: no cover - float64 bisection always reaches neighbouring doubles first
         raise RuntimeError("bisection did not converge")
     return _Brackets.concat(done)
-
-
-def _decide_points(run, scene, values: dict[str, np.ndarray], chunk_points: int | None) -> dict[str, np.ndarray]:
-    """Every variable at the points given by equal-length arrays of axis values, in tasks on ``run``."""
-    npts = len(next(iter(values.values())))
-    bounds = spans(npts, chunk_points or default_chunk_points(scene, run.threads, npts))
-    out = {}
-
-    def keep(i, result):
-        a, b = bounds[i]
-        for k, v in result.items():
-            out.setdefault(k, np.empty((npts,) + v.shape[1:], dtype=v.dtype))[a:b] = v
-
-    args = [(scene, {k: v[a:b] for k, v in values.items()}) for a, b in bounds]
-    run.run(evaluate_points, args, list(range(len(bounds))), keep)
-    return out
 
 
 def _halve(b: _Brackets, mid: np.ndarray, nc_mid: np.ndarray) -> _Brackets:
@@ -369,7 +351,7 @@ def _attrs(system, along, scan, rtol, atol, counts: _Counts) -> dict:
         "comment": "Ends are located until hi - lo <= max(rtol * max(|lo|, |hi|), atol), or lo and hi are neighbouring "
         "doubles. " + ASSUMPTION.format(label=system.label),
     }
-    if counts.provenance is not None:
+    if system.provenance is not None:
         flags = system.variable(system.provenance)
         attrs[f"critical_{flags.name}"] = "; ".join(f"{m}: {counts.provenance.get(v, 0)}" for v, m in flags.flags)
     return attrs

@@ -36,9 +36,10 @@ from ..errors import StabmapError
 from ..store.dataset import atlas_dataset, empty_arrays
 from ..systems.base import SceneBase
 from . import runner
-from .chunks import check_chunk_points, default_chunk_points, spans
+from .atlas import decide_points
+from .chunks import check_chunk_points
 from .progress import ProgressLine, wanted
-from .tasks import evaluate_grid_points, evaluate_points, point_order
+from .tasks import evaluate_points, point_order
 
 DEFAULT_MARGIN = 2  # cells split around a disagreeing cell; docs/refine.md has the measurements behind 2
 COARSE_CELLS = 64  # default: the coarsest lattice has 64 to 127 cells (65 to 128 nodes) per long axis
@@ -220,23 +221,14 @@ class _Evaluator:
         return self.arrays
 
     def _decide(self, flat: np.ndarray, stride: int) -> dict[str, np.ndarray]:
-        npts = flat.size
-        size = self.chunk_points or default_chunk_points(self.scene, self.run.threads, npts)
-        bounds = spans(npts, size)
-        out = {}
-        done_points = [0]
+        idx = np.unravel_index(flat, self.scene.shape)
+        values = {axis.name: axis.array[i] for axis, i in zip(self.scene.grid, idx)}
+        npts, before = flat.size, self.evaluated
 
-        def keep(i, result):
-            a, b = bounds[i]
-            for k, v in result.items():
-                if k not in out:
-                    out[k] = np.empty((npts,) + v.shape[1:], dtype=v.dtype)
-                out[k][a:b] = v
-            done_points[0] += b - a
-            self.progress.update(stride, done_points[0], npts, self.evaluated + done_points[0])
+        def show(done):
+            self.progress.update(stride, done, npts, before + done)
 
-        self.run.run(evaluate_grid_points, [(self.scene, flat[a:b]) for a, b in bounds], list(range(len(bounds))), keep)
-        return out
+        return decide_points(self.run, self.scene, values, chunk_points=self.chunk_points, on_progress=show)
 
 
 def _step(ev: _Evaluator, level: _Level, active: np.ndarray, margin: int, box: tuple[slice, ...]) -> np.ndarray:

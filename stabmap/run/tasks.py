@@ -44,8 +44,3 @@ def evaluate_points(scene: SceneBase, values: dict[str, np.ndarray]) -> dict[str
     """Every variable at points given by equal-length 1-D arrays of grid-axis values (the other axes: fixed values)."""
     return systems.of(scene).evaluate(scene, values)
 
-
-def evaluate_grid_points(scene: SceneBase, flat: np.ndarray) -> dict[str, np.ndarray]:
-    """Every variable at grid points given by their flat (C-order) indices."""
-    idx = np.unravel_index(flat, scene.shape)
-    return evaluate_points(scene, {axis.name: axis.array[i] for axis, i in zip(scene.grid, idx)})
