@@ -5,7 +5,8 @@
     python scripts/bench_truncation.py --plot docs/figures/truncation.png
 
 Each scene is a top on a fixed point carrying a cylinder of water, with the cavity's half height
-scanned (aspect ratio h/a). For every number of kept modes N, with the tail lumped into A and without:
+scanned (aspect ratio h/a). For every number of kept modes N, with the tail lumped into A and without,
+and for modes = "auto" (the default: the fewest modes whose tail is at most 1e-2 of A, docs/cavities.md):
 - the critical spin rate (the lower end of the first stable interval along omega, bracketed to
   1e-10 by ``stabmap.critical``) at every aspect ratio, against the reference;
 - the share of atlas points (omega x aspect ratio) whose label differs from the reference atlas;
@@ -40,22 +41,25 @@ m = 3.0
 A = 0.05
 C = {C}
 c = 0.2
-cavity = {{ shape = "cylinder", radius = 0.05, half_height = 0.05, density = 1000.0, modes = {N}, tail = {tail} }}
+cavity = {{ shape = "cylinder", radius = {a}, half_height = {a}, density = 1000.0, modes = {N}, tail = {tail} }}
 [grid]
 omega = {{ start = {w0}, stop = {w1}, num = {nw} }}
-half_height_1 = {{ start = 0.0125, stop = 0.1, num = {nh} }}
+half_height_1 = {{ start = {h0}, stop = {h1}, num = {nh} }}
 """
-SCENES = {  # name: (C, omega range); C/A' sets which cavity mode the nutation meets
-    "slender top, C = 0.02": (0.02, (60.0, 200.0)),
-    "squat top, C = 0.08": (0.08, (10.0, 60.0)),
+SCENES = {  # name: (C, omega range, cavity radius); C/A' sets which cavity mode the nutation meets
+    "slender top, C = 0.02": (0.02, (60.0, 200.0), 0.05),
+    "squat top, C = 0.08": (0.08, (10.0, 60.0), 0.05),
+    "slender top, small cavity a = 3 cm": (0.02, (60.0, 200.0), 0.03),
 }
+AUTO = "auto"
 FULL = dict(modes=(1, 2, 4, 8, 16, 32), nw=80, nh=24)
 QUICK = dict(modes=(1, 2, 4, 8), nw=24, nh=6)
 
 
-def make(name: str, N: int, tail: bool, nw: int, nh: int) -> scene.Scene:
-    C, (w0, w1) = SCENES[name]
-    text = SCENE.format(title=name, C=C, N=N, tail="true" if tail else "false", w0=w0, w1=w1, nw=nw, nh=nh)
+def make(name: str, N: int | str, tail: bool, nw: int, nh: int) -> scene.Scene:
+    C, (w0, w1), a = SCENES[name]
+    modes = f'"{N}"' if N == AUTO else N
+    text = SCENE.format(title=name, C=C, N=modes, tail="true" if tail else "false", w0=w0, w1=w1, nw=nw, nh=nh, a=a, h0=a / 4, h1=2 * a)
     return loads_scene(text)
 
 
@@ -66,17 +70,18 @@ def critical_spin(s: scene.Scene) -> np.ndarray:
     return lower.isel({d: 0 for d in lower.dims if d != "half_height_1"}).values
 
 
-def run(name: str, N: int, tail: bool, nw: int, nh: int) -> dict:
+def run(name: str, N: int | str, tail: bool, nw: int, nh: int) -> dict:
     s = make(name, N, tail, nw, nh)
+    cav = s.bodies[0].cavity
     liquid.forget_modes()  # every run pays for finding its modes, as a user's first run does
     t0 = time.perf_counter()
     ds = atlas.compute(s, progress=False)
     seconds = time.perf_counter() - t0
     return {
-        "scene": name, "N": N, "tail": tail, "seconds": seconds,
+        "scene": name, "N": N, "kept": int(s.nmodes[0]), "tail_over_A": cav.tail_over_A, "tail": tail, "seconds": seconds,
         "exact_pct": 100.0 * float((ds.decided_by.values == BY_EXACT).mean()),
         "nc": ds.n_complex_pairs.values, "critical": critical_spin(s),
-        "aspect": 2 * s.grid[1].array / 0.05,
+        "aspect": 2 * s.grid[1].array / cav.radius,
     }
 
 
@@ -111,7 +116,7 @@ def plot(rows: list[dict], refs: dict, path: str) -> None:
     ax = axes[-1]
     for name, marker in zip(names, "os"):
         for tail, colour in ((True, "C0"), (False, "C3")):
-            sel = [r for r in rows if r["scene"] == name and r["tail"] == tail and r["N"] != refs[name]["N"]]
+            sel = [r for r in rows if r["scene"] == name and r["tail"] == tail and r["N"] not in (refs[name]["N"], AUTO)]
             ax.loglog([r["seconds"] for r in sel], [max(r["max_err"], 1e-12) for r in sel], marker=marker, color=colour,
                       label=f"{name}, {'with' if tail else 'without'} tail")
             for r in sel:
@@ -136,7 +141,7 @@ def main(argv=None) -> dict:
     cfg = QUICK if args.quick else FULL
     names = list(SCENES)[:1] if args.quick else list(SCENES)
     atlas.compute(make(names[0], 1, True, 4, 2), progress=False)  # compile or load the kernels first
-    rows, refs = [], {}
+    rows, autos, refs = [], [], {}
     for name in names:
         ref = run(name, cfg["modes"][-1], True, cfg["nw"], cfg["nh"])
         refs[name] = ref
@@ -145,18 +150,23 @@ def main(argv=None) -> dict:
                 r = ref if (N, tail) == (ref["N"], True) else run(name, N, tail, cfg["nw"], cfg["nh"])
                 rows.append(compare(r, ref))
                 print(f"  {name}: N = {N:2d} tail = {tail!s:5}  {r['seconds']:.2f} s", file=sys.stderr)
+        r = run(name, AUTO, True, cfg["nw"], cfg["nh"])
+        autos.append(compare(r, ref))
+        print(f"  {name}: N = auto ({r['kept']}) tail = True  {r['seconds']:.2f} s", file=sys.stderr)
     base = {name: next(r["seconds"] for r in rows if r["scene"] == name and r["N"] == 1 and r["tail"]) for name in names}
     print(f"`python scripts/bench_truncation.py{' --quick' if args.quick else ''}` on {platform.processor() or platform.machine()}, "
           f"{os.cpu_count()} cores; grid {cfg['nw']} omega x {cfg['nh']} aspect ratios (h/a 0.5 .. 4); reference N = {cfg['modes'][-1]} + tail\n")
-    print("| scene | N | tail | critical spin: max rel. error | median | aspects off by > 1 % | labels differing | time per atlas (x N=1) | exact |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for r in rows:
-        print(f"| {r['scene']} | {r['N']} | {'yes' if r['tail'] else 'no'} | {r['max_err']:.1e} | {r['median_err']:.1e} | "
-              f"{r['off_1pct']} / {len(r['critical'])} | {r['mislabelled_pct']:.2f} % | {r['seconds']:.2f} s ({r['seconds'] / base[r['scene']]:.1f}x) | {r['exact_pct']:.0f} % |")
+    print("| scene | N | tail | critical spin: max rel. error | median | aspects off by > 1 % | labels differing | time per atlas (x N=1) | exact | tail / A |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for r in sorted(rows + autos, key=lambda r: list(SCENES).index(r["scene"])):
+        n = f"auto: {r['kept']}" if r["N"] == AUTO else str(r["N"])
+        print(f"| {r['scene']} | {n} | {'yes' if r['tail'] else 'no'} | {r['max_err']:.1e} | {r['median_err']:.1e} | "
+              f"{r['off_1pct']} / {len(r['critical'])} | {r['mislabelled_pct']:.2f} % | {r['seconds']:.2f} s ({r['seconds'] / base[r['scene']]:.1f}x) | {r['exact_pct']:.0f} % | {r['tail_over_A']:.1e} |")
     if args.plot:
         plot(rows, refs, args.plot)
         print(f"\nwrote {args.plot}")
-    return {"rows": [{k: v for k, v in r.items() if k not in ("nc", "critical", "aspect")} for r in rows]}
+    strip = lambda r: {k: v for k, v in r.items() if k not in ("nc", "critical", "aspect")}  # noqa: E731
+    return {"rows": [strip(r) for r in rows], "auto": [strip(r) for r in autos]}
 
 
 if __name__ == "__main__":

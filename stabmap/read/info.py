@@ -6,6 +6,7 @@ import numpy as np
 import xarray as xr
 
 from .. import systems
+from ..errors import StabmapError
 from .summary import summary
 
 
@@ -19,6 +20,7 @@ def describe(ds: xr.Dataset, name: str = "") -> str:
     a = ds.attrs
     lines = [f"{name}: {a.get('title', '')}"]
     lines += [f"  {line}" for line in system.describe(a)]
+    lines += [f"  {line}" for line in scene_notes(a)]
     lines.append("  axes:")
     for d in ds[system.label].dims:
         c = ds[d]
@@ -39,6 +41,22 @@ def describe(ds: xr.Dataset, name: str = "") -> str:
         lines.append("  decided by: " + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in s[system.provenance].items()))
     lines.append(f"  made by {a.get('source', '?')}; {a.get('history', '')}")
     return "\n".join(lines)
+
+
+def scene_notes(attrs: dict) -> list[str]:
+    """What the stored scene chose for itself (its ``notes()``, if it has them), such as the liquid modes kept.
+
+    The scene is read back from the atlas, so the lines say what that scene chooses;
+    a scene this version no longer reads is reported, not fatal: the atlas is still described.
+    """
+    if "scene" not in attrs:
+        return []
+    try:
+        scene = systems.loads_scene(str(attrs["scene"]), "the atlas's scene")
+    except StabmapError as exc:
+        return [f"(the stored scene does not load in this version: {exc})"]
+    notes = getattr(scene, "notes", None)
+    return list(notes()) if notes is not None else []
 
 
 def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:

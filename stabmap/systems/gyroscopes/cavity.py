@@ -83,6 +83,21 @@ def tail(shape: str, radius: float, half_height: float, density: float, n_modes:
     return float(zhukovsky_deficit(shape, radius, half_height, density)) - float(E.sum())
 
 
+def scaled_tails(shape: str, q: np.ndarray, n_max: int):
+    """(E, kappa, tails) scaled by density radius^5 at aspect ratios q: E and kappa (len(q), n_max), largest
+    E first, and tails (len(q), n_max + 1), the deficit minus the N largest E for N = 0..n_max.
+
+    The N largest modes are the first N of the n_max largest, so one search serves every N up to n_max.
+    """
+    q = np.atleast_1d(np.asarray(q, dtype=np.float64))
+    e, kappa = scaled_modes(shape, q, 1 if shape == "spheroid" else n_max)
+    kept = np.concatenate([np.zeros((len(q), 1)), np.cumsum(e, axis=1)], axis=1)
+    tails = scaled_deficit(shape, q)[:, None] - kept
+    if shape == "spheroid":  # its one mode is the whole deficit; more modes add nothing
+        tails = np.concatenate([tails, np.repeat(tails[:, -1:], n_max - 1, axis=1)], axis=1)
+    return e, kappa, tails
+
+
 def scaled_deficit(shape: str, q: np.ndarray) -> np.ndarray:
     """Deficit / (density radius^5) at aspect ratios q = half_height / radius."""
     q = np.asarray(q, dtype=np.float64)

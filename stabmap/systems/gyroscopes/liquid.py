@@ -13,7 +13,7 @@ from __future__ import annotations
 import csv
 import math
 import tomllib
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -24,10 +24,17 @@ from . import cavity
 from .parameters import CAVITY
 
 _KEYS = {
-    "spheroid": {"shape", "radius", "half_height", "density", "modes", "tail", "liquid_in_body", "centre"},
-    "cylinder": {"shape", "radius", "half_height", "density", "modes", "tail", "liquid_in_body", "centre"},
+    "spheroid": {"shape", "radius", "half_height", "density", "modes", "mode_tolerance", "tail", "liquid_in_body", "centre"},
+    "cylinder": {"shape", "radius", "half_height", "density", "modes", "mode_tolerance", "tail", "liquid_in_body", "centre"},
     "table": {"shape", "E", "kappa", "lambda_over_omega", "file", "inertia", "deficit"},
 }
+AUTO = "auto"
+# modes = "auto" keeps the fewest modes whose lumped tail is at most this share of the body's A at every grid point
+# (docs/cavities.md, "Choosing N"): 8 modes at the truncation study's worst aspect ratio (scripts/bench_truncation.py).
+DEFAULT_TOLERANCE = 1e-2
+# The default keeps at most DEFAULT_MODES: N = 16 was no more accurate than 8 in that study, at 2.5 times the cost.
+# A stated mode_tolerance may keep up to cavity.MAX_MODES.
+AUTO_MAX_MODES = cavity.DEFAULT_MODES
 _CACHE_LIMIT = 200_000
 _scaled: dict[tuple[str, int, float], tuple[np.ndarray, np.ndarray, float]] = {}
 
@@ -43,7 +50,8 @@ class Cavity:
     radius: float = 0.0  # equatorial semi-axis (spheroid) or radius (cylinder)
     half_height: float = 0.0  # polar semi-axis (spheroid) or half the height (cylinder)
     density: float = 0.0
-    modes: int | None = None  # modes kept (largest E first); None: the shape's default
+    modes: int | str | None = None  # modes kept (largest E first), or "auto"; None: "auto"
+    mode_tolerance: float | None = None  # "auto": the largest tail / A allowed; None: DEFAULT_TOLERANCE, at most AUTO_MAX_MODES
     tail: bool = True  # lump the remaining modes into A (geometric shapes; a table with deficit)
     liquid_in_body: bool = True  # m, A, C of the body already include the frozen liquid
     centre: float = 0.0  # cavity centre above the lower joint O_k (liquid_in_body = false)
@@ -51,6 +59,10 @@ class Cavity:
     kappa: tuple[float, ...] = ()  # table
     inertia: float | None = None  # table: the frozen liquid's transverse inertia, bounds sum(E)
     deficit: float | None = None  # table: J_rigid - J_Zh; with it the tail is deficit - sum(E)
+    # Set by the scene from its grid (``choose``): the modes kept, and the largest tail / A and tail / sum(E) over the grid.
+    kept: int = field(default=0, compare=False)
+    tail_over_A: float = field(default=math.nan, compare=False, repr=False)
+    tail_share: float = field(default=math.nan, compare=False, repr=False)
 
     @property
     def geometric(self) -> bool:
@@ -62,7 +74,9 @@ class Cavity:
             out = {"shape": "table", "E": list(self.E), "kappa": list(self.kappa)}
             out.update({k: v for k in ("inertia", "deficit") if (v := getattr(self, k)) is not None})
             return out
-        out = {k: getattr(self, k) for k in ("shape", "radius", "half_height", "density", "modes", "tail", "liquid_in_body")}
+        # "auto" is written back as such with its tolerance: the same grid chooses the same count again.
+        keys = ("shape", "radius", "half_height", "density", "modes") + (("mode_tolerance",) if self.mode_tolerance is not None else ())
+        out = {k: getattr(self, k) for k in keys + ("tail", "liquid_in_body")}
         if not self.liquid_in_body:
             out["centre"] = self.centre
         return out
@@ -122,17 +136,39 @@ def check(c: Cavity, where: str) -> Cavity:
     if not c.geometric:
         return _check_table(c, where)
     sizes = {key: check_value(f"{where}.{key}", getattr(c, key), CAVITY[key]) for key in ("radius", "half_height", "density")}
-    try:
-        modes = cavity.check_shape(c.shape, c.modes)
-    except StabmapError as exc:
-        raise StabmapError(f"{where}.{exc}") from None
+    modes, tolerance = _check_modes(c, where)
     for key in ("tail", "liquid_in_body"):
         if not isinstance(getattr(c, key), bool):
             raise StabmapError(f"{where}.{key} must be true or false, got {getattr(c, key)!r}")
     if c.centre and c.liquid_in_body:
         raise StabmapError(f"{where}.centre is used only with liquid_in_body = false (the body's m, A, C, c already place the liquid); remove it")
     centre = check_value(f"{where}.centre", c.centre, CAVITY["centre"])
-    return replace(c, modes=modes, centre=centre, **sizes)
+    return replace(c, modes=modes, mode_tolerance=tolerance, centre=centre, **sizes)
+
+
+def _check_modes(c: Cavity, where: str) -> tuple[int | str, float | None]:
+    """(modes, mode_tolerance) normalised: an explicit count and no tolerance, or "auto" and its tolerance."""
+    if c.mode_tolerance is not None and c.modes not in (None, AUTO):
+        raise StabmapError(
+            f"{where}: give modes = {c.modes!r} (a count) or mode_tolerance = {c.mode_tolerance!r} (the fewest modes "
+            f"meeting it), not both; remove one"
+        )
+    if c.modes is None or c.modes == AUTO:
+        if c.mode_tolerance is None:
+            return AUTO, None
+        t = c.mode_tolerance
+        if isinstance(t, bool) or not isinstance(t, (int, float)) or not 0.0 < t < 1.0:
+            raise StabmapError(
+                f"{where}.mode_tolerance must be a number with 0 < mode_tolerance < 1 (the largest lumped tail allowed, "
+                f"as a share of the body's A; e.g. 1e-2), got {t!r}"
+            )
+        return AUTO, float(t)
+    if isinstance(c.modes, str):
+        raise StabmapError(f'{where}.modes must be a whole number or "auto", got {c.modes!r}')
+    try:
+        return cavity.check_shape(c.shape, c.modes), None
+    except StabmapError as exc:
+        raise StabmapError(f"{where}.{exc}") from None
 
 
 def _check_table(c: Cavity, where: str) -> Cavity:
@@ -189,7 +225,79 @@ def _read_table(name, where: str, base_dir: Path | None) -> dict:
 def n_modes(c: Cavity | None) -> int:
     if c is None:
         return 0
-    return c.modes if c.geometric else len(c.E)
+    if not c.geometric:
+        return len(c.E)
+    return c.kept if c.modes == AUTO else c.modes
+
+
+def choose(c: Cavity, where: str, axes: dict[str, np.ndarray], inertia: float) -> Cavity:
+    """The cavity with its modes chosen for the grid: ``kept``, ``tail_over_A`` and ``tail_share`` set.
+
+    ``axes`` holds the grid values (or the one fixed value) of radius, half_height and
+    density; ``inertia`` [kg m^2] is the smallest transverse inertia A of the body,
+    liquid included, on the grid. With modes = "auto" the count is the smallest N
+    whose tail, at every grid pairing of sizes, is at most mode_tolerance * inertia:
+    one count serves every point, as the kernels take one per body.
+    """
+    a, h = (np.unique(np.asarray(axes[k], dtype=np.float64)) for k in ("radius", "half_height"))
+    ratio = (h[None, :] / a[:, None]).ravel()
+    q, rows = np.unique(ratio, return_inverse=True)
+    # Tails scale as density radius^5 at a fixed ratio: per N, the largest over the grid.
+    unit = (float(np.max(axes["density"])) * np.repeat(a, len(h)) ** 5)[:, None]
+    if c.modes != AUTO:
+        _, _, tails = cavity.scaled_tails(c.shape, q, c.modes)
+        return _chosen(c, c.modes, tails, rows, unit, inertia)
+    tolerance = tolerance_of(c)
+    limit = AUTO_MAX_MODES if c.mode_tolerance is None else cavity.MAX_MODES
+    n_max = 1 if c.shape == "spheroid" else min(8, limit)
+    while True:
+        _, _, tails = cavity.scaled_tails(c.shape, q, n_max)
+        worst = (tails[rows] * unit).max(axis=0)
+        meets = np.flatnonzero(worst[1:] <= tolerance * inertia)
+        if len(meets) or n_max >= limit or c.shape == "spheroid":
+            break
+        n_max = min(2 * n_max, limit)
+    if len(meets):
+        return _chosen(c, int(meets[0]) + 1, tails, rows, unit, inertia)
+    if c.mode_tolerance is None:  # the default tolerance: keep the cap rather than let the cost explode
+        return _chosen(c, limit, tails, rows, unit, inertia)
+    raise StabmapError(
+        f"{where}.mode_tolerance = {c.mode_tolerance:g} needs more than {limit} modes (with {limit}, the tail is "
+        f"{worst[limit] / inertia:.3g} of A at the grid's worst point); raise mode_tolerance or give modes = N"
+    )
+
+
+def tolerance_of(c: Cavity) -> float:
+    """The tail / A that modes = "auto" allows: the stated mode_tolerance or the default."""
+    return DEFAULT_TOLERANCE if c.mode_tolerance is None else c.mode_tolerance
+
+
+def describe(c: Cavity) -> str:
+    """How many modes the cavity keeps and why, in one line (``stabmap info``)."""
+    if not c.geometric:
+        return f"table cavity, {len(c.E)} modes" + (", the rest lumped into A (deficit given)" if c.tail else "")
+    n = n_modes(c)
+    head = f"{c.shape} cavity, {n} liquid mode{'s' if n > 1 else ''} kept"
+    if c.shape == "spheroid":
+        return head + " (a spheroid has exactly one)"
+    if c.modes == AUTO:
+        tol = tolerance_of(c)
+        stated = f"mode_tolerance = {tol:g}" if c.mode_tolerance is not None else f'modes = "auto", tail <= {tol:g} of A'
+        why = f"the fewest with {stated}" if c.tail_over_A <= tol else f"{stated} not met within the default's {n}; state mode_tolerance to keep more"
+    else:
+        why = f"modes = {n}"
+    lumped = "lumped into A" if c.tail else "dropped (tail = false)"
+    return (
+        f"{head} ({why}); the rest {lumped}: at the grid's worst point {c.tail_over_A:.2g} of A "
+        f"and {100 * c.tail_share:.3g} % of the liquid's sum(E)"
+    )
+
+
+def _chosen(c: Cavity, n: int, tails: np.ndarray, rows: np.ndarray, unit: np.ndarray, inertia: float) -> Cavity:
+    """``c`` keeping n modes; ``tails`` (aspect ratios, N = 0..) scaled, ``rows`` the aspect ratio of each grid pairing."""
+    over_A = float((tails[rows, n] * unit[:, 0]).max()) / inertia
+    share = float((tails[:, n] / tails[:, 0]).max())
+    return replace(c, kept=n, tail_over_A=max(over_A, 0.0), tail_share=max(share, 0.0))
 
 
 def check_body(c: Cavity, where: str, extremes: dict[str, tuple[float, float]]) -> None:
@@ -259,7 +367,7 @@ def apply(c: Cavity, body: np.ndarray, sizes: dict[str, np.ndarray]):
             body[..., 1] -= c.deficit - math.fsum(c.E)
         return E, kappa
     a, h, rho = sizes["radius"], sizes["half_height"], sizes["density"]
-    e, kappa, tail = scaled(c.shape, h / a, c.modes)
+    e, kappa, tail = scaled(c.shape, h / a, n_modes(c))
     unit = rho * a**5
     if not c.liquid_in_body:
         m_f = cavity.frozen_mass(c.shape, a, h, rho)

@@ -8,7 +8,7 @@ turns them back.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import ClassVar
 
@@ -98,6 +98,10 @@ class Scene(SceneBase):
     def parameter(self, name: str) -> Parameter:
         """The parameter a grid axis called ``name`` scans, or a StabmapError saying why it cannot be scanned."""
         return _axis_name(name, self.n, self.support, self.topology is not None).parameter
+
+    def notes(self) -> list[str]:
+        """What the scene chose for itself that its file does not state: the liquid modes each cavity keeps."""
+        return [f"body {k}: {liquid.describe(b.cavity)}" for k, b in enumerate(self.bodies, start=1) if b.cavity is not None]
 
     def to_dict(self) -> dict:
         out = {"title": self.title, "support": self.support}
@@ -221,7 +225,7 @@ def _validate(scene: Scene) -> None:
     put("grid", tuple(scene.grid))
     check_axes(scene.grid, scene.parameter)
     _check_omega(scene)
-    _check_cavities(scene)
+    put("bodies", _check_cavities(scene))
 
 
 def _checked_body(b: Body, k: int, tree: bool) -> Body:
@@ -277,8 +281,10 @@ def _check_omega(scene: Scene) -> None:
         raise StabmapError(f"omega is missing: set the common rate omega, bodies[{k}].omega, or scan omega in [grid]")
 
 
-def _check_cavities(scene: Scene) -> None:
+def _check_cavities(scene: Scene) -> tuple[Body, ...]:
+    """The bodies, each cavity checked against the grid and its number of modes chosen for it."""
     axes = {a.name: a.array for a in scene.grid}
+    bodies = []
     for k, b in enumerate(scene.bodies, start=1):
         cav = b.cavity
         for key in SCANNABLE_CAVITY:
@@ -288,13 +294,21 @@ def _check_cavities(scene: Scene) -> None:
                     f'add bodies[{k}].cavity = {{ shape = "cylinder", ... }} or remove the axis'
                 )
         if cav is None:
+            bodies.append(b)
             continue
-        extremes = {}
+        values = {}
         for key in ("m", "A", "C") + (SCANNABLE_CAVITY if cav.geometric else ()):
             fixed = getattr(b, key) if key in BODY else getattr(cav, key)
-            values = axes.get(f"{key}_{k}", axes.get(key, np.array([fixed])) if key in EVERY_BODY else np.array([fixed]))
-            extremes[key] = (float(values.min()), float(values.max()))
+            values[key] = axes.get(f"{key}_{k}", axes.get(key, np.array([fixed])) if key in EVERY_BODY else np.array([fixed]))
+        extremes = {key: (float(v.min()), float(v.max())) for key, v in values.items()}
         liquid.check_body(cav, f"bodies[{k}]", extremes)
+        if cav.geometric:
+            inertia = extremes["A"][0]
+            if not cav.liquid_in_body:  # the engine adds the frozen liquid, at least its inertia at the smallest sizes
+                inertia += float(liquid.cavity.frozen_inertia(cav.shape, *(extremes[key][0] for key in SCANNABLE_CAVITY))[0])
+            cav = liquid.choose(cav, f"bodies[{k}].cavity", values, inertia)
+        bodies.append(replace(b, cavity=cav))
+    return tuple(bodies)
 
 
 def fixed_values(scene: Scene) -> dict[str, float]:
