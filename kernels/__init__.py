@@ -7,13 +7,17 @@ of lambda everywhere (as ``numpy.polynomial``).  This folder is installed as
 modules import each other relatively, so they work under either name.
 """
 
-from .block import charpoly_block, count_block
-from .status import DECIDED_FLOAT, DECIDED_INCLUSION, UNDECIDED, ZERO_POLYNOMIAL
+from .block import charpoly_block, count_block, decide_block, linearise_block
+from .status import DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL
 
 __all__ = [
     "charpoly_block",
     "count_block",
+    "decide_block",
+    "linearise_block",
+    "DECIDED_DISKS",
     "DECIDED_FLOAT",
+    "DECIDED_INERTIA",
     "DECIDED_INCLUSION",
     "UNDECIDED",
     "ZERO_POLYNOMIAL",

@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import certify, pencil
 from .charpoly import allocate, block_det, charpoly_point, diagonal_blocks, matrix_point, same_structure
 from .count import allocate_count, count_point
 from .options import kernel
-from .status import DECIDED_FLOAT, DECIDED_INCLUSION, ZERO_POLYNOMIAL, UNDECIDED
+from .status import DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL
+
+LAPLACE_MAX = 12  # bodies: the coefficient path's 2^n minors cost 47 ms a point at n = 12
+STURM_FIRST = 16  # degree up to which the Sturm sequence is the cheapest proof (scripts/bench_kernel.py)
 
 
 @kernel
@@ -67,19 +71,80 @@ def count_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out_
     starts = np.empty(n + 1, np.int64)
     for p in range(npts):
         reuse = same_structure(body, joint, at, g, p)
-        matrix_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, ws, reuse)
-        nblocks = diagonal_blocks(ws[5], starts)
-        total, status = 0, DECIDED_FLOAT
-        for b in range(nblocks):
-            d = block_det(ws, rowdeg, starts[b], starts[b + 1], c)
-            nc, st = count_point(c[: d + 1], cs)
-            if st == ZERO_POLYNOMIAL or st == UNDECIDED:
-                total, status = -1, st
-                if st == ZERO_POLYNOMIAL:
-                    break
-            elif status != UNDECIDED:
-                total += nc
-                if st == DECIDED_INCLUSION:
-                    status = DECIDED_INCLUSION
-        out_nc[p] = total
-        out_status[p] = status
+        out_nc[p], out_status[p] = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, reuse)
+
+
+@kernel
+def _count_coefficients(body, joint, at, g, E, kappa, nmodes, parent, rowdeg, free, ws, c, cs, starts, reuse):
+    """(N_c, status) of one point from the enclosed coefficients of p, factor by factor."""
+    matrix_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
+    nblocks = diagonal_blocks(ws[5], starts)
+    total, status = 0, DECIDED_FLOAT
+    for b in range(nblocks):
+        d = block_det(ws, rowdeg, starts[b], starts[b + 1], c)
+        nc, st = count_point(c[: d + 1], cs)
+        if st == ZERO_POLYNOMIAL or st == UNDECIDED:
+            total, status = -1, st
+            if st == ZERO_POLYNOMIAL:
+                break
+        elif status != UNDECIDED:
+            total += nc
+            if st == DECIDED_INCLUSION:
+                status = DECIDED_INCLUSION
+    return total, status
+
+
+@kernel
+def decide_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out_status):
+    """N_c of a block of points by whichever certificate proves it fastest.
+
+    Inputs and outputs as for ``count_block``.  Up to degree ``STURM_FIRST``
+    the interval Sturm sequence on the coefficients is the cheapest proof
+    (docs/speed.md), so it goes first and the certificates of ``certify``
+    take what it leaves (repeated roots, mostly); above, the certificates go
+    first and the coefficient path takes what they leave, up to
+    ``LAPLACE_MAX`` bodies (its cost is exponential in n).  Points none
+    decides stay UNDECIDED: the caller takes them to exact arithmetic.
+    """
+    npts, n = body.shape[0], body.shape[1]
+    rowdeg = nmodes + 2
+    degree = int(rowdeg.sum())
+    cws = certify.allocate(n, nmodes, parent)
+    laplace = n <= LAPLACE_MAX
+    sturm_first = degree <= STURM_FIRST
+    ws = allocate(n if laplace else 1, max(1, nmodes.max()), degree if laplace else 1, parent if laplace else parent[:1])
+    c = np.empty((degree + 1, 3))
+    cs = allocate_count(degree)
+    starts = np.empty(n + 1, np.int64)
+    coefficients_last = -1  # the last point whose M and K the coefficient path built
+    for p in range(npts):
+        reuse = same_structure(body, joint, at, g, p)
+        nc, st = -1, UNDECIDED
+        if sturm_first:
+            nc, st = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, reuse)
+            coefficients_last = p
+        if st == UNDECIDED:
+            nc, st = certify.certify_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, cws, reuse)
+        if st == UNDECIDED and laplace and not sturm_first:
+            again = reuse and coefficients_last == p - 1
+            nc, st = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, again)
+            coefficients_last = p
+        out_nc[p] = nc
+        out_status[p] = st
+
+
+@kernel
+def linearise_block(body, joint, g, E, kappa, nmodes, free, parent, at, out):
+    """The D x D first-order linearisation of every point into out (npts, D, D); returns a bool mask of success.
+
+    Its eigenvalues are the roots of p (``pencil.linearisation``): what a float
+    method takes as its input.  False where M - diag(sum E) is singular.
+    """
+    npts, n = body.shape[0], body.shape[1]
+    ws = pencil.allocate(n, max(1, nmodes.max()), parent)
+    Mo = np.empty((n, n))
+    ok = np.zeros(npts, np.bool_)
+    for p in range(npts):
+        pencil.prepare(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, ws, same_structure(body, joint, at, g, p))
+        ok[p] = pencil.linearisation(body[p], E[p], nmodes, parent, ws, out[p], Mo)
+    return ok

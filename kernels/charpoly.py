@@ -148,6 +148,14 @@ def _inertia_T(body, parent, J, M):
 
 
 @kernel
+def structure(body, joint, at, g, parent, free, sub, J, M, K):
+    """M T and K T of one point (double-double intervals) into M, K (n, n, 3); J, sub are scratch."""
+    _lever_arms(body, at, parent, free, J)
+    _inertia_T(body, parent, J, M)
+    _stiffness_T(body, joint, at, parent, g, free, sub, K)
+
+
+@kernel
 def _liquid_polys(omega, E, kappa, L, q, w):
     """Q = prod_l (lambda + beta_l) into q and R = sum_l E_l prod_{l' != l} (lambda + beta_l') into w."""
     q[: L + 1] = 0.0

@@ -10,7 +10,7 @@ Point sets (all fixed or free chains with liquid, see the functions below):
   repeated      identical upper bodies on a split chain, identical free bodies: exactly repeated roots
 Methods: plain float64 Sturm (no tolerance, and a 1e-10 relative remainder tolerance), numpy.roots
 with a tolerance on |Im z| / |z|, batched companion-matrix eigenvalues (one LAPACK call per set),
-stabmap's certified kernel (and with its exact fallback), and the exact path alone.  Every method is
+batched eigenvalues of the first-order linearisation (no coefficients), stabmap's certified kernel (and with its exact fallback), and the exact path alone.  Every method is
 scored against the exact label of the same binary point.
 
 A second table gives, for the bundled example atlases, the share of points each path decided and the
@@ -33,13 +33,35 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from stabmap import kernels  # noqa: E402
-from bench_kernel import companion_pairs, random_points, timed  # noqa: E402
+from bench_kernel import random_points, timed  # noqa: E402
 from stabmap.systems.gyroscopes import exact  # noqa: E402
 from stabmap.run.atlas import compute  # noqa: E402
 from stabmap.systems.gyroscopes.decide import decided_by_from_status  # noqa: E402
-from stabmap.systems.gyroscopes.outputs import BY_EXACT, BY_INCLUSION, BY_STURM  # noqa: E402
+from stabmap.systems.gyroscopes.outputs import BY_DISKS, BY_EXACT, BY_INCLUSION, BY_INERTIA, BY_STURM  # noqa: E402
 from stabmap.examples import example  # noqa: E402
 from stabmap.systems.gyroscopes.points import PointArrays  # noqa: E402
+
+
+# --- float methods ------------------------------------------------------------------------------
+
+
+def companion_pairs(coeffs: np.ndarray, tol: float) -> np.ndarray:
+    """N_c from batched eigenvalues of the companion matrices of the float coefficients."""
+    d = coeffs.shape[1] - 1
+    comp = np.zeros((len(coeffs), d, d))
+    comp[:, 1:, :-1] = np.eye(d - 1)
+    comp[:, :, -1] = -coeffs[:, :d] / coeffs[:, d : d + 1]
+    z = np.linalg.eigvals(comp)
+    return (np.abs(z.imag) > tol * np.maximum(np.abs(z), 1e-300)).sum(axis=1) // 2
+
+
+def linearisation_pairs(pts: PointArrays, tol: float) -> np.ndarray:
+    """N_c from batched eigenvalues of the D x D first-order linearisation (the float peer of bench_kernel)."""
+    degree = int((pts.nmodes + 2).sum())
+    C = np.empty((pts.body.shape[0], degree, degree))
+    kernels.linearise_block(*pts.kernel_args(), C)
+    z = np.linalg.eigvals(C)
+    return (np.abs(z.imag) > tol * np.maximum(1.0, np.abs(z))).sum(axis=1) // 2
 
 
 # --- point sets ---------------------------------------------------------------------------------
@@ -189,7 +211,7 @@ def score(name: str, pts_list, rows: list) -> None:
         truth.append(lab)
         t_exact += t
         nc, st = np.empty(npts, np.int16), np.empty(npts, np.int8)
-        _, t = timed(kernels.count_block, *pts.kernel_args(), nc, st)
+        _, t = timed(kernels.decide_block, *pts.kernel_args(), nc, st)
         t_kernel += t
         und = np.flatnonzero(st == kernels.UNDECIDED)
         t0 = time.perf_counter()
@@ -204,7 +226,7 @@ def score(name: str, pts_list, rows: list) -> None:
         wrong = int((np.asarray(labels) != truth).sum())
         rows.append((name, method, per(seconds), wrong, npts, note))
     # Uniform degree inside one list element; the float methods run per element.
-    parts = {k: [] for k in ("fs0", "fs10", "nr10", "nr6", "ce")}
+    parts = {k: [] for k in ("fs0", "fs10", "nr10", "nr6", "ce", "lin")}
     times = dict.fromkeys(parts, 0.0)
     for c in coeffs:
         for key, f, tol in (("fs0", float_sturm, 0.0), ("fs10", float_sturm, 1e-10),
@@ -212,13 +234,19 @@ def score(name: str, pts_list, rows: list) -> None:
             out, t = timed(f, c, tol)
             parts[key].append(out)
             times[key] += t
+    for pts in pts_list:
+        out, t = timed(linearisation_pairs, pts, 1e-7)
+        parts["lin"].append(out)
+        times["lin"] += t
     fs0, fs10, nr10, nr6, ce = (np.concatenate(parts[k]) for k in ("fs0", "fs10", "nr10", "nr6", "ce"))
     row("float Sturm, no tolerance", fs0, times["fs0"])
     row("float Sturm, 1e-10 remainder tolerance", fs10, times["fs10"])
     row("numpy.roots, tol 1e-10", nr10, times["nr10"])
     row("numpy.roots, tol 1e-6", nr6, times["nr6"])
     row("companion eigvals (batched), tol 1e-8", ce, times["ce"])
-    shares = ", ".join(f"{100 * (by == v).mean():.1f} % {k}" for v, k in ((BY_STURM, "Sturm"), (BY_INCLUSION, "inclusion"), (BY_EXACT, "exact")))
+    row("linearisation eigvals (batched), tol 1e-7", np.concatenate(parts["lin"]), times["lin"])
+    paths = ((BY_STURM, "Sturm"), (BY_INCLUSION, "inclusion"), (BY_INERTIA, "inertia"), (BY_DISKS, "inertia+disks"), (BY_EXACT, "exact"))
+    shares = ", ".join(f"{100 * (by == v).mean():.1f} % {k}" for v, k in paths)
     row("stabmap certified kernel alone", np.where(by == BY_EXACT, -2, certified), t_kernel, "undecided points counted as wrong; " + shares)
     row("stabmap certified + exact fallback", certified, t_kernel + t_fallback, shares)
     row("exact path alone (python-flint)", truth, t_exact)
@@ -236,7 +264,7 @@ def atlas_shares(names, quick: bool) -> list:
         t = time.perf_counter() - t0
         by = ds["decided_by"].values.ravel()
         out.append((name, by.size, 100 * (by == BY_STURM).mean(), 100 * (by == BY_INCLUSION).mean(),
-                    100 * (by == BY_EXACT).mean(), t))
+                    100 * (by == BY_EXACT).mean(), t, 100 * np.isin(by, (BY_INERTIA, BY_DISKS)).mean()))
     return out
 
 
@@ -247,7 +275,7 @@ def main(argv=None) -> dict:
     rng = np.random.default_rng(7)
     n = 20 if args.quick else 1000
     warm = random_points(rng, 2, 1, 1)
-    kernels.count_block(*warm.kernel_args(), np.empty(2, np.int16), np.empty(2, np.int8))
+    kernels.decide_block(*warm.kernel_args(), np.empty(2, np.int16), np.empty(2, np.int8))
     _float_sturm(np.array([1.0, 0.0, 1.0]), 0.0)
     sets = {
         "random-12": [random_points(rng, n, 3, 2)],
@@ -268,11 +296,11 @@ def main(argv=None) -> dict:
     names = ["paper-n1-fixed", "paper-n2-fixed", "paper-n3-fixed"] if args.quick else \
         ["paper-n1-fixed", "paper-n1-free", "paper-n2-fixed", "paper-n2-free", "paper-n3-fixed", "paper-n3-free"]
     print()
-    print("| example atlas | points | Sturm % | inclusion % | exact % | seconds (1 thread, warm) |")
-    print("|---|---|---|---|---|---|")
+    print("| example atlas | points | Sturm % | inclusion % | inertia (+ disks) % | exact % | seconds (1 thread, warm) |")
+    print("|---|---|---|---|---|---|---|")
     shares = atlas_shares(names, args.quick)
     for s in shares:
-        print(f"| {s[0]} | {s[1]} | {s[2]:.2f} | {s[3]:.2f} | {s[4]:.2f} | {s[5]:.2f} |", flush=True)
+        print(f"| {s[0]} | {s[1]} | {s[2]:.2f} | {s[3]:.2f} | {s[6]:.2f} | {s[4]:.2f} | {s[5]:.2f} |", flush=True)
     return {"rows": rows, "atlases": shares}
 
 

@@ -12,8 +12,11 @@ SCRIPTS = pathlib.Path(__file__).resolve().parents[1] / "scripts"
 
 def test_bench_kernel_quick(capsys):
     rows = runpy.run_path(str(SCRIPTS / "bench_kernel.py"))["main"](["--quick"])
-    assert [r["degree"] for r in rows] == [2, 6, 12]
-    assert all(r["undecided_pct"] <= 100 and r["pts_per_s_1"] > 0 for r in rows)
+    assert [(r["degree"], r["kind"]) for r in rows] == [(d, k) for d in (2, 6, 12) for k in ("mixed", "identical")]
+    for r in rows:
+        assert r["pts_per_s_1"] > 0 and r["peer_us"] > 0
+        assert abs(sum(r["shares"].values()) - 100) < 1e-9
+        assert 0 <= r["peer_wrong"] <= r["compared"] == r["points"]
     assert "| n | modes |" in capsys.readouterr().out
 
 

@@ -1,19 +1,23 @@
-"""Decide N_c for a block of points: the certified kernel first, exact arithmetic for the rest."""
+"""Decide N_c for a block of points: the certified kernels first, exact arithmetic for the rest."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ...kernels import DECIDED_INCLUSION, UNDECIDED, count_block
+from ...kernels import DECIDED_DISKS, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, decide_block
 from . import exact
-from .outputs import BY_EXACT, BY_INCLUSION, BY_STURM
+from .outputs import BY_DISKS, BY_EXACT, BY_INCLUSION, BY_INERTIA, BY_STURM
 from .points import PointArrays
+
+_BY_STATUS = {DECIDED_INCLUSION: BY_INCLUSION, DECIDED_INERTIA: BY_INERTIA, DECIDED_DISKS: BY_DISKS, UNDECIDED: BY_EXACT}
 
 
 def decided_by_from_status(status: np.ndarray) -> np.ndarray:
     """The ``decided_by`` flag from the kernels' status codes (UNDECIDED points are those decided exactly)."""
-    by = np.where(status == DECIDED_INCLUSION, BY_INCLUSION, BY_STURM)
-    return np.where(status == UNDECIDED, BY_EXACT, by).astype(np.int8)
+    by = np.full(status.shape, BY_STURM, dtype=np.int8)
+    for code, flag in _BY_STATUS.items():
+        by[status == code] = flag
+    return by
 
 
 def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
@@ -21,7 +25,7 @@ def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
     npts = points.body.shape[0]
     nc = np.empty(npts, dtype=np.int16)
     status = np.empty(npts, dtype=np.int8)
-    count_block(*points.kernel_args(), nc, status)
+    decide_block(*points.kernel_args(), nc, status)
     undecided = np.flatnonzero(status == UNDECIDED)
     if undecided.size:
         nc[undecided] = exact.decide_points(*points.kernel_args(), undecided)

@@ -28,11 +28,22 @@ DECIDED_BY = Variable(
     "arithmetic that decided n_complex_pairs at this point",
     comment="interval_sturm_sequence: proved by the double-double interval Sturm sequence; "
     "interval_root_inclusion: proved by disjoint Gerschgorin inclusion disks around the roots; "
-    "exact_rational_arithmetic: neither could decide and the point was recomputed exactly. "
-    "These three are proofs; docs/certification.md. "
+    "interval_inertia: every root real, proved by the inertia of the characteristic matrix "
+    "between the roots (no coefficients formed); "
+    "inertia_and_disks: the real roots counted by that inertia, the non-real ones by inclusion "
+    "disks from the determinant of the characteristic matrix in interval arithmetic; "
+    "exact_rational_arithmetic: none of these could decide and the point was recomputed exactly. "
+    "These five are proofs; docs/certification.md. "
     f"{INFERRED}: not computed and not proved; an adaptive atlas (stabmap atlas --refine) "
     "gave the point the value on which all corners of its grid cell agree; docs/refine.md",
-    flags=((0, "interval_sturm_sequence"), (1, "exact_rational_arithmetic"), (2, "interval_root_inclusion"), (3, INFERRED)),
+    flags=(
+        (0, "interval_sturm_sequence"),
+        (1, "exact_rational_arithmetic"),
+        (2, "interval_root_inclusion"),
+        (3, INFERRED),
+        (4, "interval_inertia"),
+        (5, "inertia_and_disks"),
+    ),
 )
 VARIABLES = (N_COMPLEX_PAIRS, STABILITY, DECIDED_BY)
 
@@ -40,6 +51,8 @@ BY_STURM = DECIDED_BY.value("interval_sturm_sequence")
 BY_EXACT = DECIDED_BY.value("exact_rational_arithmetic")
 BY_INCLUSION = DECIDED_BY.value("interval_root_inclusion")
 BY_INFERRED = DECIDED_BY.value(INFERRED)
+BY_INERTIA = DECIDED_BY.value("interval_inertia")
+BY_DISKS = DECIDED_BY.value("inertia_and_disks")
 
 
 def stability_from_pairs(nc: np.ndarray) -> np.ndarray:

@@ -1,0 +1,317 @@
+"""The characteristic matrix of one point as float balls, evaluated without forming p(lambda).
+
+docs/model.md: Phi(z) = z^2 M + z G - K - diag(z^2 (z + omega_k) sum_l E_kl / (z + beta_kl))
+and p(z) = det Phi(z) prod_kl (z + beta_kl).  We work with Phi T (T the path
+matrix of ``charpoly``, det T = 1), whose stiffness part K T is exact: a
+column of K T that is exactly zero makes that column of Phi T divisible by z
+(twice if G vanishes on it too).  ``prepare`` counts those powers;
+so the structural zero roots of p (rigid tilts, ideal joints, g = 0) are known
+exactly: m of them, and p~(z) = p(z) / z^m = det Phi(z) prod (z + beta) / z^m.
+
+Evaluations use Phi itself (M = (M T) T^-1 and K = (K T) T^-1, exact
+column operations): T's cumulative sums would cost a factor ~n^2 in
+condition, which the balls of a 32-body chain cannot afford.  For real x,
+Phi(x) is real symmetric (``real_matrix``).
+
+The workspace ``ws`` (from ``allocate``) holds, per point, the balls of M T,
+K T, M, K, G, beta and sum_l E_kl (M - diag(sum_l E_kl) has the leading
+coefficient of p as its determinant).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import ball
+from .dd import two_sum
+from .charpoly import check_parent, path_matrix, structure
+from .options import kernel
+
+
+@kernel
+def allocate(n, lmax, parent):
+    """Scratch for one block; checks ``parent`` (ValueError unless a regular numbering)."""
+    check_parent(parent, n)
+    T = np.empty((n, n), np.bool_)
+    path_matrix(parent, T)
+    dd = np.empty((3, n, n, 3))  # J, M T, K T in double-double intervals
+    sub = np.empty((n, 3))
+    mat = np.empty((10, n, n))  # MT mid, rad; KT mid, rad; unused; M mid, rad; K mid, rad
+    vec = np.zeros((4, n))  # G mid, rad; sum E mid, rad
+    beta = np.zeros((2, n, max(1, lmax)))  # mid, rad
+    shift = np.zeros(n, np.int64)  # powers of z divided out of column j of Phi T
+    cm = np.empty((n, n), np.complex128)
+    cr = np.empty((n, n))
+    return T, dd, sub, mat, vec, beta, shift, cm, cr
+
+
+@kernel
+def _to_ball(x):
+    """A double-double interval (h, l, r) as a float ball."""
+    return x[0], (abs(x[1]) + x[2]) * ball.INFL
+
+
+@kernel
+def prepare(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
+    """Fill ``ws`` for one point; ``reuse``: M T and K T are those of the previous point.
+
+    Returns the number m of exact zero roots divided out (sum of ``shift``).
+    """
+    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    n = body.shape[0]
+    if not reuse:
+        structure(body, joint, at, g, parent, free, sub, dd[0], dd[1], dd[2])
+        for i in range(n):
+            for j in range(n):
+                mat[0, i, j], mat[1, i, j] = _to_ball(dd[1, i, j])
+                mat[2, i, j], mat[3, i, j] = _to_ball(dd[2, i, j])
+        # M and K themselves: (X T) T^-1 subtracts from column i the columns of the children of i
+        mat[6:] = mat[:4]
+        for c in range(n - 1, 0, -1):
+            for k in range(n):
+                for a in (6, 8):
+                    mat[a, k, parent[c]], mat[a + 1, k, parent[c]] = ball.radd(
+                        mat[a, k, parent[c]], mat[a + 1, k, parent[c]], -mat[a - 6, k, c], mat[a - 5, k, c]
+                    )
+    for k in range(n):
+        vec[0, k], vec[1, k] = ball.rmul(body[k, 2], 0.0, body[k, 5], 0.0)
+        sm, sr = 0.0, 0.0
+        for l in range(nmodes[k]):
+            sm, sr = ball.radd(sm, sr, E[k, l], 0.0)
+            # kappa - 2 exactly as a float pair, so beta is an exact zero when kappa == 2
+            h, lo = two_sum(kappa[k, l], -2.0)
+            t = ball.rmul(body[k, 5], 0.0, h, abs(lo))
+            if h == 0.0:
+                beta[0, k, l], beta[1, k, l] = 0.0, 0.0
+            else:
+                beta[0, k, l], beta[1, k, l] = ball.rdiv(t[0], t[1], kappa[k, l], 0.0)
+        vec[2, k], vec[3, k] = sm, sr
+    total = 0
+    for j in range(n):
+        s = 0
+        if not _column_nonzero(mat[2], mat[3], j):
+            s = 1
+            if not _g_on_column(T, vec[0], vec[1], j):
+                s = 2
+        shift[j] = s
+        total += s
+    return total
+
+
+@kernel
+def _column_nonzero(m, r, j):
+    for i in range(m.shape[0]):
+        if m[i, j] != 0.0 or r[i, j] != 0.0:
+            return True
+    return False
+
+
+@kernel
+def _g_on_column(T, gm, gr, j):
+    for k in range(T.shape[0]):
+        if T[k, j] and (gm[k] != 0.0 or gr[k] != 0.0):
+            return True
+    return False
+
+
+@kernel
+def _liquid_real(x, k, E, nmodes, beta):
+    """sum_l E_kl / (x + beta_kl) as a ball at real x; ok False if x may be a pole."""
+    am, ar = 0.0, 0.0
+    for l in range(nmodes[k]):
+        dm, dr = ball.radd(x, 0.0, beta[0, k, l], beta[1, k, l])
+        if not ball.excludes_zero(dm, dr):
+            return am, ar, False
+        qm, qr = ball.rdiv(E[k, l], 0.0, dm, dr)
+        am, ar = ball.radd(am, ar, qm, qr)
+    return am, ar, True
+
+
+@kernel
+def real_matrix(x, body, E, nmodes, parent, ws, Sm, Sr):
+    """Balls of Phi(x) (symmetric) at the real float x into Sm, Sr; False if x may be a pole.
+
+    In the original coordinates, not T^t Phi T: next to a pole only one
+    diagonal entry is huge, where T^t Phi T would spread it over a block whose
+    elimination then cancels it away with its radius left behind.
+    """
+    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    n = body.shape[0]
+    x2 = x * x
+    for k in range(n):
+        am, ar, ok = _liquid_real(x, k, E, nmodes, beta)
+        if not ok:
+            return False
+        # d_k = x G_k - x^2 (x + omega_k) a_k
+        wm, wr = ball.radd(x, 0.0, body[k, 5], 0.0)
+        t = ball.rmul(x2, 2.0 * ball.U * x2, wm, wr)
+        t = ball.rmul(t[0], t[1], am, ar)
+        gm, gr = ball.rmul(x, 0.0, vec[0, k], vec[1, k])
+        dm, dr = ball.radd(gm, gr, -t[0], t[1])
+        for j in range(k + 1):
+            m, r = ball.rmul(x2, 2.0 * ball.U * x2, mat[6, k, j], mat[7, k, j])
+            m, r = ball.radd(m, r, -mat[8, k, j], mat[9, k, j])
+            if j == k:
+                m, r = ball.radd(m, r, dm, dr)
+            Sm[k, j], Sr[k, j] = m, r
+    return True
+
+
+@kernel
+def complex_matrix(z, zr, body, E, nmodes, ws):
+    """Balls of Phi(z) at the ball (z, zr) into ws[7], ws[8] (original coordinates, as ``real_matrix``).
+
+    Returns (ok, prod_kl (z + beta_kl) as a ball): ok False if z may be a pole.
+    """
+    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    n = body.shape[0]
+    z2 = ball.cmul(z, zr, z, zr)
+    qm, qr = 1.0 + 0.0j, 0.0
+    for k in range(n):
+        am, ar = 0.0j, 0.0
+        for l in range(nmodes[k]):
+            dm, dr = ball.cadd(z, zr, beta[0, k, l] + 0.0j, beta[1, k, l])
+            if not ball.excludes_zero(dm, dr):
+                return False, qm, qr
+            qm, qr = ball.cmul(qm, qr, dm, dr)
+            im, ir = ball.cdiv(E[k, l] + 0.0j, 0.0, dm, dr)
+            am, ar = ball.cadd(am, ar, im, ir)
+        # d_k = z G_k - z^2 (z + omega_k) a_k
+        wm, wr = ball.cadd(z, zr, body[k, 5] + 0.0j, 0.0)
+        t = ball.cmul(z2[0], z2[1], wm, wr)
+        t = ball.cmul(t[0], t[1], am, ar)
+        g = ball.cmul(z, zr, vec[0, k] + 0.0j, vec[1, k])
+        d = ball.cadd(g[0], g[1], -t[0], t[1])
+        for j in range(k + 1):
+            m, r = ball.cmul(z2[0], z2[1], mat[6, k, j] + 0.0j, mat[7, k, j])
+            m, r = ball.cadd(m, r, -mat[8, k, j] + 0.0j, mat[9, k, j])
+            if j == k:
+                m, r = ball.cadd(m, r, d[0], d[1])
+            cm[k, j], cr[k, j] = m, r
+            cm[j, k], cr[j, k] = m, r
+    return True, qm, qr
+
+
+@kernel
+def complex_derivative(z, body, E, nmodes, ws, dm, dr):
+    """Balls of Phi'(z) at the float z into dm, dr.
+
+    Returns sum_kl 1 / (z + beta_kl) as a ball (the logarithmic derivative of
+    prod (z + beta_kl)); its radius is inf if z may be a pole.
+    """
+    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    n = body.shape[0]
+    lm, lr = 0.0j, 0.0
+    for k in range(n):
+        am, ar = 0.0j, 0.0
+        bm, br = 0.0j, 0.0  # sum E / (z + beta)^2 = -a'
+        for l in range(nmodes[k]):
+            qm, qr = ball.cadd(z, 0.0, beta[0, k, l] + 0.0j, beta[1, k, l])
+            if not ball.excludes_zero(qm, qr):
+                return lm, np.inf
+            im, ir = ball.cinv(qm, qr)
+            lm, lr = ball.cadd(lm, lr, im, ir)
+            em, er = ball.cmul(E[k, l] + 0.0j, 0.0, im, ir)
+            am, ar = ball.cadd(am, ar, em, er)
+            em, er = ball.cmul(em, er, im, ir)
+            bm, br = ball.cadd(bm, br, em, er)
+        # d_k' = G_k - (3 z^2 + 2 z omega_k) a_k + z^2 (z + omega_k) b_k
+        w = body[k, 5]
+        c3 = ball.cmul(z, 0.0, 3.0 * z + 2.0 * w, 2.0 * ball.U * abs(3.0 * z + 2.0 * w))
+        t1 = ball.cmul(c3[0], c3[1], am, ar)
+        zz = ball.cmul(z, 0.0, z, 0.0)
+        c2 = ball.cmul(zz[0], zz[1], z + w, 2.0 * ball.U * abs(z + w))
+        t2 = ball.cmul(c2[0], c2[1], bm, br)
+        d = ball.cadd(vec[0, k] + 0.0j, vec[1, k], -t1[0], t1[1])
+        d = ball.cadd(d[0], d[1], t2[0], t2[1])
+        for j in range(k + 1):
+            m, r = ball.cmul(2.0 * z, 0.0, mat[6, k, j] + 0.0j, mat[7, k, j])
+            if j == k:
+                m, r = ball.cadd(m, r, d[0], d[1])
+            dm[k, j], dr[k, j] = m, r
+            dm[j, k], dr[j, k] = m, r
+    return lm, lr
+
+
+@kernel
+def float_matrices(z, body, E, nmodes, ws, F, dF):
+    """Phi(z) and Phi'(z) in floats (as ``complex_matrix``); returns sum_kl 1 / (z + beta_kl)."""
+    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    n = body.shape[0]
+    logq = 0.0j
+    z2 = z * z
+    for k in range(n):
+        a, b = 0.0j, 0.0j
+        for l in range(nmodes[k]):
+            inv = ball.recip(z + beta[0, k, l])
+            logq += inv
+            a += E[k, l] * inv
+            b += E[k, l] * inv * inv
+        w = body[k, 5]
+        d = z * vec[0, k] - z2 * (z + w) * a
+        dd_ = vec[0, k] - (3.0 * z2 + 2.0 * z * w) * a + z2 * (z + w) * b
+        for j in range(k + 1):
+            f = z2 * mat[6, k, j] - mat[8, k, j]
+            df = 2.0 * z * mat[6, k, j]
+            if j == k:
+                f += d
+                df += dd_
+            F[k, j], dF[k, j] = f, df
+            F[j, k], dF[j, k] = f, df
+    return logq
+
+
+@kernel
+def linearisation(body, E, nmodes, parent, ws, C, Mo):
+    """The D x D first-order companion of Phi in original coordinates into C (D = sum(nmodes + 2)).
+
+    State (theta, v = z theta, y_kl = z v_k / (z + beta_kl)):
+        z theta = v
+        z M' v  = K theta - G v + sum_kl E_kl gamma_kl y_kl e_k,  M' = M - diag(sum_l E_kl)
+        z y_kl  = z v_k - beta_kl y_kl,                            gamma_kl = omega_k - beta_kl
+    Its eigenvalues are the roots of p; only approximations are needed (they
+    steer the certificate, they prove nothing), so floats.  Mo (n, n) is scratch.
+    False if M' is singular in floats.
+    """
+    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    n = body.shape[0]
+    C[:] = 0.0
+    # M = (M T) T^-1: column i of M is column i of M T minus the columns of the children of i.
+    for i in range(n):
+        for k in range(n):
+            Mo[k, i] = mat[0, k, i]
+    for c in range(1, n):
+        for k in range(n):
+            Mo[k, parent[c]] -= mat[0, k, c]
+    for k in range(n):
+        Mo[k, k] -= vec[2, k]
+    try:
+        Minv = np.linalg.inv(Mo)
+    except Exception:  # singular in floats: no approximations from here
+        return False
+    for i in range(n):
+        for k in range(n):
+            Mo[k, i] = mat[2, k, i]
+    for c in range(1, n):
+        for k in range(n):
+            Mo[k, parent[c]] -= mat[2, k, c]
+    MK = Minv @ Mo
+    for k in range(n):
+        C[k, n + k] = 1.0
+        for j in range(n):
+            C[n + k, j] = MK[k, j]
+            C[n + k, n + j] = -Minv[k, j] * vec[0, j]
+    col = 2 * n
+    for j in range(n):
+        for l in range(nmodes[j]):
+            gamma = body[j, 5] - beta[0, j, l]
+            for k in range(n):
+                C[n + k, col] = Minv[k, j] * E[j, l] * gamma
+            col += 1
+    row = 2 * n
+    for k in range(n):
+        for l in range(nmodes[k]):
+            C[row] = C[n + k]
+            C[row, row] -= beta[0, k, l]
+            row += 1
+    return True
