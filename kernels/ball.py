@@ -79,13 +79,17 @@ def cinv(bm, br):
 
     The image of the disk |y - b| <= r under 1/y is the disk with centre
     conj(b) / (|b|^2 - r^2) and radius r / (|b|^2 - r^2); we centre on the
-    float 1/b instead and add the distance between the two centres.
+    float 1/b instead and add the distance between the two centres,
+    r^2 / (|b| (|b|^2 - r^2)).  |b|^2 - r^2 = (|b| - r)(|b| + r) is divided
+    out factor by factor, so nothing overflows for huge |b|.
     """
     m = 1.0 / bm
     a = abs(bm)
-    low = (a * LOW - br * INFL) * (a * LOW + br * INFL) * LOW  # below |b|^2 - r^2
-    exact_centre_shift = br * br / (a * low) * INFL  # |conj(b)/(|b|^2-r^2) - 1/b| = r^2 / (|b| (|b|^2 - r^2))
-    return m, (br / low * INFL + exact_centre_shift + 8.0 * U * abs(m) + ETA) * INFL
+    minus = (a * LOW - br * INFL) * LOW  # below |b| - r
+    plus = a * LOW  # below |b| + r (and below |b|)
+    disk = br / plus / minus * INFL * INFL
+    shift = (br / plus) * (br / plus) / minus * INFL * INFL * INFL
+    return m, (disk + shift + 8.0 * U * abs(m) + ETA) * INFL
 
 
 @kernel

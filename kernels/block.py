@@ -11,7 +11,7 @@ from .options import kernel
 from .status import DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL
 
 LAPLACE_MAX = 12  # bodies: the coefficient path's 2^n minors cost 47 ms a point at n = 12
-STURM_FIRST = 16  # degree up to which the Sturm sequence is the cheapest proof (scripts/bench_kernel.py)
+STURM_FIRST = 12  # degree up to which the Sturm sequence is the cheapest proof (scripts/bench_kernel.py)
 
 
 @kernel
@@ -75,14 +75,14 @@ def count_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out_
 
 
 @kernel
-def _count_coefficients(body, joint, at, g, E, kappa, nmodes, parent, rowdeg, free, ws, c, cs, starts, reuse):
-    """(N_c, status) of one point from the enclosed coefficients of p, factor by factor."""
+def _count_coefficients(body, joint, at, g, E, kappa, nmodes, parent, rowdeg, free, ws, c, cs, starts, reuse, inclusion=True):
+    """(N_c, status) of one point from the enclosed coefficients of p, factor by factor (``count_point``)."""
     matrix_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     nblocks = diagonal_blocks(ws[5], starts)
     total, status = 0, DECIDED_FLOAT
     for b in range(nblocks):
         d = block_det(ws, rowdeg, starts[b], starts[b + 1], c)
-        nc, st = count_point(c[: d + 1], cs)
+        nc, st = count_point(c[: d + 1], cs, inclusion)
         if st == ZERO_POLYNOMIAL or st == UNDECIDED:
             total, status = -1, st
             if st == ZERO_POLYNOMIAL:
@@ -100,11 +100,10 @@ def decide_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out
 
     Inputs and outputs as for ``count_block``.  Up to degree ``STURM_FIRST``
     the interval Sturm sequence on the coefficients is the cheapest proof
-    (docs/speed.md), so it goes first and the certificates of ``certify``
-    take what it leaves (repeated roots, mostly); above, the certificates go
-    first and the coefficient path takes what they leave, up to
-    ``LAPLACE_MAX`` bodies (its cost is exponential in n).  Points none
-    decides stay UNDECIDED: the caller takes them to exact arithmetic.
+    (scripts/bench_kernel.py), so it goes first; then the certificates of
+    ``certify``; then root inclusion on the coefficients, up to ``LAPLACE_MAX``
+    bodies (the coefficients cost 2^n minors).  Points none decides stay
+    UNDECIDED: the caller takes them to exact arithmetic.
     """
     npts, n = body.shape[0], body.shape[1]
     rowdeg = nmodes + 2
@@ -117,16 +116,20 @@ def decide_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out
     cs = allocate_count(degree)
     starts = np.empty(n + 1, np.int64)
     coefficients_last = -1  # the last point whose M and K the coefficient path built
+    certified_last = -1  # and the certificate
     for p in range(npts):
         reuse = same_structure(body, joint, at, g, p)
         nc, st = -1, UNDECIDED
         if sturm_first:
-            nc, st = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, reuse)
+            nc, st = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, reuse, False)
             coefficients_last = p
         if st == UNDECIDED:
-            nc, st = certify.certify_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, cws, reuse)
-        if st == UNDECIDED and laplace and not sturm_first:
-            again = reuse and coefficients_last == p - 1
+            # M and K in the certificate's workspace are those of the last point it saw
+            again = reuse and certified_last == p - 1
+            nc, st = certify.certify_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, cws, again)
+            certified_last = p
+        if st == UNDECIDED and laplace:
+            again = reuse and coefficients_last == p - 1 or coefficients_last == p
             nc, st = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, again)
             coefficients_last = p
         out_nc[p] = nc

@@ -26,16 +26,16 @@ def allocate_count(degree):
 
 
 @kernel
-def count_point(c, ws):
+def count_point(c, ws, inclusion=True):
     """(N_c, status) of the interval polynomial c (ascending, (hi, lo, rad)); ws from ``allocate_count``.
 
     The Sturm sequence is cheap and decides nearly every point up to degree ~12;
-    root inclusion needs no remainder chain and decides well-separated roots at
-    any degree.  Whatever neither proves is UNDECIDED.
+    root inclusion (unless ``inclusion`` is False) needs no remainder chain and
+    decides well-separated roots at any degree.  Whatever neither proves is UNDECIDED.
     """
     W, X, a, z, R, group, flags = ws
     nc, status = count_complex_pairs(c, W)
-    if status != UNDECIDED:
+    if status != UNDECIDED or not inclusion:
         return nc, status
     low, top = nonzero_span(c)
     d = top - low

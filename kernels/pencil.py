@@ -217,7 +217,8 @@ def complex_derivative(z, body, E, nmodes, ws, dm, dr):
             bm, br = ball.cadd(bm, br, em, er)
         # d_k' = G_k - (3 z^2 + 2 z omega_k) a_k + z^2 (z + omega_k) b_k
         w = body[k, 5]
-        c3 = ball.cmul(z, 0.0, 3.0 * z + 2.0 * w, 2.0 * ball.U * abs(3.0 * z + 2.0 * w))
+        # 3 z + 2 w in floats errs by at most u |3 z| + u |3 z + 2 w| (2 w is exact)
+        c3 = ball.cmul(z, 0.0, 3.0 * z + 2.0 * w, 2.0 * ball.U * (abs(3.0 * z) + abs(3.0 * z + 2.0 * w)))
         t1 = ball.cmul(c3[0], c3[1], am, ar)
         zz = ball.cmul(z, 0.0, z, 0.0)
         c2 = ball.cmul(zz[0], zz[1], z + w, 2.0 * ball.U * abs(z + w))
