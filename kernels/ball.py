@@ -16,10 +16,12 @@ product, |fl(ab) - ab| <= sqrt(5) u |ab|):
   division    : through a rigorously bounded reciprocal (8u for the float
                 1/b, which numba forms by Smith's algorithm), then one product.
 Every radius is a sum of nonnegative float terms and is inflated by
-``INFL`` = 1 + 8u, which covers the rounding of that sum (at most four terms).
+``INFL`` = 1 + 8u, which covers the rounding of that sum (at most five terms,
+to first order in u).
 ``ETA`` covers underflow.  ``abs`` of a complex number (hypot) is within one ulp,
-covered by the same inflation.  NaN or infinite midpoints make every test below
-fail, so they never decide anything.
+covered by the same inflation.  ``excludes_zero``, the test every proof goes
+through, is False for NaN or infinite midpoints and radii, so those never
+decide anything.
 """
 
 from __future__ import annotations
@@ -56,8 +58,9 @@ def rdiv(am, ar, bm, br):
 
 @kernel
 def excludes_zero(m, r):
-    """True if the ball (real or complex) provably does not contain 0 (False for NaN)."""
-    return abs(m) * LOW > r * INFL
+    """True if the ball (real or complex) provably does not contain 0 (False for NaN and infinite midpoints)."""
+    a = abs(m)
+    return a * LOW > r * INFL and a < math.inf
 
 
 @kernel

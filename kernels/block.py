@@ -8,7 +8,7 @@ from . import certify, pencil
 from .charpoly import allocate, block_det, charpoly_point, diagonal_blocks, matrix_point, same_structure
 from .count import allocate_count, count_point
 from .options import kernel
-from .status import DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL
+from .status import DECIDED_FLOAT, DECIDED_INCLUSION, UNDECIDED, ZERO_POLYNOMIAL
 
 LAPLACE_MAX = 12  # bodies: the coefficient path's 2^n minors cost 47 ms a point at n = 12
 STURM_FIRST = 12  # degree up to which the Sturm sequence is the cheapest proof (scripts/bench_kernel.py)

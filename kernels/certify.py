@@ -5,21 +5,22 @@ Phi^(x) = diag(Q(x)) Phi(x) diag(Q(x)) (a real symmetric polynomial matrix,
 det Phi^ = p prod Q, every zero of prod Q real) and nu(x) the number of
 negative eigenvalues of Phi(x), which is that of Phi^(x) off the poles:
 
-* for separators x_0 < ... < x_s at which Phi(x_i) is provably nonsingular,
-  the real roots of p number at least  sum_i |nu(x_i+1) - nu(x_i)| - sum_k L_k
-  (the analytic eigenvalue branches of Phi^ must cross zero for nu to change);
-* the Gerschgorin disks of Braess & Hadeler around approximations z_i, with
-  p(z_i) bounded by Gaussian elimination of Phi(z_i) T in balls, prove how many
-  roots lie off the real axis: a connected group of k disks missing the axis
-  holds k non-real roots.
+* between increasing separators a < b at which Phi is provably nonsingular,
+  p has at least |nu(b) - nu(a)| - (poles in (a, b)) real roots (the analytic
+  eigenvalue branches of Phi^ must cross zero for nu to change);
+* a Newton disk around z (radius d / |p~'/p~(z)|, the ratio enclosed by
+  elimination of [Phi(z) | Phi'(z)] in balls) holds a root of p~ = p / z^m;
+  disjoint ones clear of the axis hold distinct non-real roots.  Where those
+  do not suffice, the Gerschgorin disks of Braess & Hadeler around all
+  approximations: a connected group of k disks missing the axis holds k
+  non-real roots.
 
 When the lower bound of real roots plus the non-real roots proved make deg p,
-N_c is proved.  A stable point needs the inertia only: the separators are
-midpoints between approximations of the roots and the poles, taken from the
-previous point of the block first (a grid neighbour; no root finding at all),
-else from the eigenvalues of the first-order linearisation polished by Aberth
-sweeps on det Phi T.  Repeated roots (identical bodies) need no special case:
-k branches cross zero together and nu jumps by k.
+N_c is proved.  The approximations only place separators and disks: a grid
+neighbour's roots, extrapolated, first (no eigenvalue problem at all), else
+the eigenvalues of the first-order linearisation, polished by Aberth sweeps
+on det Phi.  Repeated roots (identical bodies) need no special case: k
+branches cross zero together and nu jumps by k.
 """
 
 from __future__ import annotations
@@ -42,19 +43,20 @@ _KIND = ord("d")
 _NO_VECTORS = ord("N")
 
 COLD_SWEEPS = 24  # Aberth sweeps from the linearisation's eigenvalues (CERTIFY.md: enough to degree 48)
-WARM_STEPS = 3  # Newton steps on a neighbour's non-real roots before their disks
-WARM_SWEEPS = 4  # Aberth sweeps from a neighbour's roots where those did not do (at most)
+WARM_STEPS = 8  # Newton steps on a neighbour's non-real roots before their disks
+WARM_SWEEPS = 4  # Aberth sweeps on a neighbour's roots that the inertia found out of place (at most)
 MISSES, PAUSE = 4, 16  # warm starts that failed in a row, and the points then done cold
 SMALL = 8  # bodies up to which plain elimination in balls beats preconditioning (BLAS products)
 SHIFTS = (2.0**-30, 2.0**-20, 2.0**-12)  # a Newton disk is centred this far (relative) above its root
 UPPER = 2.0**-30  # approximations this far above the axis (relative) are tried as non-real roots
-STEP_TOL = 2.0**-46
+STEP_TOL = 2.0**-46  # an Aberth step below this share of the root: converged
 LOOSE_TOL = 2.0**-26  # enough for separators; the disks polish their own roots further
 RIDE = 0.05  # a root this close to a pole (relative) is predicted to move with it
-MERGE = 2.0**-40
+MERGE = 2.0**-40  # features closer than this share of their size get no separator between them
 FENCE = 2.0**-30  # separators this close (relative) either side of each pole
-NEAR_REAL = 2.0**-20
-MAGNITUDE_LOW, MAGNITUDE_HIGH = 2.0**-150, 2.0**150  # parameters outside are left to exact arithmetic  # approximations this close to the axis (relative) are expected to be real roots  # features closer than this share of their size get no separator between them
+NEAR_REAL = 2.0**-20  # approximations this close to the axis (relative) are expected to be real roots
+NUDGE = 2.0**-10  # relative imaginary offset given to suspect real approximations before polishing
+MAGNITUDE_LOW, MAGNITUDE_HIGH = 2.0**-150, 2.0**150  # parameters outside are left to exact arithmetic
 
 
 @kernel
@@ -77,9 +79,11 @@ def allocate(n, nmodes, parent):
     feat = np.empty(nfeat)
     R = np.empty(degree)
     group = np.empty(degree, np.int64)
-    # previous point: decided?, its deflated degree, its N_c; warm pause, misses; warm tries, hits;
-    # zold: the roots of the point before the previous one, if state[7]
-    state = np.zeros(9, np.int64)
+    # state: [0] the previous point was decided, [1] its degree d, [2] its N_c, [3] points left to do
+    # cold, [4] warm misses in a row, [5] warm tries, [6] warm hits, [7] zold holds the roots of the
+    # point before the previous one, [8] hits at the first warm attempt ([5], [6], [8]: for benchmarks),
+    # [9] the workspace holds the structure (M T, K T) of the last point given
+    state = np.zeros(10, np.int64)
     zold = np.empty(degree, np.complex128)
     bold = np.zeros((n, lmax))  # beta of the previous point
     dm = np.empty((n, n), np.complex128)
@@ -251,7 +255,7 @@ def _find(root, i):
 def _nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e):
     """Roots of p~ proved non-real by the disks of Braess & Hadeler around z (module docstring)."""
     n = body.shape[0]
-    cm, cr = pws[7], pws[8]
+    cm, cr = pws[6], pws[7]
     for i in range(d):
         zi = z[i]
         ok, qm, qr = pencil.complex_matrix(zi, 0.0, body, E, nmodes, pws)
@@ -280,6 +284,8 @@ def _nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e):
         if expo > 1000:
             continue
         R[i] = math.ldexp(mant * d * ball.INFL, expo) + ball.ETA
+        if not R[i] <= np.inf:  # NaN: an infinite disk, which proves nothing
+            R[i] = np.inf
     for i in range(d):
         group[i] = i
     for i in range(d):
@@ -328,9 +334,9 @@ def _newton_disk(zc, d, m, body, E, nmodes, pws, dm, dr):
     if not math.isfinite(lr) or not ball.excludes_zero(zc, 0.0):
         return np.inf
     if n <= SMALL:
-        ok, tm, tr = elimination.trace_bound(pws[7], pws[8], dm, dr, n)
+        ok, tm, tr = elimination.trace_bound(pws[6], pws[7], dm, dr, n)
     else:
-        ok, tm, tr = elimination.trace_preconditioned(pws[7], pws[8], dm, dr, n)
+        ok, tm, tr = elimination.trace_preconditioned(pws[6], pws[7], dm, dr, n)
     if not ok:
         return np.inf
     sm, sr = ball.cadd(tm, tr, lm, lr)
@@ -423,7 +429,9 @@ def _attempt(z, d, m, degree, body, E, nmodes, parent, ws, newton_steps):
     """
     pws, C, Mo, wr, wi, vdummy, _z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold = ws
     real = max(m, _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, done))
-    if real >= degree:
+    if real > degree:  # impossible for a proved bound: never label from it
+        return real, -1, UNDECIDED
+    if real == degree:
         return real, 0, DECIDED_INERTIA
     if (degree - real) % 2 == 0:
         if newton_steps > 0:
@@ -467,10 +475,14 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold = ws
     n = body.shape[0]
     degree = C.shape[0]
+    # M T and K T in the workspace are the previous point's only if it got as far as prepare
+    reuse = reuse and state[9] == 1
+    state[9] = 0
     if not _moderate(body, joint, at, g, E, kappa, nmodes):
         state[0] = 0
         return -1, UNDECIDED
     m = pencil.prepare(body, joint, at, g, E, kappa, nmodes, parent, free, pws, reuse)
+    state[9] = 1
     d = degree - m
     ok, lead_m, lead_e = _lead(pws, n, Sm, Sr)
     state[0] = 0 if not ok else state[0]
@@ -486,16 +498,19 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     if neighbour and state[3] <= 0:
         real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, WARM_STEPS)
         state[8] += status != UNDECIDED
-        if status == UNDECIDED:
-            # polish the approximations the inertia found out of place (done holds them),
-            # then all of them: separators need a few digits, not all
-            if done[:d].any():
-                for i in range(d):
-                    done[i] = not done[i]
-                _aberth(z, d, m, WARM_SWEEPS, body, E, nmodes, pws, F, dF, done, LOOSE_TOL)
-                real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, 0)
-        if status == UNDECIDED:
-            done[:d] = False
+        suspects = done[:d].sum()
+        if status == UNDECIDED and 0 < suspects <= d // 4:
+            # polish the few approximations the inertia found out of place (done holds them);
+            # separators need a few digits, not all.  Real ones are nudged off the axis first:
+            # on a real polynomial Aberth keeps real iterates real, so a pair of real roots
+            # that met and left the axis would never be found.  More suspects than that: the
+            # neighbour is too far, and the eigenvalues are cheaper than polishing them all.
+            sign = 1.0
+            for i in range(d):
+                if done[i] and abs(z[i].imag) <= NEAR_REAL * abs(z[i]):
+                    z[i] += complex(0.0, sign * NUDGE * (abs(z[i]) + 1e-300))
+                    sign = -sign
+                done[i] = not done[i]
             _aberth(z, d, m, WARM_SWEEPS, body, E, nmodes, pws, F, dF, done, LOOSE_TOL)
             real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, WARM_STEPS)
         state[5] += 1

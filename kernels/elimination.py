@@ -71,6 +71,23 @@ def _swap_symmetric(Sm, Sr, n, a, b):
 
 
 @kernel
+def _pivot(A, step, n):
+    """The row at or below ``step`` with the largest |A[row, step]| (partial pivoting)."""
+    p, best = step, -1.0
+    for i in range(step, n):
+        a = abs(A[i, step])
+        if a > best:
+            p, best = i, a
+    return p, best
+
+
+@kernel
+def _swap_rows(X, a, b):
+    for j in range(X.shape[1]):
+        X[a, j], X[b, j] = X[b, j], X[a, j]
+
+
+@kernel
 def det_bound(cm, cr, n, lower):
     """A bound of |det| over the complex ball matrix (cm, cr) as (ok, mantissa, exponent).
 
@@ -81,15 +98,10 @@ def det_bound(cm, cr, n, lower):
     """
     mant, expo = 1.0, 0
     for step in range(n):
-        p, best = step, -1.0
-        for i in range(step, n):
-            a = abs(cm[i, step])
-            if a > best:
-                p, best = i, a
+        p = _pivot(cm, step, n)[0]
         if p != step:
-            for j in range(n):
-                cm[step, j], cm[p, j] = cm[p, j], cm[step, j]
-                cr[step, j], cr[p, j] = cr[p, j], cr[step, j]
+            _swap_rows(cm, step, p)
+            _swap_rows(cr, step, p)
         pm, pr = cm[step, step], cr[step, step]
         if lower:
             if not ball.excludes_zero(pm, pr):
@@ -118,17 +130,12 @@ def trace_solve(F, dF, n):
     With F = Phi T this is (d/dz) log det Phi T: the Newton direction of the determinant.
     """
     for step in range(n):
-        p, best = step, -1.0
-        for i in range(step, n):
-            a = abs(F[i, step])
-            if a > best:
-                p, best = i, a
+        p, best = _pivot(F, step, n)
         if best == 0.0:
             return complex(math.nan, math.nan)
         if p != step:
-            for j in range(n):
-                F[step, j], F[p, j] = F[p, j], F[step, j]
-                dF[step, j], dF[p, j] = dF[p, j], dF[step, j]
+            _swap_rows(F, step, p)
+            _swap_rows(dF, step, p)
         inv = 1.0 / F[step, step]
         for i in range(step + 1, n):
             f = F[i, step] * inv
@@ -156,17 +163,12 @@ def trace_bound(cm, cr, dm, dr, n):
     As ``trace_solve`` in balls; (ok, midpoint, radius), ok False if a pivot may vanish.
     """
     for step in range(n):
-        p, best = step, -1.0
-        for i in range(step, n):
-            a = abs(cm[i, step])
-            if a > best:
-                p, best = i, a
+        p = _pivot(cm, step, n)[0]
         if p != step:
-            for j in range(n):
-                cm[step, j], cm[p, j] = cm[p, j], cm[step, j]
-                cr[step, j], cr[p, j] = cr[p, j], cr[step, j]
-                dm[step, j], dm[p, j] = dm[p, j], dm[step, j]
-                dr[step, j], dr[p, j] = dr[p, j], dr[step, j]
+            for X in (cm, dm):
+                _swap_rows(X, step, p)
+            for X in (cr, dr):
+                _swap_rows(X, step, p)
         if not ball.excludes_zero(cm[step, step], cr[step, step]):
             return False, 0.0j, 0.0
         im, ir = ball.cinv(cm[step, step], cr[step, step])
@@ -201,17 +203,12 @@ def _float_inverse(A, X, n):
     for i in range(n):
         X[i, i] = 1.0
     for step in range(n):
-        p, best = step, -1.0
-        for i in range(step, n):
-            a = abs(W[i, step])
-            if a > best:
-                p, best = i, a
+        p, best = _pivot(W, step, n)
         if not (best > 0.0 and math.isfinite(best)):
             return False
         if p != step:
-            for j in range(n):
-                W[step, j], W[p, j] = W[p, j], W[step, j]
-                X[step, j], X[p, j] = X[p, j], X[step, j]
+            _swap_rows(W, step, p)
+            _swap_rows(X, step, p)
         inv = 1.0 / W[step, step]
         for j in range(n):
             W[step, j] *= inv

@@ -1,12 +1,11 @@
 """The characteristic matrix of one point as float balls, evaluated without forming p(lambda).
 
 docs/model.md: Phi(z) = z^2 M + z G - K - diag(z^2 (z + omega_k) sum_l E_kl / (z + beta_kl))
-and p(z) = det Phi(z) prod_kl (z + beta_kl).  We work with Phi T (T the path
-matrix of ``charpoly``, det T = 1), whose stiffness part K T is exact: a
-column of K T that is exactly zero makes that column of Phi T divisible by z
-(twice if G vanishes on it too).  ``prepare`` counts those powers;
-so the structural zero roots of p (rigid tilts, ideal joints, g = 0) are known
-exactly: m of them, and p~(z) = p(z) / z^m = det Phi(z) prod (z + beta) / z^m.
+and p(z) = det Phi(z) prod_kl (z + beta_kl).  With T the path matrix of
+``charpoly`` (det T = 1), K T is exact in double-double: a column of K T that
+is exactly zero makes that column of Phi T divisible by z.  ``prepare`` counts
+those columns, so m structural zero roots of p (rigid tilts, ideal joints,
+g = 0) are known exactly, and p~(z) = p(z) / z^m = det Phi(z) prod (z + beta) / z^m.
 
 Evaluations use Phi itself (M = (M T) T^-1 and K = (K T) T^-1, exact
 column operations): T's cumulative sums would cost a factor ~n^2 in
@@ -39,10 +38,9 @@ def allocate(n, lmax, parent):
     mat = np.empty((10, n, n))  # MT mid, rad; KT mid, rad; unused; M mid, rad; K mid, rad
     vec = np.zeros((4, n))  # G mid, rad; sum E mid, rad
     beta = np.zeros((2, n, max(1, lmax)))  # mid, rad
-    shift = np.zeros(n, np.int64)  # powers of z divided out of column j of Phi T
     cm = np.empty((n, n), np.complex128)
     cr = np.empty((n, n))
-    return T, dd, sub, mat, vec, beta, shift, cm, cr
+    return T, dd, sub, mat, vec, beta, cm, cr
 
 
 @kernel
@@ -55,9 +53,9 @@ def _to_ball(x):
 def prepare(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
     """Fill ``ws`` for one point; ``reuse``: M T and K T are those of the previous point.
 
-    Returns the number m of exact zero roots divided out (sum of ``shift``).
+    Returns the number m of exact zero roots (columns of K T that are exactly zero).
     """
-    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    T, dd, sub, mat, vec, beta, cm, cr = ws
     n = body.shape[0]
     if not reuse:
         structure(body, joint, at, g, parent, free, sub, dd[0], dd[1], dd[2])
@@ -86,30 +84,18 @@ def prepare(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
             else:
                 beta[0, k, l], beta[1, k, l] = ball.rdiv(t[0], t[1], kappa[k, l], 0.0)
         vec[2, k], vec[3, k] = sm, sr
-    total = 0
+    # the exact zero roots: a column of K T that is exactly zero makes that column of Phi T divisible by z
+    m = 0
     for j in range(n):
-        s = 0
         if not _column_nonzero(mat[2], mat[3], j):
-            s = 1
-            if not _g_on_column(T, vec[0], vec[1], j):
-                s = 2
-        shift[j] = s
-        total += s
-    return total
+            m += 1
+    return m
 
 
 @kernel
 def _column_nonzero(m, r, j):
     for i in range(m.shape[0]):
         if m[i, j] != 0.0 or r[i, j] != 0.0:
-            return True
-    return False
-
-
-@kernel
-def _g_on_column(T, gm, gr, j):
-    for k in range(T.shape[0]):
-        if T[k, j] and (gm[k] != 0.0 or gr[k] != 0.0):
             return True
     return False
 
@@ -135,21 +121,21 @@ def real_matrix(x, body, E, nmodes, parent, ws, Sm, Sr):
     diagonal entry is huge, where T^t Phi T would spread it over a block whose
     elimination then cancels it away with its radius left behind.
     """
-    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    T, dd, sub, mat, vec, beta, cm, cr = ws
     n = body.shape[0]
-    x2 = x * x
+    x2, x2r = ball.rmul(x, 0.0, x, 0.0)  # with ETA: x * x may underflow
     for k in range(n):
         am, ar, ok = _liquid_real(x, k, E, nmodes, beta)
         if not ok:
             return False
         # d_k = x G_k - x^2 (x + omega_k) a_k
         wm, wr = ball.radd(x, 0.0, body[k, 5], 0.0)
-        t = ball.rmul(x2, 2.0 * ball.U * x2, wm, wr)
+        t = ball.rmul(x2, x2r, wm, wr)
         t = ball.rmul(t[0], t[1], am, ar)
         gm, gr = ball.rmul(x, 0.0, vec[0, k], vec[1, k])
         dm, dr = ball.radd(gm, gr, -t[0], t[1])
         for j in range(k + 1):
-            m, r = ball.rmul(x2, 2.0 * ball.U * x2, mat[6, k, j], mat[7, k, j])
+            m, r = ball.rmul(x2, x2r, mat[6, k, j], mat[7, k, j])
             m, r = ball.radd(m, r, -mat[8, k, j], mat[9, k, j])
             if j == k:
                 m, r = ball.radd(m, r, dm, dr)
@@ -159,11 +145,11 @@ def real_matrix(x, body, E, nmodes, parent, ws, Sm, Sr):
 
 @kernel
 def complex_matrix(z, zr, body, E, nmodes, ws):
-    """Balls of Phi(z) at the ball (z, zr) into ws[7], ws[8] (original coordinates, as ``real_matrix``).
+    """Balls of Phi(z) at the ball (z, zr) into ws[6], ws[7] (original coordinates, as ``real_matrix``).
 
     Returns (ok, prod_kl (z + beta_kl) as a ball): ok False if z may be a pole.
     """
-    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    T, dd, sub, mat, vec, beta, cm, cr = ws
     n = body.shape[0]
     z2 = ball.cmul(z, zr, z, zr)
     qm, qr = 1.0 + 0.0j, 0.0
@@ -199,7 +185,7 @@ def complex_derivative(z, body, E, nmodes, ws, dm, dr):
     Returns sum_kl 1 / (z + beta_kl) as a ball (the logarithmic derivative of
     prod (z + beta_kl)); its radius is inf if z may be a pole.
     """
-    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    T, dd, sub, mat, vec, beta, cm, cr = ws
     n = body.shape[0]
     lm, lr = 0.0j, 0.0
     for k in range(n):
@@ -218,7 +204,7 @@ def complex_derivative(z, body, E, nmodes, ws, dm, dr):
         # d_k' = G_k - (3 z^2 + 2 z omega_k) a_k + z^2 (z + omega_k) b_k
         w = body[k, 5]
         # 3 z + 2 w in floats errs by at most u |3 z| + u |3 z + 2 w| (2 w is exact)
-        c3 = ball.cmul(z, 0.0, 3.0 * z + 2.0 * w, 2.0 * ball.U * (abs(3.0 * z) + abs(3.0 * z + 2.0 * w)))
+        c3 = ball.cmul(z, 0.0, 3.0 * z + 2.0 * w, 2.0 * ball.U * (abs(3.0 * z) + abs(3.0 * z + 2.0 * w)) + ball.ETA)
         t1 = ball.cmul(c3[0], c3[1], am, ar)
         zz = ball.cmul(z, 0.0, z, 0.0)
         c2 = ball.cmul(zz[0], zz[1], z + w, 2.0 * ball.U * abs(z + w))
@@ -237,7 +223,7 @@ def complex_derivative(z, body, E, nmodes, ws, dm, dr):
 @kernel
 def float_matrices(z, body, E, nmodes, ws, F, dF):
     """Phi(z) and Phi'(z) in floats (as ``complex_matrix``); returns sum_kl 1 / (z + beta_kl)."""
-    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    T, dd, sub, mat, vec, beta, cm, cr = ws
     n = body.shape[0]
     logq = 0.0j
     z2 = z * z
@@ -274,29 +260,18 @@ def linearisation(body, E, nmodes, parent, ws, C, Mo):
     steer the certificate, they prove nothing), so floats.  Mo (n, n) is scratch.
     False if M' is singular in floats.
     """
-    T, dd, sub, mat, vec, beta, shift, cm, cr = ws
+    T, dd, sub, mat, vec, beta, cm, cr = ws
     n = body.shape[0]
     C[:] = 0.0
-    # M = (M T) T^-1: column i of M is column i of M T minus the columns of the children of i.
     for i in range(n):
         for k in range(n):
-            Mo[k, i] = mat[0, k, i]
-    for c in range(1, n):
-        for k in range(n):
-            Mo[k, parent[c]] -= mat[0, k, c]
-    for k in range(n):
-        Mo[k, k] -= vec[2, k]
+            Mo[k, i] = mat[6, k, i]
+        Mo[i, i] -= vec[2, i]
     try:
         Minv = np.linalg.inv(Mo)
-    except Exception:  # singular in floats: no approximations from here
+    except Exception:  # noqa: BLE001 -- numba catches no narrower class; singular in floats: no approximations
         return False
-    for i in range(n):
-        for k in range(n):
-            Mo[k, i] = mat[2, k, i]
-    for c in range(1, n):
-        for k in range(n):
-            Mo[k, parent[c]] -= mat[2, k, c]
-    MK = Minv @ Mo
+    MK = Minv @ mat[8]
     for k in range(n):
         C[k, n + k] = 1.0
         for j in range(n):

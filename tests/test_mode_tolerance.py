@@ -137,11 +137,15 @@ def test_a_tighter_tolerance_never_keeps_fewer_modes(log_tol, factor):
     assert kept[0].tail_over_A <= tight and kept[1].tail_over_A <= loose
 
 
-def test_default_is_auto_capped_at_the_old_default():
-    small = top(a=0.02).bodies[0].cavity  # a small cavity in the body: one mode is enough
+def test_default_is_the_count_and_auto_is_capped_at_it():
+    # Without modes or mode_tolerance the cavity keeps the default count, whatever its tail: the tail bound
+    # says nothing about the resonance bands of the modes it would drop (docs/cavities.md, "Choosing N").
+    plain = top(a=0.02).bodies[0].cavity
+    assert (plain.modes, plain.mode_tolerance, plain.kept) == (cavity.DEFAULT_MODES, None, cavity.DEFAULT_MODES)
+    small = top(', modes = "auto"', a=0.02).bodies[0].cavity  # a small cavity in the body: one mode is enough
     assert (small.modes, small.mode_tolerance, small.kept) == ("auto", None, 1)
     assert small.tail_over_A <= liquid.DEFAULT_TOLERANCE
-    heavy = top(q=(0.25, 3.0)).bodies[0].cavity  # tall and heavy: the default keeps its cap, says so
+    heavy = top(', modes = "auto"', q=(0.25, 3.0)).bodies[0].cavity  # tall and heavy: auto keeps its cap, says so
     assert heavy.kept == cavity.DEFAULT_MODES and heavy.tail_over_A > liquid.DEFAULT_TOLERANCE
     assert "not met" in liquid.describe(heavy)
     # A stated tolerance may keep more than the default's cap.
@@ -181,8 +185,9 @@ def test_round_trip_and_atlas_reproduce_the_choice(tmp_path):
     assert f"{c.tail_over_A:.2g} of A" in line
 
 
-def test_default_scene_writes_auto_without_a_tolerance():
-    table = top(a=0.02).to_dict()["bodies"][0]["cavity"]
+def test_default_scene_writes_its_count_and_auto_without_a_tolerance():
+    assert top(a=0.02).to_dict()["bodies"][0]["cavity"]["modes"] == cavity.DEFAULT_MODES
+    table = top(', modes = "auto"', a=0.02).to_dict()["bodies"][0]["cavity"]
     assert table["modes"] == "auto" and "mode_tolerance" not in table
 
 
@@ -229,7 +234,7 @@ def _near_boundary(nc: np.ndarray) -> np.ndarray:
 
 def test_auto_labels_agree_with_many_modes_away_from_boundaries():
     # A small cavity: "auto" keeps 1 mode; 16 modes plus the tail is the reference.
-    auto = top(a=0.03, q=(0.25, 2.0), nw=40, nh=8)
+    auto = top(', modes = "auto"', a=0.03, q=(0.25, 2.0), nw=40, nh=8)
     assert auto.nmodes.tolist() == [1]
     ref = top(", modes = 16", a=0.03, q=(0.25, 2.0), nw=40, nh=8)
     nc_auto = atlas.compute(auto, progress=False).n_complex_pairs.values
