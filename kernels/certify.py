@@ -25,33 +25,17 @@ branches cross zero together and nu jumps by k.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-from numba import types
-from numba.np.linalg import _LAPACK
 
-from . import ball, elimination, pencil
+from . import approximations, disks, elimination, pencil
 from .options import kernel
 from .status import DECIDED_DISKS, DECIDED_INERTIA, UNDECIDED
-
-# LAPACK dgeev (eigenvalues only) as numba's own np.linalg binds it: numba's
-# np.linalg.eigvals refuses real input with complex eigenvalues, and binding
-# scipy's pointer through ctypes would stop the kernels being cached.
-_RGEEV = _LAPACK().numba_ez_rgeev(types.float64)
-_KIND = ord("d")
-_NO_VECTORS = ord("N")
 
 COLD_SWEEPS = 24  # Aberth sweeps from the linearisation's eigenvalues (CERTIFY.md: enough to degree 48)
 WARM_STEPS = 8  # Newton steps on a neighbour's non-real roots before their disks
 WARM_SWEEPS = 4  # Aberth sweeps on a neighbour's roots that the inertia found out of place (at most)
 MISSES, PAUSE = 4, 16  # warm starts that failed in a row, and the points then done cold
-SMALL = 8  # bodies up to which plain elimination in balls beats preconditioning (BLAS products)
-SHIFTS = (2.0**-30, 2.0**-20, 2.0**-12)  # a Newton disk is centred this far (relative) above its root
-UPPER = 2.0**-30  # approximations this far above the axis (relative) are tried as non-real roots
-STEP_TOL = 2.0**-46  # an Aberth step below this share of the root: converged
 LOOSE_TOL = 2.0**-26  # enough for separators; the disks polish their own roots further
-RIDE = 0.05  # a root this close to a pole (relative) is predicted to move with it
 MERGE = 2.0**-40  # features closer than this share of their size get no separator between them
 FENCE = 2.0**-30  # separators this close (relative) either side of each pole
 NEAR_REAL = 2.0**-20  # approximations this close to the axis (relative) are expected to be real roots
@@ -91,66 +75,6 @@ def allocate(n, nmodes, parent):
     centre = np.empty(degree, np.complex128)
     done = np.empty(degree, np.bool_)
     return pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold
-
-
-@kernel
-def _eigenvalues(C, wr, wi, vdummy, z, degree, m):
-    """Eigenvalues of C into z, without the m of smallest modulus (the exact zero roots); False on failure."""
-    info = _RGEEV(_KIND, _NO_VECTORS, _NO_VECTORS, degree, C.ctypes, degree, wr.ctypes, wi.ctypes, vdummy.ctypes, 1, vdummy.ctypes, 1)
-    if info != 0:
-        return False
-    for _ in range(m):
-        k, best = 0, np.inf
-        for i in range(degree):
-            a = abs(complex(wr[i], wi[i]))
-            if a < best:
-                k, best = i, a
-        wr[k], wi[k] = np.nan, np.inf  # removed
-    pos = 0
-    for i in range(degree):
-        if wi[i] != np.inf:
-            z[pos] = complex(wr[i], wi[i])
-            pos += 1
-    for i in range(pos):
-        if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
-            return False
-    return True
-
-
-@kernel
-def _aberth(z, d, m, sweeps, body, E, nmodes, pws, F, dF, done, tol):
-    """Aberth-Ehrlich sweeps on p~ = det Phi prod (z + beta) / z^m; True once no root moves.
-
-    Only the roots with ``done`` False move; one whose step fell below
-    ``tol`` of itself is left alone after.
-    """
-    n = body.shape[0]
-    for _ in range(sweeps):
-        moved = False
-        for i in range(d):
-            if done[i]:
-                continue
-            zi = z[i]
-            logq = pencil.float_matrices(zi, body, E, nmodes, pws, F, dF)
-            t = elimination.trace_solve(F, dF, n) + logq - m * ball.recip(zi)
-            if not (math.isfinite(t.real) and math.isfinite(t.imag)) or t == 0.0:
-                done[i] = True
-                continue
-            ratio = ball.recip(t)
-            s = 0.0j
-            for j in range(d):
-                if j != i:
-                    s += ball.recip(zi - z[j])
-            step = ratio * ball.recip(1.0 - ratio * s)
-            if math.isfinite(step.real) and math.isfinite(step.imag):
-                z[i] = zi - step
-                if abs(step) > tol * abs(z[i]):
-                    moved = True
-                else:
-                    done[i] = True
-        if not moved:
-            return True
-    return False
 
 
 @kernel
@@ -244,183 +168,6 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
 
 
 @kernel
-def _find(root, i):
-    while root[i] != i:
-        root[i] = root[root[i]]
-        i = root[i]
-    return i
-
-
-@kernel
-def _nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e):
-    """Roots of p~ proved non-real by the disks of Braess & Hadeler around z (module docstring)."""
-    n = body.shape[0]
-    cm, cr = pws[6], pws[7]
-    for i in range(d):
-        zi = z[i]
-        ok, qm, qr = pencil.complex_matrix(zi, 0.0, body, E, nmodes, pws)
-        R[i] = np.inf
-        if not ok:
-            continue
-        ok, mant, expo = elimination.det_bound(cm, cr, n, False)
-        if not ok:
-            continue
-        mant, e = math.frexp(mant * (abs(qm) + qr) * ball.INFL)
-        expo += e - lead_e
-        mant = mant / lead_m * ball.INFL
-        for _ in range(m):  # p~ = p / z^m
-            if zi == 0.0:
-                return 0
-            mant, e = math.frexp(mant / (abs(zi) * ball.LOW) * ball.INFL)
-            expo += e
-        for j in range(d):
-            if j == i:
-                continue
-            dist = abs(zi - z[j]) * ball.LOW
-            if dist == 0.0:
-                return 0
-            mant, e = math.frexp(mant / dist * ball.INFL)
-            expo += e
-        if expo > 1000:
-            continue
-        R[i] = math.ldexp(mant * d * ball.INFL, expo) + ball.ETA
-        if not R[i] <= np.inf:  # NaN: an infinite disk, which proves nothing
-            R[i] = np.inf
-    for i in range(d):
-        group[i] = i
-    for i in range(d):
-        for j in range(i + 1, d):
-            if abs(z[i] - z[j]) * ball.LOW <= (R[i] + R[j]) * ball.INFL:
-                a, b = _find(group, i), _find(group, j)
-                if a != b:
-                    group[a] = b
-    # a group touching the axis anywhere proves nothing; count members of the others
-    touches = np.zeros(d, np.bool_)
-    for i in range(d):
-        if abs(z[i].imag) * ball.LOW <= R[i] * ball.INFL:
-            touches[_find(group, i)] = True
-    nonreal = 0
-    for i in range(d):
-        if not touches[_find(group, i)]:
-            nonreal += 1
-    return nonreal
-
-
-@kernel
-def _lead(pws, n, Sm, Sr):
-    """Lower bound of |det (M - diag(sum E))| (the leading coefficient of p) as (ok, mantissa, exponent)."""
-    mat, vec = pws[3], pws[4]
-    for i in range(n):
-        for j in range(i + 1):
-            Sm[i, j], Sr[i, j] = mat[6, i, j], mat[7, i, j]
-        Sm[i, i], Sr[i, i] = ball.radd(Sm[i, i], Sr[i, i], -vec[2, i], vec[3, i])
-    neg, mant, expo = elimination.ldl(Sm, Sr, n)
-    return neg >= 0, mant, expo
-
-
-@kernel
-def _newton_disk(zc, d, m, body, E, nmodes, pws, dm, dr):
-    """Radius of a disk around zc that holds a root of p~, or inf: d / |p~'(zc) / p~(zc)| bounded below.
-
-    p~'/p~ = sum over the d roots r of p~ of 1 / (z - r), so some root lies
-    within d / |p~'/p~| of z; the ratio is trace(Phi^-1 Phi') + sum 1 / (z + beta)
-    - m / z, solved in balls.
-    """
-    n = body.shape[0]
-    ok, qm, qr = pencil.complex_matrix(zc, 0.0, body, E, nmodes, pws)
-    if not ok:
-        return np.inf
-    lm, lr = pencil.complex_derivative(zc, body, E, nmodes, pws, dm, dr)
-    if not math.isfinite(lr) or not ball.excludes_zero(zc, 0.0):
-        return np.inf
-    if n <= SMALL:
-        ok, tm, tr = elimination.trace_bound(pws[6], pws[7], dm, dr, n)
-    else:
-        ok, tm, tr = elimination.trace_preconditioned(pws[6], pws[7], dm, dr, n)
-    if not ok:
-        return np.inf
-    sm, sr = ball.cadd(tm, tr, lm, lr)
-    zm, zr = ball.cdiv(float(m) + 0.0j, 0.0, zc, 0.0)
-    sm, sr = ball.cadd(sm, sr, -zm, zr)
-    low = abs(sm) * ball.LOW - sr * ball.INFL
-    if not low > 0.0:
-        return np.inf
-    return d / (low * ball.LOW) * ball.INFL
-
-
-@kernel
-def _nonreal_newton(z, d, m, body, E, nmodes, pws, dm, dr, R, centre):
-    """Non-real roots proved by disjoint Newton disks in the upper half plane (twice their number: conjugates)."""
-    k = 0
-    for i in range(d):
-        zi = z[i]
-        if not zi.imag > UPPER * abs(zi):
-            continue
-        found = False
-        r, zc = np.inf, zi
-        for shift in SHIFTS:
-            zc = complex(zi.real, zi.imag + shift * abs(zi))
-            r = _newton_disk(zc, d, m, body, E, nmodes, pws, dm, dr)
-            if r * ball.INFL < zc.imag * ball.LOW:
-                found = True
-                break
-        if not found:
-            continue
-        alone = True
-        for j in range(k):
-            if abs(zc - centre[j]) * ball.LOW <= (r + R[j]) * ball.INFL:
-                alone = False
-                break
-        if alone:
-            centre[k], R[k] = zc, r
-            k += 1
-    return 2 * k
-
-
-@kernel
-def _predict(z, zold, d, two, nmodes, beta, bold):
-    """This point's roots from the previous points' (z, and zold before it), in place; zold <- z.
-
-    A root close to a pole (a liquid mode: the root rides on its pole) keeps its
-    offset from that pole, scaled as the pole moved; the others are extrapolated
-    linearly from the two previous points (Aberth keeps each root's index).
-    Measured: quadratic extrapolation from three points separates fewer roots
-    (roots passing poles make the motion anything but smooth).
-    """
-    for i in range(d):
-        t = z[i]
-        best, bk, bl = np.inf, -1, -1
-        for k in range(nmodes.shape[0]):
-            for l in range(nmodes[k]):
-                dist = abs(t + bold[k, l])
-                if dist < best:
-                    best, bk, bl = dist, k, l
-        if bk >= 0 and best < RIDE * abs(bold[bk, bl]) and bold[bk, bl] != 0.0:
-            old, new = -bold[bk, bl], -beta[0, bk, bl]
-            z[i] = new + (t - old) * (new / old)
-        elif two:
-            z[i] = 2.0 * t - zold[i]
-        zold[i] = t
-
-
-@kernel
-def _newton_upper(z, d, m, steps, body, E, nmodes, pws, F, dF):
-    """A few Newton steps on p~ for the approximations in the upper half plane only."""
-    n = body.shape[0]
-    for i in range(d):
-        if not z[i].imag > UPPER * abs(z[i]):
-            continue
-        for _ in range(steps):
-            logq = pencil.float_matrices(z[i], body, E, nmodes, pws, F, dF)
-            step = ball.recip(elimination.trace_solve(F, dF, n) + logq - m * ball.recip(z[i]))
-            if not (math.isfinite(step.real) and math.isfinite(step.imag)):
-                break
-            z[i] -= step
-            if abs(step) <= STEP_TOL * abs(z[i]):
-                break
-
-
-@kernel
 def _attempt(z, d, m, degree, body, E, nmodes, parent, ws, newton_steps):
     """(real roots at least, N_c, status) from the approximations z: inertia, then Newton disks.
 
@@ -435,8 +182,8 @@ def _attempt(z, d, m, degree, body, E, nmodes, parent, ws, newton_steps):
         return real, 0, DECIDED_INERTIA
     if (degree - real) % 2 == 0:
         if newton_steps > 0:
-            _newton_upper(z, d, m, newton_steps, body, E, nmodes, pws, F, dF)
-        nonreal = _nonreal_newton(z, d, m, body, E, nmodes, pws, dm, dr, R, centre)
+            approximations.newton_upper(z, d, m, newton_steps, body, E, nmodes, pws, F, dF)
+        nonreal = disks.nonreal_newton(z, d, m, body, E, nmodes, pws, dm, dr, R, centre)
         if real + nonreal == degree:
             return real, nonreal // 2, DECIDED_DISKS
     return real, -1, UNDECIDED
@@ -484,7 +231,7 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     m = pencil.prepare(body, joint, at, g, E, kappa, nmodes, parent, free, pws, reuse)
     state[9] = 1
     d = degree - m
-    ok, lead_m, lead_e = _lead(pws, n, Sm, Sr)
+    ok, lead_m, lead_e = disks.lead_bound(pws, n, Sm, Sr)
     state[0] = 0 if not ok else state[0]
     if not ok:
         return -1, UNDECIDED
@@ -492,7 +239,7 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     # 1. a grid neighbour's roots, a few Aberth sweeps on, usually separate this point's: no eigenvalues
     neighbour = state[0] == 1 and state[1] == d
     if neighbour:
-        _predict(z, zold, d, state[7] == 1, nmodes, pws[5], bold)
+        approximations.predict(z, zold, d, state[7] == 1, nmodes, pws[5], bold)
     state[7] = 1 if neighbour else 0
     bold[:] = pws[5][0]
     if neighbour and state[3] <= 0:
@@ -511,7 +258,7 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
                     z[i] += complex(0.0, sign * NUDGE * (abs(z[i]) + 1e-300))
                     sign = -sign
                 done[i] = not done[i]
-            _aberth(z, d, m, WARM_SWEEPS, body, E, nmodes, pws, F, dF, done, LOOSE_TOL)
+            approximations.aberth(z, d, m, WARM_SWEEPS, body, E, nmodes, pws, F, dF, done, LOOSE_TOL)
             real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, WARM_STEPS)
         state[5] += 1
         state[6] += status != UNDECIDED
@@ -524,14 +271,14 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     # 2. approximations from the linearisation, 3. polished by Aberth sweeps, 4. every disk
     if status == UNDECIDED:
         state[7] = 0  # the eigenvalues come in their own order: no history to extrapolate from
-        if pencil.linearisation(body, E, nmodes, parent, pws, C, Mo) and _eigenvalues(C, wr, wi, vdummy, z, degree, m):
+        if pencil.linearisation(body, E, nmodes, parent, pws, C, Mo) and approximations.eigenvalues(C, wr, wi, vdummy, z, degree, m):
             real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, 0)
             if status == UNDECIDED:
                 done[:d] = False
-                _aberth(z, d, m, COLD_SWEEPS, body, E, nmodes, pws, F, dF, done, STEP_TOL)
+                approximations.aberth(z, d, m, COLD_SWEEPS, body, E, nmodes, pws, F, dF, done, approximations.STEP_TOL)
                 real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, 0)
             if status == UNDECIDED:
-                nonreal = _nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e)
+                nonreal = disks.nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e)
                 if real + nonreal == degree and nonreal % 2 == 0:
                     nc, status = nonreal // 2, DECIDED_DISKS
     state[0] = 1 if status != UNDECIDED else 0

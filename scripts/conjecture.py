@@ -51,6 +51,7 @@ import flint
 import numpy as np
 
 from stabmap.systems.gyroscopes import decide as _decide
+from stabmap.systems.gyroscopes.outputs import DECIDED_BY
 from stabmap.systems.gyroscopes.paper import complex_pairs, det
 from stabmap.systems.gyroscopes.points import PointArrays
 
@@ -472,7 +473,7 @@ def family_changes(n: int, lo: float = 1e-3, hi: float = 1e6, num: int = 181) ->
     return out
 
 
-_BY = {0: "sturm", 1: "exact", 2: "inclusion", 3: "inferred"}
+_BY = dict(DECIDED_BY.flags)
 
 
 def step_search(ns, sizes: dict, rng, pool, chunk: int, recheck: int) -> dict:

@@ -1,0 +1,132 @@
+"""Approximations of the roots of p for the certificates: they place separators and disks, they prove nothing.
+
+From the eigenvalues of the first-order linearisation (LAPACK dgeev), from a
+grid neighbour's roots (``predict``), polished by Aberth-Ehrlich sweeps or
+Newton steps on det Phi (the trace formula, ``elimination.trace_solve``).
+A poor approximation only makes a separator or a disk useless.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import types
+from numba.np.linalg import _LAPACK
+
+from . import ball, elimination, pencil
+from .options import kernel
+
+# LAPACK dgeev (eigenvalues only) as numba's own np.linalg binds it: numba's
+# np.linalg.eigvals refuses real input with complex eigenvalues, and binding
+# scipy's pointer through ctypes would stop the kernels being cached.
+_RGEEV = _LAPACK().numba_ez_rgeev(types.float64)
+_KIND = ord("d")
+_NO_VECTORS = ord("N")
+
+STEP_TOL = 2.0**-46  # an Aberth step below this share of the root: converged
+RIDE = 0.05  # a root this close to a pole (relative) is predicted to move with it
+UPPER = 2.0**-30  # approximations this far above the axis (relative) are taken for non-real roots
+
+
+@kernel
+def eigenvalues(C, wr, wi, vdummy, z, degree, m):
+    """Eigenvalues of C into z, without the m of smallest modulus (the exact zero roots); False on failure."""
+    info = _RGEEV(_KIND, _NO_VECTORS, _NO_VECTORS, degree, C.ctypes, degree, wr.ctypes, wi.ctypes, vdummy.ctypes, 1, vdummy.ctypes, 1)
+    if info != 0:
+        return False
+    for _ in range(m):
+        k, best = 0, np.inf
+        for i in range(degree):
+            a = abs(complex(wr[i], wi[i]))
+            if a < best:
+                k, best = i, a
+        wr[k], wi[k] = np.nan, np.inf  # removed
+    pos = 0
+    for i in range(degree):
+        if wi[i] != np.inf:
+            z[pos] = complex(wr[i], wi[i])
+            pos += 1
+    for i in range(pos):
+        if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
+            return False
+    return True
+
+
+@kernel
+def aberth(z, d, m, sweeps, body, E, nmodes, pws, F, dF, done, tol):
+    """Aberth-Ehrlich sweeps on p~ = det Phi prod (z + beta) / z^m; True once no root moves.
+
+    Only the roots with ``done`` False move; one whose step fell below
+    ``tol`` of itself is left alone after.
+    """
+    n = body.shape[0]
+    for _ in range(sweeps):
+        moved = False
+        for i in range(d):
+            if done[i]:
+                continue
+            zi = z[i]
+            logq = pencil.float_matrices(zi, body, E, nmodes, pws, F, dF)
+            t = elimination.trace_solve(F, dF, n) + logq - m * ball.recip(zi)
+            if not (math.isfinite(t.real) and math.isfinite(t.imag)) or t == 0.0:
+                done[i] = True
+                continue
+            ratio = ball.recip(t)
+            s = 0.0j
+            for j in range(d):
+                if j != i:
+                    s += ball.recip(zi - z[j])
+            step = ratio * ball.recip(1.0 - ratio * s)
+            if math.isfinite(step.real) and math.isfinite(step.imag):
+                z[i] = zi - step
+                if abs(step) > tol * abs(z[i]):
+                    moved = True
+                else:
+                    done[i] = True
+        if not moved:
+            return True
+    return False
+
+
+@kernel
+def predict(z, zold, d, two, nmodes, beta, bold):
+    """This point's roots from the previous points' (z, and zold before it), in place; zold <- z.
+
+    A root close to a pole (a liquid mode: the root rides on its pole) keeps its
+    offset from that pole, scaled as the pole moved; the others are extrapolated
+    linearly from the two previous points (Aberth keeps each root's index).
+    Measured: quadratic extrapolation from three points separates fewer roots
+    (roots passing poles make the motion anything but smooth).
+    """
+    for i in range(d):
+        t = z[i]
+        best, bk, bl = np.inf, -1, -1
+        for k in range(nmodes.shape[0]):
+            for l in range(nmodes[k]):
+                dist = abs(t + bold[k, l])
+                if dist < best:
+                    best, bk, bl = dist, k, l
+        if bk >= 0 and best < RIDE * abs(bold[bk, bl]) and bold[bk, bl] != 0.0:
+            old, new = -bold[bk, bl], -beta[0, bk, bl]
+            z[i] = new + (t - old) * (new / old)
+        elif two:
+            z[i] = 2.0 * t - zold[i]
+        zold[i] = t
+
+
+@kernel
+def newton_upper(z, d, m, steps, body, E, nmodes, pws, F, dF):
+    """A few Newton steps on p~ for the approximations in the upper half plane only."""
+    n = body.shape[0]
+    for i in range(d):
+        if not z[i].imag > UPPER * abs(z[i]):
+            continue
+        for _ in range(steps):
+            logq = pencil.float_matrices(z[i], body, E, nmodes, pws, F, dF)
+            step = ball.recip(elimination.trace_solve(F, dF, n) + logq - m * ball.recip(z[i]))
+            if not (math.isfinite(step.real) and math.isfinite(step.imag)):
+                break
+            z[i] -= step
+            if abs(step) <= STEP_TOL * abs(z[i]):
+                break
