@@ -129,7 +129,7 @@ def decide_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out
             nc, st = certify.certify_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, cws, again)
             certified_last = p
         if st == UNDECIDED and laplace:
-            again = reuse and coefficients_last == p - 1 or coefficients_last == p
+            again = (reuse and coefficients_last == p - 1) or coefficients_last == p
             nc, st = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, again)
             coefficients_last = p
         out_nc[p] = nc
