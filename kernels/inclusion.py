@@ -106,7 +106,7 @@ def _value_dd(X, d, zr, zi):
         re = dd.add(*t, X[k, 0], X[k, 1], X[k, 2])
     bre = abs(re[0]) * dd.ABS + re[2]
     bim = abs(im[0]) * dd.ABS + im[2]
-    bound = math.sqrt(bre * bre + bim * bim) * (1.0 + 4.0 * dd.U)
+    bound = math.hypot(bre, bim) * (1.0 + 4.0 * dd.U)  # hypot: the squares would underflow below 1e-154
     return complex(re[0] + re[1], im[0] + im[1]), bound, complex(dre[0] + dre[1], dim[0] + dim[1])
 
 

@@ -938,3 +938,24 @@ def test_a_point_refused_before_prepare_leaves_no_stale_structure():
         if st[p] != kernels.UNDECIDED:
             assert nc[p] == exact_nc(pts, p), (p, nc, st)
     assert st[2] in (DECIDED_INERTIA, DECIDED_DISKS)
+
+
+def test_root_inclusion_bound_does_not_underflow_on_clustered_roots():
+    # Second review: 12 identical free bodies, every pole near 0 (omega = -7.2e-4): clusters of roots near 1e-4.
+    # |p(z)| was bounded as sqrt(re^2 + im^2), whose squares underflowed, so the coefficient path's disks came out
+    # too small and "proved" 12 pairs that do not exist (exact: 0).
+    n = 12
+    body = np.empty((1, n, 6))
+    body[...] = (2.4186391540356604, 1.5368970226939508e-02, 4.5347205456361020e-02, 1.3465430947798251e-01,
+                 2.6930861895596503e-01, -7.2225599429387444e-04)
+    joint = np.full((1, n), 74.48807794494027)
+    joint[0, 0] = 0.0
+    E = np.full((1, n, 2), 3.287220276322821e-10)
+    kappa = np.broadcast_to(np.array([-1.8625132868234333, 1.744097794022779]), (1, n, 2)).copy()
+    pts = PointArrays(body, joint, np.zeros(1), E, kappa, np.full(n, 2, np.int64), True)
+    exact_label = exact_nc(pts, 0)
+    assert exact_label == 0
+    for decide in (kernels.decide_block, kernels.count_block):
+        nc, st = np.empty(1, np.int16), np.empty(1, np.int8)
+        decide(*pts.kernel_args(), nc, st)
+        assert st[0] == kernels.UNDECIDED or nc[0] == exact_label, (decide, nc, st)
