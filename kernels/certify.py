@@ -232,11 +232,11 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     state[9] = 1
     d = degree - m
     ok, lead_m, lead_e = disks.lead_bound(pws, n, Sm, Sr)
-    state[0] = 0 if not ok else state[0]
-    if not ok:
+    if not ok:  # deg p unproved: nothing below counts
+        state[0] = 0
         return -1, UNDECIDED
     nc, status = -1, UNDECIDED
-    # 1. a grid neighbour's roots, a few Aberth sweeps on, usually separate this point's: no eigenvalues
+    # 1. a grid neighbour's roots, extrapolated, usually separate this point's: no eigenvalue problem
     neighbour = state[0] == 1 and state[1] == d
     if neighbour:
         approximations.predict(z, zold, d, state[7] == 1, nmodes, pws[5], bold)
