@@ -64,10 +64,9 @@ def allocate(n, nmodes, parent):
     R = np.empty(degree)
     group = np.empty(degree, np.int64)
     # state: [0] the previous point was decided, [1] its degree d, [2] its N_c, [3] points left to do
-    # cold, [4] warm misses in a row, [5] warm tries, [6] warm hits, [7] zold holds the roots of the
-    # point before the previous one, [8] hits at the first warm attempt ([5], [6], [8]: for benchmarks),
-    # [9] the workspace holds the structure (M T, K T) of the last point given
-    state = np.zeros(10, np.int64)
+    # cold, [4] warm misses in a row, [5] zold holds the roots of the point before the previous one,
+    # [6] the workspace holds the structure (M T, K T) of the last point given
+    state = np.zeros(7, np.int64)
     zold = np.empty(degree, np.complex128)
     bold = np.zeros((n, lmax))  # beta of the previous point
     dm = np.empty((n, n), np.complex128)
@@ -223,13 +222,13 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     n = body.shape[0]
     degree = C.shape[0]
     # M T and K T in the workspace are the previous point's only if it got as far as prepare
-    reuse = reuse and state[9] == 1
-    state[9] = 0
+    reuse = reuse and state[6] == 1
+    state[6] = 0
     if not _moderate(body, joint, at, g, E, kappa, nmodes):
         state[0] = 0
         return -1, UNDECIDED
     m = pencil.prepare(body, joint, at, g, E, kappa, nmodes, parent, free, pws, reuse)
-    state[9] = 1
+    state[6] = 1
     d = degree - m
     ok, lead_m, lead_e = disks.lead_bound(pws, n, Sm, Sr)
     if not ok:  # deg p unproved: nothing below counts
@@ -239,12 +238,11 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     # 1. a grid neighbour's roots, extrapolated, usually separate this point's: no eigenvalue problem
     neighbour = state[0] == 1 and state[1] == d
     if neighbour:
-        approximations.predict(z, zold, d, state[7] == 1, nmodes, pws[5], bold)
-    state[7] = 1 if neighbour else 0
+        approximations.predict(z, zold, d, state[5] == 1, nmodes, pws[5], bold)
+    state[5] = 1 if neighbour else 0
     bold[:] = pws[5][0]
     if neighbour and state[3] <= 0:
         real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, WARM_STEPS)
-        state[8] += status != UNDECIDED
         suspects = done[:d].sum()
         if status == UNDECIDED and 0 < suspects <= d // 4:
             # polish the few approximations the inertia found out of place (done holds them);
@@ -260,8 +258,6 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
                 done[i] = not done[i]
             approximations.aberth(z, d, m, WARM_SWEEPS, body, E, nmodes, pws, F, dF, done, LOOSE_TOL)
             real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, WARM_STEPS)
-        state[5] += 1
-        state[6] += status != UNDECIDED
         # after a run of misses (scattered points, not a grid) stop trying for a while
         state[4] = 0 if status != UNDECIDED else state[4] + 1
         if state[4] >= MISSES:
@@ -270,7 +266,7 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
         state[3] -= 1
     # 2. approximations from the linearisation, 3. polished by Aberth sweeps, 4. every disk
     if status == UNDECIDED:
-        state[7] = 0  # the eigenvalues come in their own order: no history to extrapolate from
+        state[5] = 0  # the eigenvalues come in their own order: no history to extrapolate from
         if pencil.linearisation(body, E, nmodes, parent, pws, C, Mo) and approximations.eigenvalues(C, wr, wi, vdummy, z, degree, m):
             real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, 0)
             if status == UNDECIDED:
