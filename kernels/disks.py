@@ -15,18 +15,11 @@ import numpy as np
 
 from . import ball, elimination, pencil
 from .approximations import UPPER
+from .inclusion import find_root
 from .options import kernel
 
 SMALL = 8  # bodies up to which plain elimination in balls beats preconditioning (BLAS products)
 SHIFTS = (2.0**-30, 2.0**-20, 2.0**-12)  # a Newton disk is centred this far (relative) above its root
-
-
-@kernel
-def _find(root, i):
-    while root[i] != i:
-        root[i] = root[root[i]]
-        i = root[i]
-    return i
 
 
 @kernel
@@ -69,17 +62,17 @@ def nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e):
     for i in range(d):
         for j in range(i + 1, d):
             if abs(z[i] - z[j]) * ball.LOW <= (R[i] + R[j]) * ball.INFL:
-                a, b = _find(group, i), _find(group, j)
+                a, b = find_root(group, i), find_root(group, j)
                 if a != b:
                     group[a] = b
     # a group touching the axis anywhere proves nothing; count members of the others
     touches = np.zeros(d, np.bool_)
     for i in range(d):
         if abs(z[i].imag) * ball.LOW <= R[i] * ball.INFL:
-            touches[_find(group, i)] = True
+            touches[find_root(group, i)] = True
     nonreal = 0
     for i in range(d):
-        if not touches[_find(group, i)]:
+        if not touches[find_root(group, i)]:
             nonreal += 1
     return nonreal
 

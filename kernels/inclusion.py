@@ -193,7 +193,8 @@ def _snap_real(X, d, z):
 
 
 @kernel
-def _find(parent, i):
+def find_root(parent, i):
+    """The representative of i in the union-find forest ``parent`` (with path halving)."""
     while parent[i] != i:
         parent[i] = parent[parent[i]]
         i = parent[i]
@@ -259,19 +260,19 @@ def count_complex_pairs_inclusion(X, d, a, z, R, group, flags):
     for i in range(d):
         for j in range(i + 1, d):
             if abs(z[i] - z[j]) * (1.0 - 4.0 * dd.U) <= (R[i] + R[j]) * (1.0 + 2.0 * dd.U):
-                ri, rj = _find(parent, i), _find(parent, j)
+                ri, rj = find_root(parent, i), find_root(parent, j)
                 if ri != rj:
                     parent[ri] = rj
     size[:] = 0
     flags[:d] = False  # flags[r]: the group with representative r meets the real axis
     for i in range(d):
-        r = _find(parent, i)
+        r = find_root(parent, i)
         size[r] += 1
         if abs(z[i].imag) <= R[i]:
             flags[r] = True
     nonreal = 0
     for i in range(d):
-        r = _find(parent, i)
+        r = find_root(parent, i)
         if not flags[r]:
             nonreal += 1
         elif size[r] != 1 or z[i].imag != 0.0:
