@@ -74,3 +74,10 @@ def test_bench_cluster_quick(capsys):
     assert [(r["points"], r["how"]) for r in out["memory"]] == [(40000, "streamed"), (40000, "in-memory"), (160000, "write-only")]
     assert all(r["peak_mib"] > 0 for r in out["memory"])
     assert "| where | threads or workers |" in capsys.readouterr().out
+
+
+def test_bench_exact_quick(capsys):
+    rows = runpy.run_path(str(SCRIPTS / "bench_exact.py"))["main"](["--quick"])
+    assert [r["degree"] for r in rows] == [6, 12]
+    assert all(r["total"] >= r["roots"] > 0 and r["before"] > 0 for r in rows)
+    assert "| n | modes | degree |" in capsys.readouterr().out

@@ -881,7 +881,8 @@ def test_property_decided_labels_are_exact(case):
 
 SLOW_SWEEP = [(n, modes, free, kind) for n, modes in ((6, 2), (6, 4), (8, 2), (8, 4), (10, 2), (12, 2))
               for free in (False, True) for kind in ("mixed", "identical")] + [(8, 3, False, "split"), (8, 2, True, "zerok"),
-                                                                              (6, 2, False, "identical-tiny-liquid"), (8, 4, True, "identical-tiny-liquid")]
+                                                                              (6, 2, False, "identical-tiny-liquid"), (8, 4, True, "identical-tiny-liquid"),
+                                                                              (16, 2, False, "mixed"), (16, 2, True, "identical")]
 
 
 @pytest.mark.slow
