@@ -28,13 +28,18 @@ from __future__ import annotations
 import numpy as np
 
 from . import approximations, disks, elimination, pencil
+from .approximations import RIDE
 from .options import kernel
 from .status import DECIDED_DISKS, DECIDED_INERTIA, UNDECIDED
 
 COLD_SWEEPS = 24  # Aberth sweeps from the linearisation's eigenvalues (CERTIFY.md: enough to degree 48)
-WARM_STEPS = 8  # Newton steps on a neighbour's non-real roots before their disks
+WARM_STEPS = 8  # Aberth sweeps (at most) on a neighbour's non-real roots before their disks
+# What the warm-or-cold choice counts, in n x n complex solves (one Aberth or Newton step); measured on
+# the kernels for n = 2..32 (inertia at a separator 0.43-0.62 solves, a Newton disk 3.9-10)
+SEPARATOR_COST, DISK_COST = 0.55, 7.0
 WARM_SWEEPS = 4  # Aberth sweeps on a neighbour's roots that the inertia found out of place (at most)
-MISSES, PAUSE = 4, 16  # warm starts that failed in a row, and the points then done cold
+PAUSE = 16  # points done cold when warm starts do not pay, before the next try
+SMOOTH = 0.1  # weight of the newest point in those running means
 LOOSE_TOL = 2.0**-26  # enough for separators; the disks polish their own roots further
 MERGE = 2.0**-40  # features closer than this share of their size get no separator between them
 FENCE = 2.0**-30  # separators this close (relative) either side of each pole
@@ -64,25 +69,28 @@ def allocate(n, nmodes, parent):
     R = np.empty(degree)
     group = np.empty(degree, np.int64)
     # state: [0] the previous point was decided, [1] its degree d, [2] its N_c, [3] points left to do
-    # cold, [4] warm misses in a row, [5] zold holds the roots of the point before the previous one,
+    # cold, [4] unused, [5] zold holds the roots of the point before the previous one,
     # [6] the workspace holds the structure (M T, K T) of the last point given
     state = np.zeros(7, np.int64)
+    # running means: cost of a warm start (n x n solves), its hit rate (hoped 1 until tried), cost of a cold start
+    costs = np.array([0.0, 1.0, 0.0])
     zold = np.empty(degree, np.complex128)
     bold = np.zeros((n, lmax))  # beta of the previous point
     dm = np.empty((n, n), np.complex128)
     dr = np.empty((n, n))
     centre = np.empty(degree, np.complex128)
     done = np.empty(degree, np.bool_)
-    return pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold
+    return pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs
 
 
 @kernel
 def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, suspect):
     """Lower bound of the real roots of p from the inertia of Phi at separators.
 
-    Every pole (and the exact zero roots) is fenced by separators just either
-    side of it, and two neighbouring approximations (real parts of z) that no
-    fence separates get a separator midway.  So a root that moved past a pole
+    Neighbouring features (approximations that may be real, within NUDGE of
+    the axis, and poles) get a separator midway; poles with such an
+    approximation close by, and the exact zero roots, are fenced by
+    separators just either side instead.  So a root that moved past a pole
     since z was found is still counted; where nu changes
     less across an interval than the near-real roots and poles inside it, the
     approximations inside are marked in ``suspect``: polishing them is usually
@@ -92,8 +100,10 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
     beta = pws[5]
     nr = 0
     for i in range(d):
-        feat[nr] = z[i].real
-        nr += 1
+        # only approximations that may be real need separating: the others' disks prove them
+        if abs(z[i].imag) <= NUDGE * abs(z[i]):
+            feat[nr] = z[i].real
+            nr += 1
     if m > 0:
         feat[nr] = 0.0
         nr += 1
@@ -105,32 +115,46 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
     roots = np.sort(feat[:nr])
     poles = np.sort(feat[nr : nr + lsum])
     sep = feat[nr + lsum :]
-    lo = min(roots[0], poles[0]) if lsum else roots[0]
-    hi = max(roots[nr - 1], poles[lsum - 1]) if lsum else roots[nr - 1]
+    if nr + lsum == 0:
+        return 0  # nothing may be real: no real root is proved
+    lo = min(roots[0], poles[0]) if lsum and nr else (poles[0] if lsum else roots[0])
+    hi = max(roots[nr - 1], poles[lsum - 1]) if lsum and nr else (poles[lsum - 1] if lsum else roots[nr - 1])
     pad = 0.25 * (hi - lo) + 1e-3 * max(abs(lo), abs(hi)) + 1e-300
     zero_eps = FENCE * max(abs(lo), abs(hi)) + 1e-300
-    # every pole (and the exact zero roots) fenced on both sides, and a separator midway between
-    # two approximations that no fence already separates
+    # a separator midway between neighbouring features (approximations that may be real, poles);
+    # a pole with such an approximation within RIDE of it, and the exact zero roots, are fenced on
+    # both sides instead, so that a root that moved past its pole since z was found is still counted
     sep[0] = lo - pad
     ns = 1
-    for j in range(lsum):
-        eps = FENCE * abs(poles[j]) + 1e-300
-        sep[ns] = poles[j] - eps
-        sep[ns + 1] = poles[j] + eps
-        ns += 2
-    if m > 0:
-        sep[ns] = -zero_eps
-        sep[ns + 1] = zero_eps
-        ns += 2
-    j = 0
-    for i in range(1, nr):
-        a, b = roots[i - 1], roots[i]
-        while j < lsum and poles[j] <= a:
+    i, j = 0, 0
+    last, last_fenced, started = 0.0, False, False
+    while i < nr or j < lsum:
+        pole = j < lsum and (i >= nr or poles[j] < roots[i])
+        x = poles[j] if pole else roots[i]
+        fence = False
+        eps = 0.0
+        if pole:
+            k = np.searchsorted(roots[:nr], x)
+            near = np.inf
+            if k < nr:
+                near = roots[k] - x
+            if k > 0:
+                near = min(near, x - roots[k - 1])
+            fence = near < RIDE * abs(x)
+            eps = FENCE * abs(x) + 1e-300
             j += 1
-        fenced = (j < lsum and poles[j] < b) or (m > 0 and a <= 0.0 <= b)
-        if not fenced and b - a > MERGE * max(abs(a), abs(b)):
-            sep[ns] = 0.5 * (a + b)
+        else:
+            fence = m > 0 and x == 0.0
+            eps = zero_eps
+            i += 1
+        if fence:
+            sep[ns] = x - eps
+            sep[ns + 1] = x + eps
+            ns += 2
+        elif started and not last_fenced and x - last > MERGE * max(abs(x), abs(last)):
+            sep[ns] = 0.5 * (x + last)
             ns += 1
+        last, last_fenced, started = x, fence, True
     sep[ns] = hi + pad
     ns += 1
     # the count below needs increasing separators (a fence may lie beyond a neighbouring root)
@@ -167,25 +191,40 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
 
 
 @kernel
-def _attempt(z, d, m, degree, body, E, nmodes, parent, ws, newton_steps):
-    """(real roots at least, N_c, status) from the approximations z: inertia, then Newton disks.
+def _attempt(z, d, m, degree, body, E, nmodes, parent, ws, sweeps):
+    """(real roots at least, N_c, status, cost in n x n solves) from the approximations z.
 
-    ``newton_steps``: first polish the approximations of non-real roots (a
+    The inertia, then Newton disks.  ``sweeps``: first polish the
+    approximations of non-real roots by at most as many Aberth sweeps (a
     neighbour's roots are good enough for separators, not for disks).
     """
-    pws, C, Mo, wr, wi, vdummy, _z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold = ws
+    pws, C, Mo, wr, wi, vdummy, _z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs = ws
     real = max(m, _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, done))
+    near, upper = 0, 0
+    for i in range(d):
+        near += abs(z[i].imag) <= NUDGE * abs(z[i])
+        upper += z[i].imag > approximations.UPPER * abs(z[i])
+    cost = SEPARATOR_COST * (near + 2 * nmodes.sum() + 2)
     if real > degree:  # impossible for a proved bound: never label from it
-        return real, -1, UNDECIDED
+        return real, -1, UNDECIDED, cost
     if real == degree:
-        return real, 0, DECIDED_INERTIA
+        return real, 0, DECIDED_INERTIA, cost
     if (degree - real) % 2 == 0:
-        if newton_steps > 0:
-            approximations.newton_upper(z, d, m, newton_steps, body, E, nmodes, pws, F, dF)
+        if sweeps > 0:
+            cost += approximations.aberth_nonreal(z, d, m, sweeps, body, E, nmodes, pws, F, dF, group)
+        cost += DISK_COST * upper
         nonreal = disks.nonreal_newton(z, d, m, body, E, nmodes, pws, dm, dr, R, centre)
         if real + nonreal == degree:
-            return real, nonreal // 2, DECIDED_DISKS
-    return real, -1, UNDECIDED
+            return real, nonreal // 2, DECIDED_DISKS, cost
+    return real, -1, UNDECIDED, cost
+
+
+@kernel
+def _eigenvalue_price(n, degree):
+    """The D x D eigenvalue problem in n x n solves: fits of their measured times (us, D = 6..64, n = 2..32)."""
+    eig = 3.0 + 0.5 * degree + 0.04 * degree**2 + 1.1e-3 * degree**3
+    solve = 0.15 + 8e-3 * n**2 + 1e-3 * n**3
+    return eig / solve
 
 
 @kernel
@@ -218,7 +257,7 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     The previous point given to the same workspace is taken as a grid
     neighbour: its roots are tried first.
     """
-    pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold = ws
+    pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs = ws
     n = body.shape[0]
     degree = C.shape[0]
     # M T and K T in the workspace are the previous point's only if it got as far as prepare
@@ -242,7 +281,7 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     state[5] = 1 if neighbour else 0
     bold[:] = pws[5][0]
     if neighbour and state[3] <= 0:
-        real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, WARM_STEPS)
+        real, nc, status, warm = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, WARM_STEPS)
         suspects = done[:d].sum()
         if status == UNDECIDED and 0 < suspects <= d // 4:
             # polish the few approximations the inertia found out of place (done holds them);
@@ -256,23 +295,30 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
                     z[i] += complex(0.0, sign * NUDGE * (abs(z[i]) + 1e-300))
                     sign = -sign
                 done[i] = not done[i]
-            approximations.aberth(z, d, m, WARM_SWEEPS, body, E, nmodes, pws, F, dF, done, LOOSE_TOL)
-            real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, WARM_STEPS)
-        # after a run of misses (scattered points, not a grid) stop trying for a while
-        state[4] = 0 if status != UNDECIDED else state[4] + 1
-        if state[4] >= MISSES:
-            state[3], state[4] = PAUSE, 0
+            warm += approximations.aberth(z, d, m, WARM_SWEEPS, body, E, nmodes, pws, F, dF, done, LOOSE_TOL)
+            real, nc, status, more = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, WARM_STEPS)
+            warm += more
+        # try warm starts while they pay: their mean cost below the cold start's times their hit rate
+        # (scattered points, or grid neighbours too far apart, make them fail or cost too much)
+        costs[0] = (1 - SMOOTH) * costs[0] + SMOOTH * warm if costs[0] > 0 else warm
+        costs[1] = (1 - SMOOTH) * costs[1] + SMOOTH * (status != UNDECIDED)
+        if costs[2] > 0 and costs[0] > costs[1] * costs[2]:
+            state[3] = PAUSE
     elif state[3] > 0:
         state[3] -= 1
     # 2. approximations from the linearisation, 3. polished by Aberth sweeps, 4. every disk
     if status == UNDECIDED:
         state[5] = 0  # the eigenvalues come in their own order: no history to extrapolate from
         if pencil.linearisation(body, E, nmodes, parent, pws, C, Mo) and approximations.eigenvalues(C, wr, wi, vdummy, z, degree, m):
-            real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, 0)
+            cold = _eigenvalue_price(n, degree)
+            real, nc, status, more = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, 0)
+            cold += more
             if status == UNDECIDED:
                 done[:d] = False
-                approximations.aberth(z, d, m, COLD_SWEEPS, body, E, nmodes, pws, F, dF, done, approximations.STEP_TOL)
-                real, nc, status = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, 0)
+                cold += approximations.aberth(z, d, m, COLD_SWEEPS, body, E, nmodes, pws, F, dF, done, approximations.STEP_TOL)
+                real, nc, status, more = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, 0)
+                cold += more
+            costs[2] = (1 - SMOOTH) * costs[2] + SMOOTH * cold if costs[2] > 0 else cold
             if status == UNDECIDED:
                 nonreal = disks.nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e)
                 if real + nonreal == degree and nonreal % 2 == 0:
