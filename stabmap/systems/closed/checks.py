@@ -98,7 +98,7 @@ def lengths(fam: Family, values, where: str = "lengths") -> np.ndarray:
             same = out[[k for k, p in enumerate(fam.pattern) if p == kind]]
             if np.ptp(same) > PATTERN_RTOL * same.max():
                 raise StabmapError(
-                    f"{where} = {out.tolist()} does not follow family {fam.name!r}'s pattern {pattern_text(fam)}: "
+                    f"{where} = {out.tolist()} does not follow the pattern {pattern_text(fam)} of family {fam.name!r}: "
                     f"bodies marked h{kind} must have equal lengths (or choose another family)"
                 )
     return out

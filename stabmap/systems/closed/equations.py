@@ -26,8 +26,10 @@ import numpy as np
 # value near sqrt(1e-7), far above it.
 RANK_TOL = 1e-10
 # Relative size below which an eigenvalue of the reduced Hessian (in units of c1^2/h) counts as zero.  Rounding
-# leaves about 1e-15; a configuration 1e-7 (relative) from a change of index keeps eigenvalues near 1e-7.
-NULL_TOL = 1e-10
+# leaves about 1e-15; a configuration 1e-7 (relative) from a change of index keeps eigenvalues near 1e-7.  The
+# points called degenerate around a change of index form a band of width about 2 NULL_TOL / |d lambda/d ratio|,
+# far below the 1e-10 to which critical values locate a boundary.
+NULL_TOL = 1e-12
 
 
 def wrap(angle: np.ndarray) -> np.ndarray:
