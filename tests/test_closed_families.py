@@ -8,6 +8,7 @@ and the energy probe on the closed configurations for every index and nullity; t
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import mpmath as mp
 import numpy as np
@@ -228,9 +229,11 @@ def test_points_1e_7_either_side_of_every_boundary(name):
             assert ref.closed_form(family, ref.lengths_of(family, r)) is None
 
 
-def test_the_hinge_loses_stability_at_sqrt_2_and_the_six_body_eight_gains_it_near_5_986():
-    assert abs(_stability_boundary("hinge", "1.4") - mp.sqrt(2)) < mp.mpf(10) ** -18
-    assert abs(_stability_boundary("figure-eight-6", "6") - mp.mpf("5.98605461610343983")) < mp.mpf(10) ** -15
+def test_the_boundaries_docs_closed_md_quotes_are_the_references():
+    text = (Path(__file__).resolve().parents[1] / "docs" / "closed.md").read_text(encoding="utf-8")
+    assert abs(_stability_boundary("hinge", "1.4") - mp.sqrt(2)) < mp.mpf(10) ** -18 and "stable below ratio √2" in text
+    assert f"{float(_stability_boundary('figure-eight-6', '6')):.15g}" in text
+    assert f"{float(2 / (mp.sqrt(2) - 1)):.10g}" in text
 
 
 def test_odd_rings_with_unequal_lengths_do_not_close():
