@@ -19,7 +19,7 @@ import stabmap
 from stabmap import closed
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
 ROOT = Path(__file__).resolve().parents[1]
 COLOURS = {"stable": "#56B4E9", "unstable": "#E69F00", "degenerate": "#999999", "absent": "#FFFFFF"}

@@ -15,4 +15,4 @@ from .systems.closed.families import FAMILIES, SHAPES
 from .systems.closed.search import search
 from .systems.closed.solve import Equilibrium, solve
 
-__all__ = ["Equilibrium", "FAMILIES", "SHAPES", "search", "solve"]
+__all__ = ["FAMILIES", "SHAPES", "Equilibrium", "search", "solve"]

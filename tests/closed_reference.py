@@ -159,8 +159,9 @@ def probe(theta, lengths, loops, eps=None):
     return Q
 
 
-def inertia(Q, tol=mp.mpf(10) ** (-8)):
+def inertia(Q, tol=1e-8):
     """(index, nullity) of a symmetric matrix."""
+    tol = mp.mpf(tol)
     if Q.rows == 0:
         return 0, 0
     ev = mp.eigsy(Q, eigvals_only=True)

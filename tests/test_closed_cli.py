@@ -157,6 +157,14 @@ def test_bad_scenes_give_one_line_exit_2_and_no_file(tmp_path, capsys, body, mes
         stabmap.loads_scene('system = "closed"\n' + body + "\n")
 
 
+def test_refinement_is_declined_with_one_line_and_no_file(tmp_path, capsys):
+    scene = tmp_path / "hinge.toml"
+    scene.write_text(HINGE)
+    out = tmp_path / "r.nc"
+    assert main(["atlas", str(scene), "-o", str(out), "--refine", "-q"]) == 2
+    assert "not available for closed atlases" in capsys.readouterr().err and not out.exists()
+
+
 def test_a_family_without_equilibrium_is_data_not_an_error(tmp_path):
     scene = tmp_path / "none.toml"
     scene.write_text('system = "closed"\nfamily = "figure-eight-4"\nratio = 1.5\n')

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import closed_reference as ref
 import mpmath as mp
 import numpy as np
 import pytest
@@ -17,7 +18,6 @@ import sympy as sp
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import closed_reference as ref
 import stabmap
 from stabmap import closed
 from stabmap.errors import StabmapError
@@ -74,7 +74,7 @@ def test_the_closed_forms_of_closed_md_solve_the_general_equations_at_40_digits(
 
 
 def test_exact_closed_forms_with_sympy():
-    r, t = sp.symbols("r t", positive=True)
+    r = sp.symbols("r", positive=True)
     c, s = sp.sqrt(1 - r**2), r  # figure-eight-4: sin t = h2/h1 = r, h1 = 1, c1^2 = h = 1
     th = [(-s, c), (1, 0), (-s, -c), (1, 0)]  # (sin, cos) of -t, pi/2, pi + t, pi/2
     L = [1, r, 1, r]

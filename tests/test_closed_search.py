@@ -9,14 +9,14 @@ from __future__ import annotations
 
 import math
 
+import closed_reference as ref
 import mpmath as mp
 import numpy as np
 import pytest
+from test_closed_families import joint_angles, scaled_residual
 
-import closed_reference as ref
 from stabmap import closed
 from stabmap.errors import StabmapError
-from test_closed_families import joint_angles, scaled_residual
 
 
 def same_shape(a, b) -> bool:
@@ -59,7 +59,7 @@ def test_every_found_equilibrium_is_a_regular_root_with_the_probes_index(found):
     for eq in eqs:
         theta = [mp.mpf(float(t)) for t in eq.theta]
         start = [t + mp.mpf(float(d)) for t, d in zip(theta, rng.normal(0, 1e-4, len(theta)))]
-        th, F = ref.newton(start, [tuple(mp.mpf(float(c)) * mp.mpf("1.03") for c in eq.forces[0])], L, loops)
+        th, _ = ref.newton(start, [tuple(mp.mpf(float(c)) * mp.mpf("1.03") for c in eq.forces[0])], L, loops)
         assert np.abs(np.angle(np.exp(1j * (joint_angles([float(t) for t in th]) - joint_angles(eq.theta))))).max() < 1e-10
         with mp.workdps(40):
             exact, _ = ref.newton(theta, [tuple(mp.mpf(float(c)) for c in eq.forces[0])], L, loops)

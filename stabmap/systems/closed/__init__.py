@@ -19,7 +19,7 @@ from ..base import Cost, System
 from . import scene as _scene
 from .decide import ABSENT, DEGENERATE, STABLE, decide
 from .equations import joint_angles
-from .families import FAMILIES, loops_of
+from .families import FAMILIES
 from .outputs import STABILITY, VARIABLES
 from .scene import Scene
 
@@ -119,4 +119,4 @@ class Closed(System):
 
 SYSTEM = Closed()
 
-__all__ = ["SYSTEM", "Scene", "FAMILIES", "loops_of"]
+__all__ = ["FAMILIES", "SYSTEM", "Scene"]

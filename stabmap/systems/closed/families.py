@@ -150,8 +150,3 @@ FAMILIES = {
     )
 }
 SHAPES = tuple(FAMILIES)
-
-
-def loops_of(family: Family, n: int) -> tuple[tuple[int, ...], ...]:
-    """The 1-based bodies of each loop (a plain chain: one loop of every body)."""
-    return family.loops or (tuple(range(1, n + 1)),)

@@ -249,4 +249,4 @@ def combinations(*arrays: np.ndarray):
         yield tuple(key), np.flatnonzero(inverse.ravel() == i)
 
 
-__all__ = ["Scene", "from_dict", "fixed_values", "PARAMETERS"]
+__all__ = ["PARAMETERS", "Scene", "fixed_values", "from_dict"]
