@@ -212,5 +212,5 @@ def test_the_stored_scene_names_its_system_and_old_files_default_to_gyroscopes()
     scene = loads_scene(GOOD)
     assert scene.to_toml().startswith('system = "gyroscopes"\n')
     assert loads_scene(scene.to_toml()) == scene == loads_scene('system = "gyroscopes"\n' + GOOD)
-    with pytest.raises(StabmapError, match="system = 'closed' is not a system stabmap knows; choose one of: gyroscopes"):
-        loads_scene('system = "closed"\n' + GOOD)
+    with pytest.raises(StabmapError, match="system = 'pendulum' is not a system stabmap knows; choose one of: gyroscopes"):
+        loads_scene('system = "pendulum"\n' + GOOD)

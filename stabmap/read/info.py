@@ -33,10 +33,13 @@ def describe(ds: xr.Dataset, name: str = "") -> str:
         lines.append("  fixed: " + ", ".join(f"{k} = {float(ds[k]):.6g}" for k in fixed))
     if system.stable_label is not None:
         degenerate = f", degenerate: {s['degenerate']}" if s["degenerate"] else ""
-        lines.append(f"  points: {s['points']}, stable: {s['stable']} ({100 * s['stable_fraction']:.2f} %)" + degenerate)
+        absent = f", absent: {s['absent']}" if s["absent"] else ""
+        lines.append(f"  points: {s['points']}, stable: {s['stable']} ({100 * s['stable_fraction']:.2f} %)" + degenerate + absent)
     else:
         lines.append(f"  points: {s['points']}")
-    lines.append(f"  {system.label} ({system.label_symbol}): " + ", ".join(f"{k}: {v}" for k, v in s[system.label].items()))
+    flags = system.variable(system.label).flags
+    name = (lambda k: system.variable(system.label).meaning(k)) if flags else str  # a flag label: its meanings
+    lines.append(f"  {system.label} ({system.label_symbol}): " + ", ".join(f"{name(k)}: {v}" for k, v in s[system.label].items()))
     if system.provenance in s:
         lines.append("  decided by: " + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in s[system.provenance].items()))
     lines.append(f"  made by {a.get('source', '?')}; {a.get('history', '')}")

@@ -42,6 +42,7 @@ _LEGEND_WIDTH = 2.5  # [inch] beside small multiples
 _STABLE = "#56B4E9"
 _UNSTABLE = ["#F0E442", "#E69F00", "#D55E00", "#CC79A7", "#882255", "#332288", "#117733", "#44AA99", "#999933", "#AA4499"]
 _DEGENERATE = "#BBBBBB"
+_ABSENT = "#FFFFFF"  # nothing to decide (System.absent_label): left blank
 _BOUNDARY = "#000000"
 _CLASS_EDGE = "#333333"
 _HATCH_INFERRED = "////"
@@ -51,8 +52,11 @@ _VECTOR_RUNS = 20_000  # a panel with more runs of equal cells along x is filled
 
 
 
-def colour(value: int, stable: int | None = 0) -> str:
-    """The colour of the label ``value`` (negative: degenerate; ``stable``: the stable class) in every figure."""
+def colour(value: int, stable: int | None = 0, absent: int | None = None) -> str:
+    """The colour of the label ``value`` (``absent``: white; other negatives: degenerate; ``stable``: the stable
+    class) in every figure."""
+    if absent is not None and value == absent:
+        return _ABSENT
     if value < 0:
         return _DEGENERATE
     if value == stable:
@@ -276,7 +280,7 @@ def _rectangles(mask: np.ndarray, xe: np.ndarray, ye: np.ndarray) -> list[np.nda
     return [np.array([[xe[a], ye[j0]], [xe[b], ye[j0]], [xe[b], ye[j1]], [xe[a], ye[j1]]]) for a, b, j0, j1 in done]
 
 
-def _fill(ax, values: np.ndarray, xe: np.ndarray, ye: np.ndarray, cmap, norm, stable: int | None) -> None:
+def _fill(ax, values: np.ndarray, xe: np.ndarray, ye: np.ndarray, cmap, norm, stable: int | None, absent: int | None = None) -> None:
     """Colour the cells: one vector rectangle per block of equal cells, or an image when the map is too busy.
 
     Rectangles are outlined in their own colour, so no hairline seams show between them in a PDF viewer.
@@ -289,7 +293,7 @@ def _fill(ax, values: np.ndarray, xe: np.ndarray, ye: np.ndarray, cmap, norm, st
         ax.pcolormesh(xe, ye, values, cmap=cmap, norm=norm, shading="flat", rasterized=True)
         return
     for v in np.unique(values):
-        c = colour(int(v), stable)
+        c = colour(int(v), stable, absent)
         cells = PolyCollection(_rectangles(values == v, xe, ye), facecolors=c, edgecolors=c, linewidths=0.3, antialiaseds=False, zorder=1)
         cells.set_gid(f"cells-{int(v)}")
         ax.add_collection(cells, autolim=False)
@@ -442,9 +446,10 @@ def atlas_figure(
     everything = np.concatenate([d.ravel() for d in data])
     present = sorted(int(v) for v in np.unique(everything))
     top = max(1, present[-1])
-    stable = system.stable_label
-    cmap = ListedColormap([colour(v, stable) for v in range(-1, top + 1)])
-    norm = BoundaryNorm(np.arange(-1.5, top + 1.5), cmap.N)
+    bottom = min(-1, present[0])
+    stable, absent = system.stable_label, system.absent_label
+    cmap = ListedColormap([colour(v, stable, absent) for v in range(bottom, top + 1)])
+    norm = BoundaryNorm(np.arange(bottom - 0.5, top + 1.5), cmap.N)
 
     xs = np.asarray(ds[plan.x], dtype=float)
     xe = _edges(xs, "log" if _log_axis(ds, plan.x) else None)
@@ -477,8 +482,8 @@ def atlas_figure(
 
     drawn = {"stability": False, "classes": False, "inferred": False, "light": False}
     for ax, values, inf, (r, c) in zip(axes, data, inferred, panels):
-        _fill(ax, values, xe, ye, cmap, norm, stable)
-        for mask, gid in ((inf, "inferred-cells"), (values < 0, "degenerate-cells")):
+        _fill(ax, values, xe, ye, cmap, norm, stable, absent)
+        for mask, gid in ((inf, "inferred-cells"), ((values < 0) & (values != absent), "degenerate-cells")):
             if mask is not None and mask.any():
                 drawn["inferred"] |= gid == "inferred-cells"
                 drawn["light"] |= _overlay(ax, mask, xe, ye, gid)
@@ -526,8 +531,9 @@ def atlas_figure(
 
     handles = []
     for v in present:
-        hatch = _HATCH_DEGENERATE if v < 0 else None
-        handles.append(Patch(facecolor=colour(v, stable), edgecolor="none", hatch=hatch, label=class_label(v, system)))
+        hatch = _HATCH_DEGENERATE if v < 0 and v != absent else None
+        edge = "#888888" if v == absent else "none"  # a white patch needs an outline to be seen
+        handles.append(Patch(facecolor=colour(v, stable, absent), edgecolor=edge, lw=0.5, hatch=hatch, label=class_label(v, system)))
     if drawn["stability"]:
         handles.append(Line2D([], [], color=_BOUNDARY, lw=1.5, label="stability boundary"))
     if drawn["classes"]:

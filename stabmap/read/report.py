@@ -87,7 +87,7 @@ def _label_json(label: Label, atlas) -> str:
 def _fraction_text(f: StableFraction) -> str:
     lines = [
         f"stable fraction {f.fraction:.6g}: {f.stable} of {f.points} grid points stable ({100 * f.fraction:.2f} %), "
-        f"{f.unstable} unstable" + (f", {f.degenerate} degenerate" if f.degenerate else "")
+        f"{f.unstable} unstable" + (f", {f.degenerate} degenerate" if f.degenerate else "") + (f", {f.absent} absent" if f.absent else "")
     ]
     lines += [f"  {a.describe()}" for a in f.axes.values()]
     if f.inferred:
@@ -102,6 +102,8 @@ def _fraction_text(f: StableFraction) -> str:
 
 def _fraction_record(f: StableFraction) -> dict:
     row = {k: getattr(f, k) for k in ("fraction", "stable", "points", "unstable", "degenerate", "inferred", "inferred_stable")}
+    if f.absent is not None:
+        row["absent"] = f.absent
     for name, a in f.axes.items():
         row[f"{name}_lo"], row[f"{name}_hi"] = a.bounds
         row[f"{name}_n"] = len(a.values)

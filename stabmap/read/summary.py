@@ -24,7 +24,8 @@ def _counts(values) -> dict[int, int]:
 def summary(ds: xr.Dataset) -> dict:
     """Points, the stable fraction, a histogram of the label and of who decided.
 
-    Keys: ``points``, ``stable``, ``degenerate`` (label < 0), ``stable_fraction``, the label's name (a
+    Keys: ``points``, ``stable``, ``degenerate`` (label < 0, but for ``absent``), ``absent`` (the system's
+    ``absent_label``: nothing to decide there), ``stable_fraction``, the label's name (a
     histogram, e.g. ``n_complex_pairs``) and the provenance variable's name (counts by flag meaning, e.g.
     ``decided_by``).
     """
@@ -35,7 +36,8 @@ def summary(ds: xr.Dataset) -> dict:
     out = {
         "points": points,
         "stable": stable,
-        "degenerate": sum(c for v, c in label.items() if v < 0),
+        "degenerate": sum(c for v, c in label.items() if v < 0 and v != system.absent_label),
+        "absent": label.get(system.absent_label, 0) if system.absent_label is not None else 0,
         "stable_fraction": stable / points if points else float("nan"),
         system.label: dict(sorted(label.items())),
     }

@@ -53,8 +53,8 @@ ASSUMPTION = (
     "Changes of {label} are searched for only between adjacent scan values whose {label} differ. "
     "Features narrower than the scan spacing are not found: a stable or unstable interval lying wholly between "
     "two adjacent scan values, or an even number of changes within one scan step, is invisible unless a "
-    "bisection midpoint happens to land on it. Everything that is reported is proved: every located boundary "
-    "lies inside its bracket, whose two ends have certified, different {label}."
+    "bisection midpoint happens to land on it. Everything that is reported is {proved}: every located boundary "
+    "lies inside its bracket, whose two ends have {certified}, different {label}."
 )
 
 
@@ -176,7 +176,7 @@ def critical(
     with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run:
         nc = _scan(run, scene, index, progress, chunk_points, counts)
         brackets = _bisect(run, scene, along, others, _initial_brackets(nc, scan), rtol, atol, chunk_points, counts)
-    ds = _dataset(system, scene, along, others, scan, nc, brackets)
+    ds = _dataset(system, scene, along, others, scan, nc, brackets, _proved(system))
     ds.attrs.update(_attrs(system, along, scan, rtol, atol, counts))
     ds.attrs["history"] += _history(along, counts, time.perf_counter() - t0)
     return ds
@@ -300,7 +300,12 @@ def _stable_intervals(nc_start: int, scan: np.ndarray, b: _Brackets, stable: int
     return out
 
 
-def _dataset(system, scene, along, others, scan, nc, brackets) -> xr.Dataset:
+def _proved(system) -> str:
+    """How the labels were decided, for the texts: "proved", or "decided" for a system whose labels are not proofs."""
+    return "proved" if system.proves_labels else "decided"
+
+
+def _dataset(system, scene, along, others, scan, nc, brackets, proved: str = "proved") -> xr.Dataset:
     info = system.parameter(scene, along)
     label = system.variable(system.label)
     dims = tuple(a.name for a in others)
@@ -320,16 +325,16 @@ def _dataset(system, scene, along, others, scan, nc, brackets) -> xr.Dataset:
 
     data = {
         "n_stable_intervals": (dims, grid(t.n_intervals), {"long_name": "number of stable intervals in the scan range", "units": "1"}),
-        f"{along}_stable_lower": (iv, grid(t.lower), along_attrs("lower end of a stable interval", "proved stable; NaN pads")),
-        f"{along}_stable_upper": (iv, grid(t.upper), along_attrs("upper end of a stable interval", "proved stable; NaN pads")),
+        f"{along}_stable_lower": (iv, grid(t.lower), along_attrs("lower end of a stable interval", f"{proved} stable; NaN pads")),
+        f"{along}_stable_upper": (iv, grid(t.upper), along_attrs("upper end of a stable interval", f"{proved} stable; NaN pads")),
         f"{along}_stable_lower_outer": (iv, grid(t.lower_outer), along_attrs(
-            "value just below a stable interval", "proved unstable; the boundary lies in (lower_outer, lower]; "
+            "value just below a stable interval", f"{proved} unstable; the boundary lies in (lower_outer, lower]; "
             "NaN where the interval starts at the scan range end (it may continue below)")),
         f"{along}_stable_upper_outer": (iv, grid(t.upper_outer), along_attrs(
-            "value just above a stable interval", "proved unstable; the boundary lies in [upper, upper_outer); "
+            "value just above a stable interval", f"{proved} unstable; the boundary lies in [upper, upper_outer); "
             "NaN where the interval ends at the scan range end (it may continue above)")),
-        "boundary_lower": (bd, grid(t.b_lower), along_attrs(f"lower end of the bracket of a change of {lab}", f"{lab}_below holds here, proved; NaN pads")),
-        "boundary_upper": (bd, grid(t.b_upper), along_attrs(f"upper end of the bracket of a change of {lab}", f"{lab}_above holds here, proved; a change lies in (lower, upper]; NaN pads")),
+        "boundary_lower": (bd, grid(t.b_lower), along_attrs(f"lower end of the bracket of a change of {lab}", f"{lab}_below holds here, {proved}; NaN pads")),
+        "boundary_upper": (bd, grid(t.b_upper), along_attrs(f"upper end of the bracket of a change of {lab}", f"{lab}_above holds here, {proved}; a change lies in (lower, upper]; NaN pads")),
         f"{lab}_below": (bd, grid(t.nc_below), count_attrs(f"{lab} at boundary_lower")),
         f"{lab}_above": (bd, grid(t.nc_above), count_attrs(f"{lab} at boundary_upper")),
     }
@@ -349,7 +354,8 @@ def _attrs(system, along, scan, rtol, atol, counts: _Counts) -> dict:
         "critical_evaluated_points": np.int64(counts.scan_points + counts.bisection_points),
         "critical_bisection_steps": np.int64(counts.iterations),
         "comment": "Ends are located until hi - lo <= max(rtol * max(|lo|, |hi|), atol), or lo and hi are neighbouring "
-        "doubles. " + ASSUMPTION.format(label=system.label),
+        "doubles. " + ASSUMPTION.format(label=system.label, proved=_proved(system),
+                                          certified="certified" if system.proves_labels else "decided"),
     }
     if system.provenance is not None:
         flags = system.variable(system.provenance)

@@ -78,6 +78,13 @@ class System:
         The legend's title for the label, e.g. ``"complex root pairs N$_c$"``.
     stable_label : int or None
         The label value of a stable point; None for a system without a notion of stability.
+    absent_label : int or None
+        The (negative) label value of a point where there is nothing to decide, e.g. a family of equilibria
+        that does not exist there; summaries count such points apart from the degenerate ones and figures
+        leave them white. None: every point has something to decide.
+    proves_labels : bool
+        True when every label is a proof (the texts of critical values say "proved"); False for a system that
+        decides its labels in floating point with stated tolerances (they say "decided").
     provenance : str or None
         A flag variable saying how each point was decided. A system that allows adaptive
         refinement (``inferred``) has ``store.variables.INFERRED`` among its meanings.
@@ -93,6 +100,8 @@ class System:
     label_symbol: str
     label_title: str
     stable_label: int | None = None
+    absent_label: int | None = None
+    proves_labels: bool = True
     provenance: str | None = None
     symbols: dict[str, str] = {}
 

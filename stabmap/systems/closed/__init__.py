@@ -1,0 +1,122 @@
+"""Closed chains of elastic joints (docs/closed.md): the planar equilibria of a closed rod of n bodies, their
+forces and their stability, from Bolgrabskaya, Savchenko and Shchepin (2006), as checked in CLOSED.md.
+
+The pipeline's part of this system is the ``System`` below; the physics is in the modules beside it:
+
+- ``families``: the named families (ring, figure-eights, hinges) and their closed forms;
+- ``equations``: the general equilibrium equations, energy, constrained Hessian, rotation index;
+- ``decide``: a batch of configurations -> every output (shared by atlases and ``solve``);
+- ``solve`` and ``search``: the Python API (``stabmap.closed``);
+- ``checks``, ``scene``: what an input must satisfy, and the scene files;
+- ``outputs``: the variables written.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..base import Cost, System
+from . import scene as _scene
+from .decide import ABSENT, DEGENERATE, STABLE, decide
+from .equations import joint_angles
+from .families import FAMILIES
+from .outputs import STABILITY, VARIABLES
+from .scene import Scene
+
+REFERENCES = (
+    "I. A. Bolgrabskaya, A. Ya. Savchenko, N. N. Shchepin, Closed systems of coupled rigid bodies (in Russian), "
+    "Mekhanika tverdogo tela 36 (2006): equations (22)-(52); corrected and extended by stabmap's CLOSED.md"
+)
+
+
+class Closed(System):
+    name = "closed"
+    title = "planar equilibria of a closed chain of elastic joints, with their forces and stability"
+    references = REFERENCES
+    variables = VARIABLES
+    label = STABILITY.name
+    label_symbol = "class"
+    label_title = "equilibrium"
+    stable_label = STABLE
+    absent_label = ABSENT
+    proves_labels = False  # floating point with the tolerances of equations.py, every point's residual stored
+    provenance = None
+    symbols = {"ratio": "h_2/h_1", "n": "n", "j": "j", "h": "h"}
+
+    def scene_from_dict(self, table, base_dir=None) -> Scene:
+        return _scene.from_dict(table, base_dir)
+
+    def parameter(self, scene: Scene, name: str):
+        return scene.parameter(name)
+
+    def fixed_values(self, scene: Scene) -> dict[str, float]:
+        return _scene.fixed_values(scene)
+
+    def attrs(self, scene: Scene) -> dict:
+        fam = scene.fam
+        out = {"closed_family": fam.name, "closed_family_title": fam.title, "closed_exists_where": fam.ratio_range}
+        if scene.lengths:
+            out["closed_lengths"] = np.array(scene.lengths)
+        if fam.loops:
+            out["closed_loops"] = "; ".join(" ".join(f"S{k}" for k in loop) for loop in fam.loops)
+        out["closed_h"] = "min of the lengths at each point" if scene.h is None else f"{scene.h:g} m"
+        return out
+
+    def describe(self, attrs: dict) -> list[str]:
+        lines = [f"family {attrs.get('closed_family')}: {attrs.get('closed_family_title')}; exists where {attrs.get('closed_exists_where')}"]
+        if "closed_loops" in attrs:
+            lines.append(f"two loops, each with its own force: {attrs['closed_loops']}")
+        if "closed_lengths" in attrs:
+            lines.append(f"lengths {[float(v) for v in np.atleast_1d(attrs['closed_lengths'])]} m")
+        lines.append(f"h: {attrs.get('closed_h')}")
+        return lines
+
+    def dims(self, scene: Scene) -> dict[str, int]:
+        return {"body": scene.n_max, "loop": len(scene.fam.loops) or 1}
+
+    def cost(self, scene: Scene) -> Cost:
+        # Measured on one core (numpy on batches, an SVD and an eigenvalue problem per point): 7-9 us a point
+        # for six bodies, 0.2 ms for twenty; the n x n SVD dominates.
+        n = scene.n_max
+        return Cost(seconds=5e-6 + 2.5e-8 * n**3, bytes=8 * (6 + 2 * n))
+
+    def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        shape = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()
+        p = _scene.point_values(scene, values)
+        size = int(np.prod(shape, dtype=np.int64))
+        dims = self.dims(scene)
+        out = {v.name: np.empty((size,) + tuple(dims[d] for d in v.dims), dtype=v.dtype) for v in VARIABLES}
+        for name in ("theta", "joint_angle", "force_y", "force_z"):
+            out[name][:] = np.nan
+        fam = scene.fam
+        n_of = p["n"].astype(np.int64) if "n" in p else np.full(size, scene.n_max)
+        j_of = p["j"].astype(np.int64) if "j" in p else np.ones(size, dtype=np.int64)
+        for (n, j), pts in _scene.combinations(n_of, j_of):
+            if scene.lengths:
+                lengths = np.broadcast_to(np.asarray(scene.lengths), (pts.size, n))
+            else:
+                lengths = fam.lengths(p["h1"][pts], p["ratio"][pts], n)
+            c1sq = p["c1sq"][pts]
+            h = p["h"][pts] if "h" in p else lengths.min(-1)
+            theta, forces, exists = fam.closed_form(lengths, c1sq, h, j)
+            d = decide(theta, forces, exists, lengths, fam.loop_of(n), c1sq, h)
+            out["stability"][pts] = d.stability
+            out["exists"][pts] = d.exists
+            out["index"][pts] = d.index
+            out["nullity"][pts] = d.nullity
+            out["rotation_index"][pts] = d.rotation_index
+            out["energy"][pts] = d.energy
+            out["residual"][pts] = d.residual
+            out["theta"][pts, :n] = d.theta
+            out["joint_angle"][pts, :n] = joint_angles(d.theta)
+            out["force_y"][pts] = d.forces[..., 0]
+            out["force_z"][pts] = d.forces[..., 1]
+        return {k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}
+
+    def class_name(self, value: int) -> str:
+        return {ABSENT: "absent (no equilibrium)", DEGENERATE: "degenerate (nullity > 0)"}.get(value) or STABILITY.meaning(value)
+
+
+SYSTEM = Closed()
+
+__all__ = ["FAMILIES", "SYSTEM", "Scene"]
