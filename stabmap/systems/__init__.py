@@ -16,6 +16,7 @@ from .base import SceneBase, System
 
 SYSTEMS = {
     "gyroscopes": "stabmap.systems.gyroscopes",
+    "reactions": "stabmap.systems.reactions",
 }
 DEFAULT = "gyroscopes"  # scene files and atlases from before the ``system`` key
 
