@@ -290,3 +290,16 @@ def test_zero_load_gives_zero_reactions():
 def test_bad_input_names_the_parameter(nodes, F, M, releases, message):
     with pytest.raises(StabmapError, match=message):
         solve(nodes, F, M, releases=releases)
+
+
+@pytest.mark.slow
+@settings(max_examples=600, deadline=None)
+@given(problems())
+def test_many_layouts_match_the_50_digit_svd(problem):
+    """The fast test's comparison on ten times as many layouts, loads and releases."""
+    nodes, F, M, releases = problem
+    r = solve(nodes, F, M, releases=releases)
+    ref, rank = mpmath_least_norm(nodes, F, M, releases)
+    assert r.rank == rank and r.compatible and ref is not None
+    assert np.abs(r.R - ref).max() <= 1e-10 * load_scale(nodes, F, M, ref)[0]
+    check_solution(nodes, F, M, releases, r.R)

@@ -147,9 +147,9 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
     if ("load" in data) == ("body" in data):
         raise StabmapError("give the load either as a [load] table (F and M) or as a [body] table (mass, centre, gravity, motion), exactly one of the two")
     values = {k: data[k] for k in ("title", "load_factor") if k in data}
-    nodes = check_nodes(data["nodes"])
-    if nodes.ndim != 2:
-        raise StabmapError(f"nodes must be a list of [x, y, z] positions, got an array of shape {nodes.shape}")
+    if not isinstance(data["nodes"], list) or not data["nodes"]:
+        raise StabmapError(f"nodes must be a non-empty list of [x, y, z] positions [m], got {data['nodes']!r}")
+    nodes = tuple(_vector(p, f"nodes[{i}]") for i, p in enumerate(data["nodes"]))
     raw = data.get("releases", [])
     if not isinstance(raw, list):
         raise StabmapError("releases must be a list of tables such as { node = 0, direction = [1.0, 0.0, 0.0] }")
@@ -173,7 +173,7 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
         values["body"] = Body(**data["body"])
     kind = "load" if "load" in data else "body"
     grid = parse_axes(data.get("grid", {}), lambda name: parameters.parse(name, len(nodes), kind)[1])
-    return Scene(nodes=tuple(map(tuple, nodes.tolist())), releases=tuple(releases), grid=grid, **values)
+    return Scene(nodes=nodes, releases=tuple(releases), grid=grid, **values)
 
 
 # ------------------------------------------------------------------------------------------------------ the checks
