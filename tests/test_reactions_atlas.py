@@ -4,6 +4,8 @@ load, centre of mass and node coordinates, the CLI's atlas/info/query/plot, and 
 from __future__ import annotations
 
 import json
+import pathlib
+import runpy
 import subprocess
 import sys
 
@@ -224,3 +226,13 @@ def test_cli_options_a_reactions_atlas_cannot_take(tmp_path, args, message):
     assert not (tmp_path / "out.nc").exists()
     run = run_cli(tmp_path, "critical", str(scene_file), "--along", "c_x", "-o", str(tmp_path / "c.nc"))
     assert run.returncode == 2 and "no stability" in run.stderr and not (tmp_path / "c.nc").exists()
+
+
+def test_figure_script_and_its_benchmark_run(tmp_path, capsys):
+    """scripts/reactions_figure.py, once, so that it cannot rot (docs/reactions.md shows its figures)."""
+    script = runpy.run_path(str(pathlib.Path(__file__).resolve().parents[1] / "scripts" / "reactions_figure.py"))
+    script["main"](["--out", str(tmp_path)])
+    for name in ("reactions-square-plate.png", "reactions-spinning-stage.png"):
+        assert (tmp_path / name).read_bytes()[:4] == b"\x89PNG"
+    script["main"](["--bench", "--quick"])
+    assert capsys.readouterr().out.count("us per point") == 3

@@ -23,9 +23,9 @@ REFERENCES = (
     "of a constrained rigid body (in Russian), Uchenye Zapiski TsAGI 18(6), 1987: equations (1)-(17); the "
     "collinear case corrected (docs/reactions.md)"
 )
-# Seconds per point on one core (scripts/reactions_figure.py --bench): one SVD per point when the layout is
-# scanned, one per block when only the load is.
-SECONDS_LAYOUT, SECONDS_LOAD = 2e-5, 2e-6
+# Seconds per point on one core (scripts/reactions_figure.py --bench: 12, 0.9 and 1.8 us): one SVD per point
+# when two or more node coordinates are scanned; with one, an SVD per value of it; with none, one per block.
+SECONDS_LAYOUT, SECONDS_LOAD = 1.2e-5, 2e-6
 
 
 class Reactions(System):
@@ -68,8 +68,8 @@ class Reactions(System):
         return {NODE_DIM: scene.n, COMPONENT_DIM: 3}
 
     def cost(self, scene: Scene) -> Cost:
-        layout = any(scene.key(a.name)[0] == "node" for a in scene.grid)
-        return Cost(seconds=SECONDS_LAYOUT if layout else SECONDS_LOAD, bytes=8 * (3 * scene.n + 6))
+        layouts = sum(scene.key(a.name)[0] == "node" for a in scene.grid)
+        return Cost(seconds=SECONDS_LAYOUT if layouts >= 2 else SECONDS_LOAD, bytes=8 * (3 * scene.n + 6))
 
     def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         from .load import load, node_positions
