@@ -23,9 +23,9 @@ REFERENCES = (
     "of a constrained rigid body (in Russian), Uchenye Zapiski TsAGI 18(6), 1987: equations (1)-(17); the "
     "collinear case corrected (docs/reactions.md)"
 )
-# Seconds per point on one core (scripts/reactions_figure.py --bench: 12, 0.9 and 1.8 us): one SVD per point
+# Seconds per point on one core (scripts/reactions_figure.py --bench: 14, 1.9 and 3.6 us): one SVD per point
 # when two or more node coordinates are scanned; with one, an SVD per value of it; with none, one per block.
-SECONDS_LAYOUT, SECONDS_LOAD = 1.2e-5, 2e-6
+SECONDS_LAYOUT, SECONDS_LOAD = 1.4e-5, 4e-6
 
 
 class Reactions(System):

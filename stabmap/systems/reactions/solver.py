@@ -240,6 +240,10 @@ def least_norm(x: np.ndarray, F: np.ndarray, M: np.ndarray, Q: np.ndarray) -> Ba
     compatible = outside <= BALANCE_RTOL * scale
     inv = np.divide(1.0, s, out=np.zeros_like(s), where=kept)
     rho = np.einsum("...ji,...j->...i", Vt, coef * inv)
+    # One step of iterative refinement on what the first solve left unbalanced (within the range, as the part
+    # outside cannot be carried): it takes the rounding of the SVD's factors out of the balance.
+    left = b - np.einsum("...ij,...j->...i", A, rho)
+    rho = rho + np.einsum("...ji,...j->...i", Vt, np.einsum("...ij,...i->...j", U, left) * kept * inv)
     R = (rho @ Q.T).reshape(rho.shape[:-1] + (n, 3))
 
     # Balance as achieved, in the same scaled form (forces, and moments about the centroid over ell).
