@@ -80,6 +80,7 @@ def test_plate_atlas_matches_the_linear_distribution():
     for name in ("R_max", "critical_node", "n_critical", "rank", "free_motions", "compatible", "balance_residual"):
         assert ds[name].dims == ("c_x", "c_y")
     assert ds["R"].attrs["units"] == "N" and ds["compatible"].attrs["flag_meanings"] == "incompatible compatible"
+    assert list(ds["component"].values) == ["x", "y", "z"] and list(ds["node"].values) == [0, 1, 2, 3]
     assert ds.attrs["stabmap_system"] == "reactions" and float(ds["mass"]) == 10.0
     G, a = 10.0 * 9.81, 0.5
     x, y = np.array(PLATE_NODES)[:, 0], np.array(PLATE_NODES)[:, 1]
@@ -170,6 +171,7 @@ def test_cli_atlas_info_query_plot(tmp_path, capsys):
     np.testing.assert_allclose(sum(r[2] for r in answer["R"]), 98.1, rtol=1e-12)
     assert main(["atlas", str(scene_file), "-o", str(tmp_path / "a.zarr"), "-q"]) == 0
     assert stabmap.open_atlas(tmp_path / "a.zarr")["R"].identical(stabmap.open_atlas(out)["R"])
+    assert float(stabmap.open_atlas(out)["R"].sel(c_x=0.0, c_y=0.0, component="z", node=3)) == pytest.approx(98.1 / 4, rel=1e-15)
     assert main(["plot", str(out), "-o", str(tmp_path / "b.pdf"), "--x", "c_y"]) == 0
     assert (tmp_path / "b.pdf").read_bytes()[:4] == b"%PDF"
     fig = stabmap.atlas_figure(stabmap.open_atlas(out))

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..base import Cost, System
 from . import scene as _scene
-from .outputs import COMPONENT_DIM, CRITICAL_NODE, NODE_DIM, VARIABLES
+from .outputs import COMPONENT_DIM, COMPONENTS, CRITICAL_NODE, NODE_DIM, VARIABLES
 from .scene import Body, Load, Release, Scene
 
 REFERENCES = (
@@ -66,6 +66,13 @@ class Reactions(System):
 
     def dims(self, scene: Scene) -> dict[str, int]:
         return {NODE_DIM: scene.n, COMPONENT_DIM: 3}
+
+    def dim_coords(self, scene: Scene) -> dict:
+        # Components as variable-length strings: Zarr (the checkpoint) has no stable spec for fixed-length ones.
+        return {
+            NODE_DIM: (np.arange(scene.n, dtype=np.int32), {"long_name": "node index (0-based, as in the scene's nodes and releases)", "units": "1"}),
+            COMPONENT_DIM: (np.array(COMPONENTS, dtype=object), {"long_name": "Cartesian component in the nodes' frame"}),
+        }
 
     def cost(self, scene: Scene) -> Cost:
         layouts = sum(scene.key(a.name)[0] == "node" for a in scene.grid)
