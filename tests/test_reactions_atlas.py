@@ -201,6 +201,8 @@ BAD = [
     (SCENE.replace("c_y = {", "x_0 = { values = [-0.5, 0.5] }\nc_y = {"), "nodes 0 and 1 are at the same point"),
     (SCENE.replace("c_y = {", "F_x = {"), "belongs to a scene whose load is given by a [load] table"),
     (SCENE.replace("c_y = {", "spin = {"), "unknown parameter name 'spin'"),
+    (SCENE.replace("c_y = {", "g_x = { values = [0.0, 1.0] }\ng_azimuth = {"), "scan its components or its direction, not both"),
+    (SCENE.replace("c_y = {", "g_azimuth = {"), "grid axis g_azimuth has no effect: body.gravity is vertical"),
     (SCENE.replace("[body]", "[load]\nF = [0.0, 0.0, -1.0]\n[body]"), "exactly one of the two"),
     (SCENE.replace("mass = 10.0", "mass = 10.0\ninertia = [[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]"), "body.inertia must be symmetric"),
 ]

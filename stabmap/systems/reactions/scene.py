@@ -250,9 +250,15 @@ def _check_directions(scene: Scene) -> None:
                 "scan its components or its direction, not both"
             )
     for prefix in angles:
-        if not any(scene.vectors[prefix]):
-            what = "load.F" if prefix == "F" else "body.gravity"
+        what = "load.F" if prefix == "F" else "body.gravity"
+        x, y, z = scene.vectors[prefix]
+        if not (x or y or z):
             raise StabmapError(f"grid axis {prefix}_azimuth/{prefix}_elevation turns {what}, which is zero; give {what} a magnitude")
+        if not (x or y) and (prefix, "elevation") not in {key[1:] for key in names.values() if key[0] == "angle"}:
+            raise StabmapError(
+                f"grid axis {prefix}_azimuth has no effect: {what} is vertical (elevation {'+' if z > 0 else '-'}90 degrees); "
+                f"scan {prefix}_elevation as well, or tilt {what}"
+            )
 
 
 def _check_distinct_on_grid(scene: Scene) -> None:
