@@ -461,7 +461,7 @@ def atlas_figure(
     else:
         nrows = ncols = 1
     width = 7.5 if plan.facet is None else max(3.5, 2.6 * ncols + 0.9) + _LEGEND_WIDTH
-    title = _title(ds, plan, everything == stable if stable is not None else everything, 70 if plan.facet is None else int(12 * (width - _LEGEND_WIDTH)))
+    title = _title(ds, plan, None if stable is None else everything == stable, everything.size, 70 if plan.facet is None else int(12 * (width - _LEGEND_WIDTH)))
     lines = title.count("\n") + 1
     if plan.facet is None:
         size = (width, 5.2) if plan.y else (width, max(1.4 + 0.17 * lines, 0.22 * (len(present) + 4)) + 0.6)
@@ -554,16 +554,15 @@ def atlas_figure(
     return fig
 
 
-def _title(ds: xr.Dataset, plan: FigurePlan, stable: np.ndarray, chars: int) -> str:
-    """The atlas title, the stable fraction of the points shown (``stable``: a mask of them; the labels themselves
-    for a system without stability, whose title gives the number of points), the fixed axes, the panels and
-    the notes."""
+def _title(ds: xr.Dataset, plan: FigurePlan, stable: np.ndarray | None, points: int, chars: int) -> str:
+    """The atlas title, the stable fraction of the ``points`` shown (``stable``: a mask of them; None for a
+    system without stability), the fixed axes, the panels and the notes."""
     title = [textwrap.fill(ds.attrs.get("title", "") or "stabmap atlas", chars)]
     part = plan.facet is not None or bool(plan.fixed)
-    if stable.dtype == bool:
-        title.append(f"{100 * float(np.mean(stable)):.1f} % of {'the ' if part else ''}{stable.size:,} grid points{' shown' if part else ''} stable")
+    if stable is not None:
+        title.append(f"{100 * float(np.mean(stable)):.1f} % of {'the ' if part else ''}{points:,} grid points{' shown' if part else ''} stable")
     else:
-        title.append(f"{stable.size:,} grid points{' shown' if part else ''}")
+        title.append(f"{points:,} grid points{' shown' if part else ''}")
     if plan.fixed:
         fixed = []
         for k, (i, asked) in plan.fixed.items():

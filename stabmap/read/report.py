@@ -195,7 +195,7 @@ def _boundaries_text(b: xr.Dataset, frame, limit: int) -> str:
     if star:
         lines.append("* not computed: inferred from the agreeing corners of its grid cell (docs/refine.md)")
     located = b.attrs.get("located_by", f"{CRITICAL_HINT.format(along=along)}.")
-    lines.append(f"Each change lies between the two grid values, not at either" + (f"; {located}" if located else "."))
+    lines.append("Each change lies between the two grid values, not at either" + (f"; {located}" if located else "."))
     return "\n".join(lines)
 
 
