@@ -240,3 +240,14 @@ def test_figure_script_and_its_benchmark_run(tmp_path, capsys):
         assert (tmp_path / name).read_bytes()[:4] == b"\x89PNG"
     script["main"](["--bench", "--quick"])
     assert capsys.readouterr().out.count("us per point") == 3
+
+
+@pytest.mark.slow
+def test_a_local_dask_cluster_gives_the_same_atlas(tmp_path):
+    scene_file = tmp_path / "plate.toml"
+    scene_file.write_text(SCENE)
+    assert main(["atlas", str(scene_file), "-o", str(tmp_path / "here.nc"), "-q"]) == 0
+    assert main(["atlas", str(scene_file), "-o", str(tmp_path / "cluster.nc"), "--workers", "1", "--chunk-points", "20", "-q"]) == 0
+    here, there = stabmap.open_atlas(tmp_path / "here.nc"), stabmap.open_atlas(tmp_path / "cluster.nc")
+    for name in ("R", "critical_node", "rank", "compatible"):
+        assert here[name].identical(there[name])
