@@ -277,6 +277,8 @@ def test_zero_load_gives_zero_reactions():
     [
         ([[0, 0, np.nan], [1, 0, 0]], [0, 0, 1], [0, 0, 0], (), "nodes: node 0 has a non-finite coordinate"),
         ([[0, 0], [1, 0]], [0, 0, 1], [0, 0, 0], (), r"nodes must be an \(n, 3\) array"),
+        ([[0, 0, 0], [1, 0]], [0, 0, 1], [0, 0, 0], (), r"nodes must be an \(n, 3\) array of node positions \[x, y, z\], got \[\[0, 0, 0\], \[1, 0\]\]"),
+        (PLATE, "up", [0, 0, 0], (), r"F must be a 3-vector"),
         (PLATE, [0, 1], [0, 0, 0], (), r"F must be a 3-vector"),
         (PLATE, [0, 0, 1], [0, np.inf, 0], (), "M must be finite"),
         (PLATE, [0, 0, 1], [0, 0, 0], [(1, [0.0, 0.0, 0.0])], r"releases\[0\] direction is zero"),

@@ -305,9 +305,12 @@ def solve(nodes, F, M, *, releases=()) -> Reactions:
     array([25., 25., 25., 25.])
     """
     for value, where, ndim in ((nodes, "nodes", 2), (F, "F", 1), (M, "M", 1)):
-        shape = np.shape(value)
+        want = "an (n, 3) array of node positions [x, y, z]" if ndim == 2 else "a 3-vector [x, y, z]"
+        try:
+            shape = np.shape(value)
+        except ValueError:  # rows of different lengths
+            raise StabmapError(f"{where} must be {want}, got {value!r}") from None
         if len(shape) != ndim:
-            want = "an (n, 3) array of node positions" if ndim == 2 else "a 3-vector [x, y, z]"
             raise StabmapError(f"{where} must be {want}, got shape {shape} (solve_batch takes stacks)")
     out = solve_batch(nodes, F, M, releases=releases)
     ok = bool(out.compatible)
