@@ -46,7 +46,7 @@ _API = {
     "summary": "stabmap.read.summary",
     "write_atlas": "stabmap.store.files",
 }
-_MODULES = {"cavity": "stabmap.systems.gyroscopes.cavity", "closed": "stabmap.closed"}
+_MODULES = {"cavity": "stabmap.systems.gyroscopes.cavity", "closed": "stabmap.closed", "reactions": "stabmap.reactions"}
 
 __all__ = sorted(["StabmapError", "__version__", *_API, *_MODULES])
 

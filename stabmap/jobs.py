@@ -91,7 +91,10 @@ def atlas(
 
 def summary_line(system, s: dict, evaluated=None) -> str:
     """One line about a finished atlas: points, stable share, who decided, the saving of refinement."""
-    line = f"{s['points']} points, {100 * s['stable_fraction']:.1f} % stable"
+    if system.stable_label is not None:
+        line = f"{s['points']} points, {100 * s['stable_fraction']:.1f} % stable"
+    else:  # a system without stability: how often each class of its label occurs
+        line = f"{s['points']} points; " + ", ".join(f"{system.class_name(v)}: {c}" for v, c in s[system.label].items())
     if system.provenance in s:
         line += "; decided by " + ", ".join(f"{m.replace('_', ' ')} {c}" for m, c in s[system.provenance].items() if c)
     if evaluated is not None:

@@ -1,4 +1,4 @@
-"""Bundled example scenes (the paper's cases n = 1, 2, 3, fixed and free; a cavity; trees of bodies)."""
+"""Bundled example scenes (the paper's cases n = 1, 2, 3, fixed and free; a cavity; trees of bodies; reactions of joints)."""
 
 from __future__ import annotations
 

@@ -59,6 +59,8 @@ def colour(value: int, stable: int | None = 0, absent: int | None = None) -> str
         return _ABSENT
     if value < 0:
         return _DEGENERATE
+    if stable is None:  # classes without a stable one (e.g. the critical node): one palette, blue first
+        return ([_STABLE] + _UNSTABLE)[value % (len(_UNSTABLE) + 1)]
     if value == stable:
         return _STABLE
     return _UNSTABLE[(value - 1 if stable is not None and value > stable else value) % len(_UNSTABLE)]
@@ -345,7 +347,7 @@ def _units(units: str) -> str:
 def _symbol(ds: xr.Dataset, name: str) -> str:
     """'omega' -> '$\\omega$', 'm_2' -> '$m_{2}$' (the system's ``symbols``); other names are returned as they are."""
     symbols = systems.of_atlas(ds.attrs).symbols
-    m = re.fullmatch(r"([A-Za-z]+)(?:_(\d+))?", name)
+    m = re.fullmatch(r"([A-Za-z]+)(?:_(\d+|[a-z]))?", name)  # m_2, and components such as c_x
     if not m or m.group(1) not in symbols:
         return name
     base, k = symbols[m.group(1)], m.group(2)
@@ -464,7 +466,7 @@ def atlas_figure(
     else:
         nrows = ncols = 1
     width = 7.5 if plan.facet is None else max(3.5, 2.6 * ncols + 0.9) + _LEGEND_WIDTH
-    title = _title(ds, plan, everything == stable, 70 if plan.facet is None else int(12 * (width - _LEGEND_WIDTH)))
+    title = _title(ds, plan, None if stable is None else everything == stable, everything.size, 70 if plan.facet is None else int(12 * (width - _LEGEND_WIDTH)))
     lines = title.count("\n") + 1
     if plan.facet is None:
         size = (width, 5.2) if plan.y else (width, max(1.4 + 0.17 * lines, 0.22 * (len(present) + 4)) + 0.6)
@@ -498,8 +500,11 @@ def atlas_figure(
             parts = [_value_text(ds, plan.facet, float(ds[plan.facet][c]))]
             if plan.row is not None:
                 parts.append(_value_text(ds, plan.row, float(ds[plan.row][r])))
-            parts.append(f"{100 * float(np.mean(values == stable)):.0f} % stable")
-            ax.set_title("\n".join([", ".join(parts[:-1]), parts[-1]]) if plan.row is not None else f"{parts[0]}  ({parts[1]})", fontsize=9)
+            if stable is not None:
+                parts.append(f"{100 * float(np.mean(values == stable)):.0f} % stable")
+                ax.set_title("\n".join([", ".join(parts[:-1]), parts[-1]]) if plan.row is not None else f"{parts[0]}  ({parts[1]})", fontsize=9)
+            else:  # a system without stability: the panel's coordinates only
+                ax.set_title("\n".join(parts), fontsize=9)
 
     first = axes[0]
     if _log_axis(ds, plan.x):
@@ -555,12 +560,15 @@ def atlas_figure(
     return fig
 
 
-def _title(ds: xr.Dataset, plan: FigurePlan, stable: np.ndarray, chars: int) -> str:
-    """The atlas title, the stable fraction of the points shown (``stable``: a mask of them), the fixed axes,
-    the panels and the notes."""
+def _title(ds: xr.Dataset, plan: FigurePlan, stable: np.ndarray | None, points: int, chars: int) -> str:
+    """The atlas title, the stable fraction of the ``points`` shown (``stable``: a mask of them; None for a
+    system without stability), the fixed axes, the panels and the notes."""
     title = [textwrap.fill(ds.attrs.get("title", "") or "stabmap atlas", chars)]
     part = plan.facet is not None or bool(plan.fixed)
-    title.append(f"{100 * float(np.mean(stable)):.1f} % of {'the ' if part else ''}{stable.size:,} grid points{' shown' if part else ''} stable")
+    if stable is not None:
+        title.append(f"{100 * float(np.mean(stable)):.1f} % of {'the ' if part else ''}{points:,} grid points{' shown' if part else ''} stable")
+    else:
+        title.append(f"{points:,} grid points{' shown' if part else ''}")
     if plan.fixed:
         fixed = []
         for k, (i, asked) in plan.fixed.items():

@@ -428,6 +428,8 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
         coords=coords,
     )
     n_lines = int(np.prod(shape)) if others else 1
+    # Only a stability boundary has a command that locates it more finely.
+    located = f" {CRITICAL_HINT.format(along=along)}." if systems.of_atlas(ds.attrs).stable_label is not None else ""
     out.attrs = {
         "title": ds.attrs.get("title", ""),
         "stabmap_query": "boundaries",
@@ -440,10 +442,11 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
         "along_grid_values": int(x.size),
         "selection": _selection_text(axes),
         "fixed_axes": _fixed_names(axes),
+        "located_by": located.strip(),
         "comment": (
             f"Each change of {lab} lies somewhere between boundary_lower and boundary_upper, two "
             f"neighbouring grid values of {along}; it is not located more finely. Changes hidden between two grid "
-            f"values with equal {lab} are not seen. {CRITICAL_HINT.format(along=along)}."
+            f"values with equal {lab} are not seen.{located}"
         ),
     }
     return out

@@ -196,7 +196,8 @@ def _boundaries_text(b: xr.Dataset, frame, limit: int) -> str:
     lines += _more(len(frame), limit)
     if star:
         lines.append("* not computed: inferred from the agreeing corners of its grid cell (docs/refine.md)")
-    lines.append(f"Each change lies between the two grid values, not at either; {CRITICAL_HINT.format(along=along)}.")
+    located = b.attrs.get("located_by", f"{CRITICAL_HINT.format(along=along)}.")
+    lines.append("Each change lies between the two grid values, not at either" + (f"; {located}" if located else "."))
     return "\n".join(lines)
 
 
@@ -235,6 +236,8 @@ def _smallest_text(s: xr.Dataset, frame, limit: int) -> str:
 
 
 def _plain(v):
+    if isinstance(v, np.ndarray):  # a variable with dimensions beyond the grid's (e.g. reactions per node)
+        return _plain(v.tolist())
     if isinstance(v, dict):
         return {str(k): _plain(x) for k, x in v.items()}
     if isinstance(v, (list, tuple)):

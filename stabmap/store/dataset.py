@@ -47,7 +47,9 @@ def atlas_dataset(system, scene, arrays: dict) -> xr.Dataset:
     """The atlas Dataset of ``scene`` from one array (numpy or dask) per declared variable, in grid shape."""
     dims = tuple(a.name for a in scene.grid)
     data = {v.name: (dims + v.dims, arrays[v.name], v.attrs()) for v in system.variables}
-    return xr.Dataset(data, coords=coordinates(system, scene), attrs=global_attrs(system, scene, "stabmap atlas"))
+    coords = coordinates(system, scene)
+    coords.update({d: (d, values, attrs) for d, (values, attrs) in system.dim_coords(scene).items()})
+    return xr.Dataset(data, coords=coords, attrs=global_attrs(system, scene, "stabmap atlas"))
 
 
 def empty_arrays(system, scene, shape: tuple[int, ...] | None = None) -> dict[str, np.ndarray]:

@@ -17,6 +17,7 @@ from .base import SceneBase, System
 SYSTEMS = {
     "gyroscopes": "stabmap.systems.gyroscopes",
     "closed": "stabmap.systems.closed",
+    "reactions": "stabmap.systems.reactions",
 }
 DEFAULT = "gyroscopes"  # scene files and atlases from before the ``system`` key
 

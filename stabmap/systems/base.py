@@ -131,6 +131,10 @@ class System:
         """Sizes of the dimensions of ``variables`` beyond the grid's."""
         return {}
 
+    def dim_coords(self, scene: SceneBase) -> dict[str, tuple[np.ndarray, dict]]:
+        """Coordinates of the dimensions beyond the grid's: ``{dim: (values, attrs)}`` (default: none)."""
+        return {}
+
     def fastest_axes(self, scene: SceneBase) -> tuple[int, ...]:
         """Grid axes that should vary fastest within a block (e.g. those that leave the expensive set-up alone)."""
         return ()
