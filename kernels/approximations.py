@@ -54,13 +54,22 @@ def eigenvalues(C, wr, wi, vdummy, z, degree, m):
 
 
 @kernel
+def _newton_step(z, m, body, E, nmodes, pws, F, dF):
+    """p~(z) / p~'(z) in floats (the trace formula); NaN where it is not finite."""
+    logq = pencil.float_matrices(z, body, E, nmodes, pws, F, dF)
+    t = elimination.trace_solve(F, dF, body.shape[0]) + logq - m * ball.recip(z)
+    if not (math.isfinite(t.real) and math.isfinite(t.imag)) or t == 0.0:
+        return complex(np.nan, np.nan)
+    return ball.recip(t)
+
+
+@kernel
 def aberth(z, d, m, sweeps, body, E, nmodes, pws, F, dF, done, tol):
     """Aberth-Ehrlich sweeps on p~ = det Phi prod (z + beta) / z^m; returns the n x n solves it took.
 
     Only the roots with ``done`` False move; one whose step fell below
     ``tol`` of itself is left alone after.
     """
-    n = body.shape[0]
     solves = 0
     for _ in range(sweeps):
         moved = False
@@ -69,12 +78,10 @@ def aberth(z, d, m, sweeps, body, E, nmodes, pws, F, dF, done, tol):
                 continue
             zi = z[i]
             solves += 1
-            logq = pencil.float_matrices(zi, body, E, nmodes, pws, F, dF)
-            t = elimination.trace_solve(F, dF, n) + logq - m * ball.recip(zi)
-            if not (math.isfinite(t.real) and math.isfinite(t.imag)) or t == 0.0:
+            ratio = _newton_step(zi, m, body, E, nmodes, pws, F, dF)
+            if not (math.isfinite(ratio.real) and math.isfinite(ratio.imag)):
                 done[i] = True
                 continue
-            ratio = ball.recip(t)
             s = 0.0j
             for j in range(d):
                 if j != i:
@@ -129,7 +136,6 @@ def aberth_nonreal(z, d, m, sweeps, body, E, nmodes, pws, F, dF, idx):
     on grid lines at degree 36-48: warm starts then decided 85-94 % of points
     instead of 43-51 %).  ``idx`` is int64 scratch of d entries.
     """
-    n = body.shape[0]
     nu, nl = 0, 0
     for i in range(d):
         if z[i].imag > UPPER * abs(z[i]):
@@ -151,12 +157,10 @@ def aberth_nonreal(z, d, m, sweeps, body, E, nmodes, pws, F, dF, idx):
                 continue
             zi = z[i]
             solves += 1
-            logq = pencil.float_matrices(zi, body, E, nmodes, pws, F, dF)
-            t = elimination.trace_solve(F, dF, n) + logq - m * ball.recip(zi)
-            if not (math.isfinite(t.real) and math.isfinite(t.imag)) or t == 0.0:
+            ratio = _newton_step(zi, m, body, E, nmodes, pws, F, dF)
+            if not (math.isfinite(ratio.real) and math.isfinite(ratio.imag)):
                 idx[a] = -1 - i
                 continue
-            ratio = ball.recip(t)
             s = 0.0j
             for j in range(d):
                 if j == i or (paired and z[j].imag < -UPPER * abs(z[j])):
