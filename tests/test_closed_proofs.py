@@ -254,15 +254,18 @@ def test_undecided_points_are_a_class_of_their_own_in_files_info_query_and_plot(
         k = int(undecided.sum())
     assert main(["info", str(out)]) == 0
     text = capsys.readouterr().out
-    assert f"undecided: {k}" in text and "decided by: ball arithmetic" in text
+    assert f"undecided (not proved): {k}" in text and f"undecided: {k}" in text and "decided by: ball arithmetic" in text
     assert main(["query", str(out), f"ratio={b!r}"]) == 0
     text = capsys.readouterr().out
-    assert "stability = undecided" in text and "(decided by undecided)" in text
+    assert "stability = undecided" in text and "(not proved: the class is undecided)" in text
     png = tmp_path / "s.png"
     assert main(["plot", str(out), "-o", str(png)]) == 0 and png.stat().st_size > 3000
-    from stabmap.read.plot import class_label
+    from stabmap.read.plot import class_label, colour
 
     assert class_label(-3, SYSTEM) == "undecided (not proved)"
+    assert colour(-3, 0, -2, -3) not in (colour(-1, 0, -2, -3), colour(-2, 0, -2, -3))  # not drawn as degenerate or absent
+    assert main(["query", str(out), "--fraction"]) == 0
+    assert f"{k} undecided (not proved)" in capsys.readouterr().out
 
 
 # ------------------------------------------------------------------------------------ no closed form: Krawczyk

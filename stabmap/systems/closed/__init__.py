@@ -41,6 +41,7 @@ class Closed(System):
     label_title = "equilibrium"
     stable_label = STABLE
     absent_label = ABSENT
+    undecided_label = UNDECIDED
     proves_labels = True  # every class is proved or flagged undecided (proofs.py, docs/closed.md)
     provenance = "decided_by"
     symbols = {"ratio": "h_2/h_1", "n": "n", "j": "j", "h": "h"}
@@ -77,10 +78,12 @@ class Closed(System):
         return {"body": scene.n_max, "loop": len(scene.fam.loops) or 1}
 
     def cost(self, scene: Scene) -> Cost:
-        # Measured on one core (numpy on batches, an SVD and an eigenvalue problem per point): 7-9 us a point
-        # for six bodies, 0.2 ms for twenty; the n x n SVD dominates.
+        # Measured on one core (scripts/bench_closed.py): a two-length family costs 0.1-0.15 ms a ratio, almost
+        # all of it the proof in ball arithmetic (proofs.py; points of one ratio share it); a ring 9 us a point
+        # for six bodies, 25 us for fifty (numpy on batches, an exact cyclotomic test per ratio).
         n = scene.n_max
-        return Cost(seconds=5e-6 + 2.5e-8 * n**3, bytes=8 * (6 + 2 * n))
+        seconds = 6e-6 + 4e-7 * n if scene.ring else 1.6e-4
+        return Cost(seconds=seconds, bytes=8 * (6 + 2 * n))
 
     def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         shape = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()
