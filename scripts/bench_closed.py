@@ -21,15 +21,15 @@ from stabmap.systems.closed import SYSTEM
 
 
 def _scenes(num: int) -> list[tuple[str, str]]:
-    side = max(2, int(round(num**0.5)))
+    side = max(2, round(num**0.5))
     return [
         ("figure-eight-6 ratio", f'family = "figure-eight-6"\n[grid]\nratio = {{ start = 3.0, stop = 12.0, num = {num} }}'),
         ("hinge ratio", f'family = "hinge"\n[grid]\nratio = {{ start = 0.2, stop = 2.6, num = {num} }}'),
         ("figure-eight-4 ratio", f'family = "figure-eight-4"\n[grid]\nratio = {{ start = 0.05, stop = 1.2, num = {num} }}'),
-        ("hinge ratio x c1sq", f'family = "hinge"\n[grid]\nratio = {{ start = 0.2, stop = 2.6, num = {side} }}\n'
-                               f'c1sq = {{ start = 0.5, stop = 4.0, num = {side} }}'),
-        ("ring n x ratio", f'family = "ring"\n[grid]\nn = {{ values = [5, 6, 7, 8, 9, 10] }}\n'
-                           f'ratio = {{ start = 0.5, stop = 2.0, num = {max(2, num // 6)} }}'),
+        ("hinge ratio x c1sq", (f'family = "hinge"\n[grid]\nratio = {{ start = 0.2, stop = 2.6, num = {side} }}\n'
+                                f'c1sq = {{ start = 0.5, stop = 4.0, num = {side} }}')),
+        ("ring n x ratio", (f'family = "ring"\n[grid]\nn = {{ values = [5, 6, 7, 8, 9, 10] }}\n'
+                            f'ratio = {{ start = 0.5, stop = 2.0, num = {max(2, num // 6)} }}')),
     ]
 
 

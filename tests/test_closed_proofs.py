@@ -348,3 +348,17 @@ def test_critical_says_proved_and_brackets_sqrt_2():
     assert "undecided: 0" in ds.attrs["critical_decided_by"]
     upper, outer = float(ds["ratio_stable_upper"].values.ravel()[0]), float(ds["ratio_stable_upper_outer"].values.ravel()[0])
     assert upper < math.sqrt(2) < outer and outer - upper <= 1e-10 * math.sqrt(2)
+
+
+def test_bench_closed_quick(capsys):
+    """scripts/bench_closed.py in quick mode, so it cannot rot (no timing is asserted)."""
+    import pathlib
+    import runpy
+
+    script = pathlib.Path(__file__).resolve().parents[1] / "scripts" / "bench_closed.py"
+    rows = runpy.run_path(str(script))["main"](["--quick"])
+    assert [r["block"] for r in rows][:2] == ["figure-eight-6 ratio", "hinge ratio"]
+    for r in rows:
+        assert r["us_per_point"] > 0 and sum(r["decided_by"].values()) == r["points"]
+        assert "undecided" not in r["decided_by"]
+    assert "| block | points |" in capsys.readouterr().out

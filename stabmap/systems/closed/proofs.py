@@ -1,4 +1,4 @@
-"""Proofs of the closed-chain labels (docs/closed.md, "What is proved"): every stability class is proved, or the
+"""Proofs of the closed-chain labels (docs/closed.md, section 5): every stability class is proved, or the
 point is flagged ``undecided``.
 
 A label says whether a family's equilibrium exists at the given lengths and, if it does, the index and nullity of
@@ -9,7 +9,7 @@ The parameters are taken at their exact binary values; a family's labels depend 
 - **Existence** is decided in exact rational arithmetic (python-flint ``fmpq``): figure-eight-4 exists iff
   h2 <= h1, figure-eight-6 iff (2 h1 + h2)^2 < 2 h2^2 (that is h1/h2 < (sqrt 2 - 1)/2; equality is irrational),
   the hinges iff h2 <= 2 h1, the ring of winding j iff sum h_k w^k = 0 for w = exp(2 pi i j/n), i.e. iff the
-  n-th... cyclotomic polynomial of w's order divides sum h_k x^k.  At equality a two-length family is folded onto
+  cyclotomic polynomial of w's order n/gcd(n, j) divides sum h_k x^k.  At equality a two-length family is folded onto
   a line (every axis parallel): an exact point whose closed form is rational.
 - **Index and nullity** of an unfolded family member come from the bordered (KKT) matrix
   K = [[H, A^T], [A, 0]], H the Hessian (units of c1^2/h), A the m = 2L + 1 rows of the closures and the
@@ -40,6 +40,7 @@ working precision is global, so every proof holds ``_LOCK`` while it sets it.
 
 from __future__ import annotations
 
+import itertools
 import math
 import threading
 from contextlib import contextmanager
@@ -47,7 +48,7 @@ from dataclasses import dataclass
 
 import flint
 import numpy as np
-from flint import arb, arb_mat, fmpq, fmpq_mat, fmpq_poly, fmpz_mat, fmpz_poly
+from flint import arb, arb_mat, fmpq, fmpq_mat, fmpq_poly, fmpz_poly
 
 # Values of the provenance flag ``decided_by`` (outputs.DECIDED_BY gives their meanings).
 BY_BALLS = 0  # existence exactly, index and nullity in ball arithmetic from the closed form
@@ -272,7 +273,7 @@ def exact_inertia(H, rows) -> tuple[int, int]:
 
 def _sign_changes(coeffs) -> int:
     signs = [1 if x > 0 else -1 for x in coeffs if x != 0]
-    return sum(1 for a, b in zip(signs, signs[1:]) if a != b)
+    return sum(1 for a, b in itertools.pairwise(signs) if a != b)
 
 
 # ------------------------------------------------------------------------------------------------------- families

@@ -52,7 +52,7 @@ class Equilibrium:
     decided_by : str
         How existence, index and nullity were proved: ``"ball_arithmetic"``, ``"exact_rational_arithmetic"``,
         ``"exact_structure"``, ``"interval_newton"``; or ``"undecided"``: nothing is proved and the stability
-        is ``"undecided"`` (docs/closed.md, "What is proved").
+        is ``"undecided"`` (docs/closed.md, section 5).
     """
 
     shape: str
