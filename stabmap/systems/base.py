@@ -87,7 +87,8 @@ class System:
         flags such points instead of guessing); summaries count them apart from the degenerate ones and figures
         draw them dark grey. None: the system has no such value.
     proves_labels : bool
-        True when every label is a proof (the texts of critical values say "proved"); False for a system that
+        True when every label is a proof, or carries ``undecided_label`` (the texts of critical values say
+        "proved"); False for a system that
         decides its labels in floating point with stated tolerances (they say "decided").
     provenance : str or None
         A flag variable saying how each point was decided. A system that allows adaptive

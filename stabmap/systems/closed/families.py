@@ -5,7 +5,8 @@ which of two lengths: ``pattern`` gives 1 for a body of length h1 and 2 for one 
 ``ratio`` = h2/h1.  ``closed_form`` evaluates the family at a batch of length vectors: the axis angles, the loop
 forces and where the family exists.  At the end of its range each two-length family folds onto a line (a
 collinear state, an equilibrium for every force along that line): that end point is reported as existing, and
-the constraints' lost rank makes it degenerate (``equations.inertia``).
+the constraints' lost rank makes it degenerate.  Everything here is floating point; ``proofs`` decides existence
+exactly and evaluates the same closed forms in ball and rational arithmetic.
 """
 
 from __future__ import annotations
