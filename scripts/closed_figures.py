@@ -22,7 +22,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 ROOT = Path(__file__).resolve().parents[1]
-COLOURS = {"stable": "#56B4E9", "unstable": "#E69F00", "degenerate": "#999999", "absent": "#FFFFFF"}
+COLOURS = {"stable": "#56B4E9", "unstable": "#E69F00", "degenerate": "#999999", "absent": "#FFFFFF", "undecided": "#707070"}
 SHAPES = (
     ("ring", [1.0] * 8, 1, "ring n = 8, j = 1"),
     ("ring", [1.0, 0.5] * 4, 3, "ring n = 8, j = 3, h2/h1 = 0.5"),
@@ -59,18 +59,22 @@ def shapes_figure(path: Path) -> None:
 
 def atlas_figure(path: Path) -> list[str]:
     lines = []
+    seen, decided = set(), {}
     fig, axes = plt.subplots(len(FAMILIES), 1, figsize=(9, 1.25 * len(FAMILIES) + 1.2), sharex=True, constrained_layout=True)
     for ax, (family, lo, hi) in zip(axes, FAMILIES):
         scene = stabmap.loads_scene(
             f'system = "closed"\nfamily = "{family}"\n[grid]\nratio = {{ start = {lo}, stop = {hi}, num = 600, scale = "log" }}\n'
         )
         ds = stabmap.compute_atlas(scene, progress=False)
+        for k, v in stabmap.summary(ds)["decided_by"].items():
+            decided[k] = decided.get(k, 0) + v
         crit = stabmap.critical(scene, "ratio", progress=False)
         r = ds["ratio"].values
         edges = np.sqrt(r[1:] * r[:-1])
         edges = np.concatenate([[r[0] ** 2 / edges[0]], edges, [r[-1] ** 2 / edges[-1]]])
         meanings = dict(zip(ds["stability"].attrs["flag_values"].tolist(), ds["stability"].attrs["flag_meanings"].split()))
         for i, v in enumerate(ds["stability"].values):
+            seen.add(meanings[int(v)])
             ax.axvspan(edges[i], edges[i + 1], color=COLOURS[meanings[int(v)]], lw=0)
         # U h / c1^2 = sum (1 - cos of the joint angles): the shape's bending, free of the paper's h = min h_k
         bending = ds["energy"].values * np.minimum(1.0, r) / float(ds["c1sq"])
@@ -87,8 +91,10 @@ def atlas_figure(path: Path) -> list[str]:
     axes[-1].set_xscale("log")
     axes[-1].set_xlim(0.05, 40)
     axes[-1].set_xlabel("length ratio h2/h1 of the family's pattern (log scale)")
-    handles = [plt.Rectangle((0, 0), 1, 1, fc=c, ec="#888888", lw=0.5) for c in COLOURS.values()]
-    fig.legend(handles, list(COLOURS), loc="outside lower center", ncol=4, fontsize=8, frameon=False)
+    shown = [k for k in COLOURS if k in seen or k != "undecided"]  # undecided only if a point is
+    handles = [plt.Rectangle((0, 0), 1, 1, fc=COLOURS[k], ec="#888888", lw=0.5) for k in shown]
+    fig.legend(handles, shown, loc="outside lower center", ncol=len(shown), fontsize=8, frameon=False)
+    lines.append("decided by: " + ", ".join(f"{k} {v}" for k, v in sorted(decided.items())))
     fig.suptitle("stability of each family along its length ratio (curve: bending energy U h / c1²);\n"
                  "dashed: class changes located by stabmap critical to 1e-10", fontsize=9)
     fig.savefig(path, dpi=130)

@@ -6,6 +6,8 @@
   second differences along curves that stay closed (Gauss-Newton back onto the closures).  The probe never
   uses the forces or a Hessian formula: its inertia is the index and nullity of U on the constraint manifold.
 - ``newton``: Newton's method on the general equations (mpmath), from any start.
+- ``hessian``, ``hessian_inertia``: CLOSED.md's Hessian formula on the same tangent basis, at any precision (the
+  probe's second differences cannot resolve eigenvalues much below its step; this can, at enough digits).
 """
 
 from __future__ import annotations
@@ -197,3 +199,39 @@ def newton(theta, forces, lengths, loops, c1sq=1, h=None, steps: int = 40):
     x = mp.findroot(F, x0, tol=mp.mpf(10) ** (-30), maxsteps=steps)
     x = [x[i] for i in range(len(x0))]
     return [t1] + x[: n - 1], [(x[n - 1 + 2 * i], x[n + 2 * i]) for i in range(nl)]
+
+
+def hessian(theta, lengths, forces, loops, c1sq=1, h=None):
+    """CLOSED.md's Hessian of U - sum R . closure: (c1^2/h) (cyclic Laplacian with weights cos(theta_k -
+    theta_(k-1))) + diag(h_k (R_z cos theta_k - R_y sin theta_k)), each body with its loop's force."""
+    n = len(theta)
+    L = [mp.mpf(x) for x in lengths]
+    h = min(L) if h is None else mp.mpf(h)
+    scale = mp.mpf(c1sq) / h
+    loop_of = {k: i for i, loop in enumerate(loops) for k in loop}
+    H = mp.matrix(n, n)
+    for k in range(n):
+        i = (k - 1) % n
+        w = mp.cos(theta[k] - theta[i])  # joint k: bodies k - 1 and k
+        H[k, k] += scale * w
+        H[i, i] += scale * w
+        H[k, i] -= scale * w
+        H[i, k] -= scale * w
+        Ry, Rz = forces[loop_of[k]]
+        H[k, k] += L[k] * (Rz * mp.cos(theta[k]) - Ry * mp.sin(theta[k]))
+    return H
+
+
+def hessian_inertia(theta, lengths, forces, loops, tol):
+    """(index, nullity, the eigenvalues) of the Hessian on the closures' tangent space modulo rotation
+    (``tangent_basis``); an eigenvalue counts as zero when |ev| <= tol.  Use far more digits than tol needs."""
+    basis = tangent_basis(theta, lengths, loops)
+    d = len(basis)
+    if d == 0:
+        return 0, 0, []
+    H = hessian(theta, lengths, forces, loops)
+    B = mp.matrix([[basis[i][k] for i in range(d)] for k in range(len(theta))])
+    ev = mp.eigsy(B.T * H * B, eigvals_only=True)
+    ev = [ev[i] for i in range(d)]
+    tol = mp.mpf(tol)
+    return sum(1 for e in ev if e < -tol), sum(1 for e in ev if abs(e) <= tol), ev

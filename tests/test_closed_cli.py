@@ -15,6 +15,7 @@ import stabmap
 from stabmap import closed
 from stabmap.cli import main
 from stabmap.errors import StabmapError
+from stabmap.systems.closed import SYSTEM
 
 HINGE = """system = "closed"
 title = "hinge against its length ratio"
@@ -47,7 +48,10 @@ def test_atlas_file_holds_every_variable_with_cf_metadata_and_the_scene(hinge_at
         assert stabmap.loads_scene(ds.attrs["scene"]) == stabmap.loads_scene(HINGE)
         assert ds["ratio"].attrs["units"] == "1" and "ratio" in ds["ratio"].attrs["long_name"]
         st = ds["stability"]
-        assert st.attrs["flag_meanings"] == "absent degenerate stable unstable" and list(st.attrs["flag_values"]) == [-2, -1, 0, 1]
+        assert st.attrs["flag_meanings"] == "undecided absent degenerate stable unstable" and list(st.attrs["flag_values"]) == [-3, -2, -1, 0, 1]
+        by = ds["decided_by"]  # every point proved: the ratio's ball arithmetic, or exactly (absent, folded)
+        assert set(np.unique(by.values)) == {0, 1} and by.attrs["flag_meanings"].split()[:2] == ["ball_arithmetic", "exact_rational_arithmetic"]
+        assert ((by.values == 1) == (ds["ratio"].values >= 2.0)).all()
         assert ds["theta"].dims == ("ratio", "body") and ds["force_y"].dims == ("ratio", "loop") and ds.sizes["loop"] == 2
         assert ds["force_y"].attrs["units"] == "N" and ds["energy"].attrs["units"] == "J" and ds["theta"].attrs["units"] == "rad"
         assert float(ds["c1sq"]) == 2.0
@@ -56,6 +60,7 @@ def test_atlas_file_holds_every_variable_with_cf_metadata_and_the_scene(hinge_at
             eq = closed.solve("hinge", [1, 1, r, 1, 1, r], c1sq=2.0)
             p = ds.sel(ratio=r)
             assert bool(p["exists"]) == eq.exists and int(p["stability"]) == {"stable": 0, "unstable": 1, "degenerate": -1, "absent": -2}[eq.stability]
+            assert SYSTEM.variable("decided_by").meaning(int(p["decided_by"])) == eq.decided_by
             if eq.exists:
                 np.testing.assert_allclose(p["theta"].values, eq.theta, atol=0)
                 np.testing.assert_allclose(p["force_y"].values, eq.forces[:, 0], atol=0)
@@ -74,9 +79,10 @@ def test_info_query_plot_on_a_closed_atlas(hinge_atlas, tmp_path, capsys):
     text = capsys.readouterr().out
     assert "family hinge" in text and "S1 S5 S6; S2 S3 S4" in text
     assert f"absent: {absent}," in text and f"stable: {stable}," in text and f"unstable: {unstable}" in text
+    assert f"decided by: ball arithmetic {r.size - folded - absent}, exact rational arithmetic {folded + absent}" in text
     assert main(["query", str(hinge_atlas), "ratio=1.2"]) == 0
     text = capsys.readouterr().out
-    assert "stability = stable" in text and "force_y = [" in text
+    assert "stability = stable" in text and "force_y = [" in text and "(decided by ball arithmetic)" in text
     assert main(["query", str(hinge_atlas), "--fraction", "--json"]) == 0
     f = json.loads(capsys.readouterr().out)
     assert (f["stable"], f["unstable"], f["degenerate"], f["absent"], f["points"]) == (stable, unstable, folded, absent, r.size)

@@ -257,15 +257,16 @@ def test_critical_locates_existence_and_stability_boundaries_to_1e_10(name, fami
     expected = [float(BOUNDARIES[k][1]()) for k in BOUNDARIES if BOUNDARIES[k][0] == family]
     assert len(expected) == 2
     for b in expected:
-        # The brackets at one boundary: one, or two around the few points within the Hessian's zero tolerance
-        # that are called degenerate.  Together they hold the reference value and span at most 1e-10 of it.
+        # The brackets at one boundary: one (two if a point on it were degenerate or undecided).  Together they
+        # hold the reference value and span at most 1e-10 of it.
         near = np.abs(lower - b) < 1e-6 * b
         assert near.any(), (b, lower, upper)
         lo, hi = lower[near].min(), upper[near].max()
         assert lo <= b <= hi and hi - lo <= 1e-10 * b, (b, lo, hi)
     # ... and nothing else changes along the scan
     assert (np.abs(lower[:, None] - np.array(expected)) < 1e-6 * np.array(expected)).any(axis=1).all()
-    assert "decided" in ds.attrs["comment"] and "proved" not in ds["ratio_stable_lower"].attrs["comment"]
+    assert "is proved" in ds.attrs["comment"] and "proved" in ds["ratio_stable_lower"].attrs["comment"]
+    assert "undecided: 0" in ds.attrs["critical_decided_by"]
 
 
 # ---------------------------------------------------------------------------------------------------- bad input

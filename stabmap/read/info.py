@@ -34,7 +34,8 @@ def describe(ds: xr.Dataset, name: str = "") -> str:
     if system.stable_label is not None:
         degenerate = f", degenerate: {s['degenerate']}" if s["degenerate"] else ""
         absent = f", absent: {s['absent']}" if s["absent"] else ""
-        lines.append(f"  points: {s['points']}, stable: {s['stable']} ({100 * s['stable_fraction']:.2f} %)" + degenerate + absent)
+        undecided = f", undecided (not proved): {s['undecided']}" if s["undecided"] else ""
+        lines.append(f"  points: {s['points']}, stable: {s['stable']} ({100 * s['stable_fraction']:.2f} %)" + degenerate + absent + undecided)
     else:
         lines.append(f"  points: {s['points']}")
     flags = system.variable(system.label).flags

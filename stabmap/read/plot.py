@@ -10,7 +10,7 @@ boundaries between classes.
   ``sel`` (nearest grid value).
 - Classes are coloured from the Okabe-Ito palette (stable: sky blue; 1, 2, 3 ... complex pairs: yellow, orange,
   vermillion, ...); each class always has the same colour. Degenerate points (p identically zero) are grey and
-  cross-hatched; points of an adaptive atlas that were inferred from their cell's corners (``decided_by`` = 3)
+  cross-hatched, points whose class was not proved (``System.undecided_label``) dark grey and cross-hatched; points of an adaptive atlas that were inferred from their cell's corners (``decided_by`` = 3)
   carry a light diagonal hatch (a light veil in very large adaptive atlases).
 - Boundaries are drawn on grid-cell edges, between every two neighbouring points whose N_c differ: thick where
   one side is stable and the other not, thin where only the number of pairs changes. A line is drawn only where
@@ -43,6 +43,7 @@ _STABLE = "#56B4E9"
 _UNSTABLE = ["#F0E442", "#E69F00", "#D55E00", "#CC79A7", "#882255", "#332288", "#117733", "#44AA99", "#999933", "#AA4499"]
 _DEGENERATE = "#BBBBBB"
 _ABSENT = "#FFFFFF"  # nothing to decide (System.absent_label): left blank
+_UNDECIDED = "#707070"  # not proved (System.undecided_label): darker than degenerate, hatched like it
 _BOUNDARY = "#000000"
 _CLASS_EDGE = "#333333"
 _HATCH_INFERRED = "////"
@@ -52,11 +53,13 @@ _VECTOR_RUNS = 20_000  # a panel with more runs of equal cells along x is filled
 
 
 
-def colour(value: int, stable: int | None = 0, absent: int | None = None) -> str:
-    """The colour of the label ``value`` (``absent``: white; other negatives: degenerate; ``stable``: the stable
-    class) in every figure."""
+def colour(value: int, stable: int | None = 0, absent: int | None = None, undecided: int | None = None) -> str:
+    """The colour of the label ``value`` (``absent``: white; ``undecided``: dark grey; other negatives: degenerate;
+    ``stable``: the stable class) in every figure."""
     if absent is not None and value == absent:
         return _ABSENT
+    if undecided is not None and value == undecided:
+        return _UNDECIDED
     if value < 0:
         return _DEGENERATE
     if stable is None:  # classes without a stable one (e.g. the critical node): one palette, blue first
@@ -282,7 +285,8 @@ def _rectangles(mask: np.ndarray, xe: np.ndarray, ye: np.ndarray) -> list[np.nda
     return [np.array([[xe[a], ye[j0]], [xe[b], ye[j0]], [xe[b], ye[j1]], [xe[a], ye[j1]]]) for a, b, j0, j1 in done]
 
 
-def _fill(ax, values: np.ndarray, xe: np.ndarray, ye: np.ndarray, cmap, norm, stable: int | None, absent: int | None = None) -> None:
+def _fill(ax, values: np.ndarray, xe: np.ndarray, ye: np.ndarray, cmap, norm, stable: int | None, absent: int | None = None,
+          undecided: int | None = None) -> None:
     """Colour the cells: one vector rectangle per block of equal cells, or an image when the map is too busy.
 
     Rectangles are outlined in their own colour, so no hairline seams show between them in a PDF viewer.
@@ -295,7 +299,7 @@ def _fill(ax, values: np.ndarray, xe: np.ndarray, ye: np.ndarray, cmap, norm, st
         ax.pcolormesh(xe, ye, values, cmap=cmap, norm=norm, shading="flat", rasterized=True)
         return
     for v in np.unique(values):
-        c = colour(int(v), stable, absent)
+        c = colour(int(v), stable, absent, undecided)
         cells = PolyCollection(_rectangles(values == v, xe, ye), facecolors=c, edgecolors=c, linewidths=0.3, antialiaseds=False, zorder=1)
         cells.set_gid(f"cells-{int(v)}")
         ax.add_collection(cells, autolim=False)
@@ -449,8 +453,8 @@ def atlas_figure(
     present = sorted(int(v) for v in np.unique(everything))
     top = max(1, present[-1])
     bottom = min(-1, present[0])
-    stable, absent = system.stable_label, system.absent_label
-    cmap = ListedColormap([colour(v, stable, absent) for v in range(bottom, top + 1)])
+    stable, absent, undecided = system.stable_label, system.absent_label, system.undecided_label
+    cmap = ListedColormap([colour(v, stable, absent, undecided) for v in range(bottom, top + 1)])
     norm = BoundaryNorm(np.arange(bottom - 0.5, top + 1.5), cmap.N)
 
     xs = np.asarray(ds[plan.x], dtype=float)
@@ -484,7 +488,7 @@ def atlas_figure(
 
     drawn = {"stability": False, "classes": False, "inferred": False, "light": False}
     for ax, values, inf, (r, c) in zip(axes, data, inferred, panels):
-        _fill(ax, values, xe, ye, cmap, norm, stable, absent)
+        _fill(ax, values, xe, ye, cmap, norm, stable, absent, undecided)
         for mask, gid in ((inf, "inferred-cells"), ((values < 0) & (values != absent), "degenerate-cells")):
             if mask is not None and mask.any():
                 drawn["inferred"] |= gid == "inferred-cells"
@@ -538,7 +542,7 @@ def atlas_figure(
     for v in present:
         hatch = _HATCH_DEGENERATE if v < 0 and v != absent else None
         edge = "#888888" if v == absent else "none"  # a white patch needs an outline to be seen
-        handles.append(Patch(facecolor=colour(v, stable, absent), edgecolor=edge, lw=0.5, hatch=hatch, label=class_label(v, system)))
+        handles.append(Patch(facecolor=colour(v, stable, absent, undecided), edgecolor=edge, lw=0.5, hatch=hatch, label=class_label(v, system)))
     if drawn["stability"]:
         handles.append(Line2D([], [], color=_BOUNDARY, lw=1.5, label="stability boundary"))
     if drawn["classes"]:

@@ -107,11 +107,12 @@ class StableFraction:
     stable: int  # N_c = 0
     points: int  # grid points in the slice
     unstable: int  # N_c > 0
-    degenerate: int  # N_c = -1 (p identically zero); a negative label other than the system's absent_label
+    degenerate: int  # N_c = -1 (p identically zero); a negative label other than the system's absent/undecided_label
     inferred: int  # points not computed (decided_by = inferred_from_cell_corners), stable or not
     inferred_stable: int  # of those, how many carry the label stable
     axes: dict[str, AxisSelection]  # every grid axis of the atlas, in order
     absent: int | None = None  # points with nothing to decide (the system's absent_label); None: the system has none
+    undecided: int | None = None  # points whose class was not proved (the system's undecided_label); None: it has none
 
     @property
     def selected(self) -> dict[str, float | tuple[float, float]]:
@@ -320,11 +321,12 @@ def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
         stable=int(stable.sum()),
         points=int(nc.size),
         unstable=int((~stable & (nc >= 0)).sum()),
-        degenerate=int(((nc < 0) & (nc != system.absent_label)).sum()),
+        degenerate=int(((nc < 0) & (nc != system.absent_label) & (nc != system.undecided_label)).sum()),
         inferred=int(inferred.sum()),
         inferred_stable=int((inferred & stable).sum()),
         axes=axes,
         absent=int((nc == system.absent_label).sum()) if system.absent_label is not None else None,
+        undecided=int((nc == system.undecided_label).sum()) if system.undecided_label is not None else None,
     )
 
 

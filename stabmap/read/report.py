@@ -60,6 +60,8 @@ def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
         lines[-1] += (
             " (not computed: inferred from the agreeing corners of its grid cell; docs/refine.md)"
             if label.inferred
+            else " (not proved: the class is undecided)"
+            if how == "undecided"
             else f" (decided by {how.replace('_', ' ')})"
         )
     return "\n".join(lines)
@@ -88,6 +90,7 @@ def _fraction_text(f: StableFraction) -> str:
     lines = [
         f"stable fraction {f.fraction:.6g}: {f.stable} of {f.points} grid points stable ({100 * f.fraction:.2f} %), "
         f"{f.unstable} unstable" + (f", {f.degenerate} degenerate" if f.degenerate else "") + (f", {f.absent} absent" if f.absent else "")
+        + (f", {f.undecided} undecided (not proved)" if f.undecided else "")
     ]
     lines += [f"  {a.describe()}" for a in f.axes.values()]
     if f.inferred:
@@ -104,6 +107,8 @@ def _fraction_record(f: StableFraction) -> dict:
     row = {k: getattr(f, k) for k in ("fraction", "stable", "points", "unstable", "degenerate", "inferred", "inferred_stable")}
     if f.absent is not None:
         row["absent"] = f.absent
+    if f.undecided is not None:
+        row["undecided"] = f.undecided
     for name, a in f.axes.items():
         row[f"{name}_lo"], row[f"{name}_hi"] = a.bounds
         row[f"{name}_n"] = len(a.values)

@@ -24,8 +24,9 @@ def _counts(values) -> dict[int, int]:
 def summary(ds: xr.Dataset) -> dict:
     """Points, the stable fraction, a histogram of the label and of who decided.
 
-    Keys: ``points``, ``stable``, ``degenerate`` (label < 0, but for ``absent``), ``absent`` (the system's
-    ``absent_label``: nothing to decide there), ``stable_fraction``, the label's name (a
+    Keys: ``points``, ``stable``, ``degenerate`` (label < 0, but for ``absent`` and ``undecided``), ``absent`` (the
+    system's ``absent_label``: nothing to decide there), ``undecided`` (its ``undecided_label``: not proved),
+    ``stable_fraction``, the label's name (a
     histogram, e.g. ``n_complex_pairs``) and the provenance variable's name (counts by flag meaning, e.g.
     ``decided_by``).
     """
@@ -36,8 +37,9 @@ def summary(ds: xr.Dataset) -> dict:
     out = {
         "points": points,
         "stable": stable,
-        "degenerate": sum(c for v, c in label.items() if v < 0 and v != system.absent_label),
+        "degenerate": sum(c for v, c in label.items() if v < 0 and v not in (system.absent_label, system.undecided_label)),
         "absent": label.get(system.absent_label, 0) if system.absent_label is not None else 0,
+        "undecided": label.get(system.undecided_label, 0) if system.undecided_label is not None else 0,
         "stable_fraction": stable / points if points else float("nan"),
         system.label: dict(sorted(label.items())),
     }

@@ -82,8 +82,13 @@ class System:
         The (negative) label value of a point where there is nothing to decide, e.g. a family of equilibria
         that does not exist there; summaries count such points apart from the degenerate ones and figures
         leave them white. None: every point has something to decide.
+    undecided_label : int or None
+        The (negative) label value of a point whose class was not proved (a system that proves its labels
+        flags such points instead of guessing); summaries count them apart from the degenerate ones and figures
+        draw them dark grey. None: the system has no such value.
     proves_labels : bool
-        True when every label is a proof (the texts of critical values say "proved"); False for a system that
+        True when every label is a proof, or carries ``undecided_label`` (the texts of critical values say
+        "proved"); False for a system that
         decides its labels in floating point with stated tolerances (they say "decided").
     provenance : str or None
         A flag variable saying how each point was decided. A system that allows adaptive
@@ -101,6 +106,7 @@ class System:
     label_title: str
     stable_label: int | None = None
     absent_label: int | None = None
+    undecided_label: int | None = None
     proves_labels: bool = True
     provenance: str | None = None
     symbols: dict[str, str] = {}

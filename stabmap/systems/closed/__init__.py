@@ -5,7 +5,8 @@ The pipeline's part of this system is the ``System`` below; the physics is in th
 
 - ``families``: the named families (ring, figure-eights, hinges) and their closed forms;
 - ``equations``: the general equilibrium equations, energy, constrained Hessian, rotation index;
-- ``decide``: a batch of configurations -> every output (shared by atlases and ``solve``);
+- ``proofs``: the proof of every label (exact rational and ball arithmetic, python-flint), or the flag undecided;
+- ``decide``: a batch of configurations and their proofs -> every output (shared by atlases and ``solve``);
 - ``solve`` and ``search``: the Python API (``stabmap.closed``);
 - ``checks``, ``scene``: what an input must satisfy, and the scene files;
 - ``outputs``: the variables written.
@@ -16,8 +17,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..base import Cost, System
+from . import proofs
 from . import scene as _scene
-from .decide import ABSENT, DEGENERATE, STABLE, decide
+from .decide import ABSENT, DEGENERATE, STABLE, UNDECIDED, decide
 from .equations import joint_angles
 from .families import FAMILIES
 from .outputs import STABILITY, VARIABLES
@@ -39,8 +41,9 @@ class Closed(System):
     label_title = "equilibrium"
     stable_label = STABLE
     absent_label = ABSENT
-    proves_labels = False  # floating point with the tolerances of equations.py, every point's residual stored
-    provenance = None
+    undecided_label = UNDECIDED
+    proves_labels = True  # every class is proved or flagged undecided (proofs.py, docs/closed.md)
+    provenance = "decided_by"
     symbols = {"ratio": "h_2/h_1", "n": "n", "j": "j", "h": "h"}
 
     def scene_from_dict(self, table, base_dir=None) -> Scene:
@@ -75,10 +78,12 @@ class Closed(System):
         return {"body": scene.n_max, "loop": len(scene.fam.loops) or 1}
 
     def cost(self, scene: Scene) -> Cost:
-        # Measured on one core (numpy on batches, an SVD and an eigenvalue problem per point): 7-9 us a point
-        # for six bodies, 0.2 ms for twenty; the n x n SVD dominates.
+        # Measured on one core (scripts/bench_closed.py): a two-length family costs 0.1-0.15 ms a ratio, almost
+        # all of it the proof in ball arithmetic (proofs.py; points of one ratio share it); a ring 9 us a point
+        # for six bodies, 25 us for fifty (numpy on batches, an exact cyclotomic test per ratio).
         n = scene.n_max
-        return Cost(seconds=5e-6 + 2.5e-8 * n**3, bytes=8 * (6 + 2 * n))
+        seconds = 6e-6 + 4e-7 * n if scene.ring else 1.6e-4
+        return Cost(seconds=seconds, bytes=8 * (6 + 2 * n))
 
     def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         shape = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()
@@ -98,9 +103,16 @@ class Closed(System):
                 lengths = fam.lengths(p["h1"][pts], p["ratio"][pts], n)
             c1sq = p["c1sq"][pts]
             h = p["h"][pts] if "h" in p else lengths.min(-1)
-            theta, forces, exists = fam.closed_form(lengths, c1sq, h, j)
-            d = decide(theta, forces, exists, lengths, fam.loop_of(n), c1sq, h)
+            loop_of = fam.loop_of(n)
+            if scene.lengths:  # one proof for the scene's lengths (c1^2 and h leave the labels alone)
+                guess = _guess(fam, lengths[:1], c1sq[:1], h[:1], j)
+                verdicts = proofs.Verdicts.of([proofs.prove_lengths(fam, j, scene.lengths, guess)] * pts.size)
+            else:  # the labels depend on the exact ratio h2/h1 only: one proof per ratio
+                verdicts = proofs.prove_ratios(fam, n, j, p["ratio"][pts])
+            theta, forces, _ = fam.closed_form(lengths, c1sq, h, j, exists=verdicts.exists != 0)
+            d = decide(theta, forces, verdicts, lengths, loop_of, c1sq, h)
             out["stability"][pts] = d.stability
+            out["decided_by"][pts] = d.decided_by
             out["exists"][pts] = d.exists
             out["index"][pts] = d.index
             out["nullity"][pts] = d.nullity
@@ -114,7 +126,18 @@ class Closed(System):
         return {k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}
 
     def class_name(self, value: int) -> str:
-        return {ABSENT: "absent (no equilibrium)", DEGENERATE: "degenerate (nullity > 0)"}.get(value) or STABILITY.meaning(value)
+        names = {ABSENT: "absent (no equilibrium)", DEGENERATE: "degenerate (nullity > 0)", UNDECIDED: "undecided (not proved)"}
+        return names.get(value) or STABILITY.meaning(value)
+
+
+def _guess(fam, lengths, c1sq, h, j):
+    """(theta, rho = R h / c1^2) of the floating-point closed form at one length vector, for ``proofs``."""
+
+    def guess():
+        theta, forces, _ = fam.closed_form(lengths, c1sq, h, j, exists=[True])
+        return theta[0], forces[0] * (h[0] / c1sq[0])
+
+    return guess
 
 
 SYSTEM = Closed()

@@ -1,8 +1,10 @@
 """Everything an atlas point or a ``solve`` call reports about a configuration: one function for both.
 
-``decide`` takes a batch of configurations of one family (same n, same loops) and returns the outputs as plain
-arrays: existence, angles, forces, energy, the residual of the general equations, index and nullity of the
-constrained Hessian, the stability class and the rotation index.  Absent points get NaN and fill values.
+``decide`` takes a batch of configurations of one family (same n, same loops) with their verdicts (``proofs``:
+existence, index and nullity, and how they were proved) and returns the outputs as plain arrays: existence,
+angles, forces, energy, the residual of the general equations, index and nullity, the stability class and the
+rotation index.  The class comes from the verdicts alone; the angles, forces, energy, residual and rotation
+index are floating-point values of the closed form.  Absent points get NaN and fill values.
 """
 
 from __future__ import annotations
@@ -12,10 +14,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import equations
+from .proofs import UNDECIDED as BY_NONE
+from .proofs import Verdicts
 
 # Values of the stability class (the atlases' label): negative values are "no class" in every figure.
-STABLE, UNSTABLE, DEGENERATE, ABSENT = 0, 1, -1, -2
-NO_COUNT = -1  # index and nullity where nothing exists
+STABLE, UNSTABLE, DEGENERATE, ABSENT, UNDECIDED = 0, 1, -1, -2, -3
+NO_COUNT = -1  # index and nullity where nothing exists or nothing is proved
 NO_TURNS = -128  # rotation index where nothing exists or a joint is folded back
 
 
@@ -23,45 +27,56 @@ NO_TURNS = -128  # rotation index where nothing exists or a joint is folded back
 class Decided:
     """Per-point outputs of a batch of P configurations of n bodies and L loops."""
 
-    exists: np.ndarray  # (P,) bool
+    exists: np.ndarray  # (P,) int8: 1 exists, 0 absent, -1 undecided
     theta: np.ndarray  # (P, n) [rad]
     forces: np.ndarray  # (P, L, 2) [N], (R_y, R_z)
     energy: np.ndarray  # (P,) [J]
     residual: np.ndarray  # (P,) scaled
     index: np.ndarray  # (P,) int16
     nullity: np.ndarray  # (P,) int16
-    stability: np.ndarray  # (P,) int8: STABLE, UNSTABLE, DEGENERATE, ABSENT
+    stability: np.ndarray  # (P,) int8: STABLE, UNSTABLE, DEGENERATE, ABSENT, UNDECIDED
     rotation_index: np.ndarray  # (P,) int8
-    eigenvalues: np.ndarray  # (P, d): reduced Hessian in units of c1^2/h, NaN pads
+    decided_by: np.ndarray  # (P,) int8: proofs.BY_*
+    eigenvalues: np.ndarray  # (P, d): reduced Hessian in units of c1^2/h (floating point), NaN pads
 
 
-def stability_class(exists: np.ndarray, index: np.ndarray, nullity: np.ndarray) -> np.ndarray:
-    """stable only where the index and the nullity are both 0; any nullity is degenerate, whatever the index."""
+def stability_class(exists: np.ndarray, index: np.ndarray, nullity: np.ndarray, decided_by: np.ndarray) -> np.ndarray:
+    """stable only where the index and the nullity are both 0; any nullity is degenerate, whatever the index;
+    undecided wherever the verdict is not a proof."""
     out = np.where(nullity > 0, DEGENERATE, np.where(index > 0, UNSTABLE, STABLE))
-    return np.where(exists, out, ABSENT).astype(np.int8)
+    out = np.where(exists == 1, out, ABSENT)
+    return np.where(decided_by == BY_NONE, UNDECIDED, out).astype(np.int8)
 
 
-def decide(theta, forces, exists, lengths, loop_of, c1sq, h) -> Decided:
-    """The outputs at configurations ``theta`` (P, n) with loop ``forces`` (P, L, 2) where ``exists`` (P,)."""
+def decide(theta, forces, verdicts: Verdicts, lengths, loop_of, c1sq, h, eigenvalues: bool = False) -> Decided:
+    """The outputs at configurations ``theta`` (P, n) with loop ``forces`` (P, L, 2) and their ``verdicts``.
+
+    The floating-point values are kept wherever an equilibrium exists or its existence is undecided; with
+    ``eigenvalues`` the reduced Hessian's eigenvalues are computed too (floating point, for information).
+    """
     theta = np.asarray(theta, dtype=float)
     lengths = np.asarray(lengths, dtype=float)
     P, n = theta.shape
     c1sq = np.broadcast_to(np.asarray(c1sq, dtype=float), (P,))
     h = np.broadcast_to(np.asarray(h, dtype=float), (P,))
-    exists = np.asarray(exists, dtype=bool)
+    exists = np.asarray(verdicts.exists, dtype=np.int8)
     energy = np.full(P, np.nan)
     residual = np.full(P, np.nan)
-    index = np.full(P, NO_COUNT, dtype=np.int16)
-    nullity = np.full(P, NO_COUNT, dtype=np.int16)
     turns = np.full(P, NO_TURNS, dtype=np.int8)
     eig = np.full((P, n - 1), np.nan)  # at most n - 1 tangent directions (the rotation is always out)
-    at = np.flatnonzero(exists)
+    at = np.flatnonzero(exists != 0)
+    theta = np.where((exists != 0)[:, None], theta, np.nan)
+    forces = np.where((exists != 0)[:, None, None], forces, np.nan)
     if at.size:
         args = (theta[at], lengths[at], forces[at], loop_of, c1sq[at], h[at])
         energy[at] = equations.energy(theta[at], c1sq[at], h[at])
         residual[at] = equations.residuals(*args)
-        inertia = equations.inertia(*args)
-        index[at], nullity[at] = inertia.index, inertia.nullity
-        eig[at, : inertia.eigenvalues.shape[1]] = inertia.eigenvalues
         turns[at] = equations.rotation_index(theta[at])
-    return Decided(exists, theta, forces, energy, residual, index, nullity, stability_class(exists, index, nullity), turns, eig)
+        if eigenvalues:
+            ev = equations.inertia(*args).eigenvalues
+            eig[at, : ev.shape[1]] = ev
+    index = np.where(exists == 1, verdicts.index, NO_COUNT).astype(np.int16)
+    nullity = np.where(exists == 1, verdicts.nullity, NO_COUNT).astype(np.int16)
+    stability = stability_class(exists, index, nullity, verdicts.decided_by)
+    return Decided(exists, theta, forces, energy, residual, index, nullity, stability, turns,
+                   np.asarray(verdicts.decided_by, dtype=np.int8), eig)

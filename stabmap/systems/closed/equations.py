@@ -12,7 +12,7 @@ k-1 and k), the constraints are the closures sum_{k in loop} h_k e_k = 0, and th
 multipliers: the equilibrium equations (22) and (24) of the paper (docs/closed.md) are the stationarity
 conditions of U - sum_loops R . (closure).  Stability in the plane is a strict minimum of U on closed
 configurations, decided by the Hessian of that Lagrangian on the tangent space of the constraints modulo the
-rotation of the whole chain.
+rotation of the whole chain (proved in ``proofs``; everything here is floating point).
 """
 
 from __future__ import annotations
@@ -21,14 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+# The tolerances of ``inertia``, a floating-point estimate that labels nothing: the labels are proved in
+# ``proofs``; ``inertia`` gives the eigenvalues that ``solve`` reports for information.
 # Relative size below which a singular value of the (normalised) closure Jacobian counts as zero: the
-# constraints have lost rank (a loop folded onto a line).  A loop 1e-7 away from folding keeps a singular
-# value near sqrt(1e-7), far above it.
+# constraints have lost rank (a loop folded onto a line).
 RANK_TOL = 1e-10
-# Relative size below which an eigenvalue of the reduced Hessian (in units of c1^2/h) counts as zero.  Rounding
-# leaves about 1e-15; a configuration 1e-7 (relative) from a change of index keeps eigenvalues near 1e-7.  The
-# points called degenerate around a change of index form a band of width about 2 NULL_TOL / |d lambda/d ratio|,
-# far below the 1e-10 to which critical values locate a boundary.
+# Relative size below which an eigenvalue of the reduced Hessian (in units of c1^2/h) counts as zero.
 NULL_TOL = 1e-12
 
 
@@ -139,7 +137,8 @@ def tangent_basis(A: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
 
 
 def inertia(theta, lengths, forces, loop_of, c1sq, h) -> Inertia:
-    """Index (negative eigenvalues) and nullity (zero ones) of the Hessian on the closures' tangent space.
+    """Index (negative eigenvalues) and nullity (zero ones) of the Hessian on the closures' tangent space, in
+    floating point with the tolerances above: an estimate, and its eigenvalues (the labels come from ``proofs``).
 
     The tangent space is that of every loop's closure with the rotation of the whole chain taken out (dimension
     n - 2L - 1).  Where a loop is folded onto a line its two closure rows become dependent: the closed

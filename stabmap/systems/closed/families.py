@@ -5,7 +5,8 @@ which of two lengths: ``pattern`` gives 1 for a body of length h1 and 2 for one 
 ``ratio`` = h2/h1.  ``closed_form`` evaluates the family at a batch of length vectors: the axis angles, the loop
 forces and where the family exists.  At the end of its range each two-length family folds onto a line (a
 collinear state, an equilibrium for every force along that line): that end point is reported as existing, and
-the constraints' lost rank makes it degenerate (``equations.inertia``).
+the constraints' lost rank makes it degenerate.  Everything here is floating point; ``proofs`` decides existence
+exactly and evaluates the same closed forms in ball and rational arithmetic.
 """
 
 from __future__ import annotations
@@ -50,13 +51,18 @@ class Family:
         h1, h2 = np.broadcast_arrays(h1, h2)
         return np.stack([h1 if p == 1 else h2 for p in pattern], axis=-1)
 
-    def closed_form(self, lengths, c1sq, h, j=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """theta (P, n) [rad], forces (P, L, 2) [N] as (R_y, R_z), exists (P,) at lengths (P, n); NaN where absent."""
+    def closed_form(self, lengths, c1sq, h, j=None, exists=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """theta (P, n) [rad], forces (P, L, 2) [N] as (R_y, R_z), exists (P,) at lengths (P, n); NaN where absent.
+
+        In floating point: ``exists`` decided here is a float comparison, which ``proofs`` replaces by an exact
+        one; pass ``exists`` (P,) to use that instead (the formulas stay finite up to and just past the ends).
+        """
         lengths = np.atleast_2d(np.asarray(lengths, dtype=float))
         P = lengths.shape[0]
         c1sq = np.broadcast_to(np.asarray(c1sq, dtype=float), (P,))
         h = np.broadcast_to(np.asarray(h, dtype=float), (P,))
-        theta, forces, exists = _FORMS[self.name](lengths, c1sq, h, j)
+        theta, forces, float_exists = _FORMS[self.name](lengths, c1sq, h, j)
+        exists = float_exists if exists is None else np.broadcast_to(np.asarray(exists, dtype=bool), (P,))
         theta = np.where(exists[:, None], theta, np.nan)
         forces = np.where(exists[:, None, None], forces, np.nan)
         return theta, forces, exists
@@ -90,7 +96,7 @@ def _figure_eight_6(lengths, c1sq, h, j):
     a = h1 / h2
     exists = a <= A_STAR_6
     with np.errstate(invalid="ignore", divide="ignore"):  # where absent: the values are discarded
-        p = 1.0 - 2.0 * a + np.sqrt(np.where(exists, 1.0 - 4.0 * a, 0.0))
+        p = 1.0 - 2.0 * a + np.sqrt(np.maximum(1.0 - 4.0 * a, 0.0))
         sin2 = np.clip((p * p - 1.0) / (p * p - 4.0 * a * a), 0.0, 1.0)
     st, ct = np.sqrt(sin2), np.sqrt(1.0 - sin2)
     t = np.arctan2(st, ct)

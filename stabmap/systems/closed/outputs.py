@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 from ...store.variables import Variable
-from .decide import ABSENT, DEGENERATE, NO_COUNT, NO_TURNS, STABLE, UNSTABLE
+from .decide import ABSENT, DEGENERATE, NO_COUNT, NO_TURNS, STABLE, UNDECIDED, UNSTABLE
+from .proofs import BY_BALLS, BY_EXACT, BY_INTERVAL_NEWTON, BY_STRUCTURE
+from .proofs import UNDECIDED as BY_NONE
 
 STABILITY = Variable(
     "stability",
@@ -11,29 +13,46 @@ STABILITY = Variable(
     "stability of the planar equilibrium: a strict minimum of the elastic energy on closed configurations",
     comment="stable: index and nullity of the constrained Hessian both 0; unstable: index > 0 and nullity 0; "
     "degenerate: nullity > 0 (a zero eigenvalue, or a loop folded onto a line), never called stable; "
-    "absent: the family has no equilibrium at these lengths. Out-of-plane stability is not decided",
-    flags=((ABSENT, "absent"), (DEGENERATE, "degenerate"), (STABLE, "stable"), (UNSTABLE, "unstable")),
-    fill=-3,
+    "absent: the family has no equilibrium at these lengths; undecided: no class, the proof did not decide the "
+    "point (decided_by = undecided). Every other value is proved (decided_by, docs/closed.md). "
+    "Out-of-plane stability is not decided",
+    flags=((UNDECIDED, "undecided"), (ABSENT, "absent"), (DEGENERATE, "degenerate"), (STABLE, "stable"), (UNSTABLE, "unstable")),
+    fill=-4,
 )
 EXISTS = Variable(
     "exists",
     "int8",
     "whether the family has an equilibrium at these lengths",
-    flags=((0, "absent"), (1, "exists")),
+    comment="proved, in exact rational arithmetic or by the Krawczyk operator (decided_by); undecided: not proved",
+    flags=((-1, "undecided"), (0, "absent"), (1, "exists")),
+)
+DECIDED_BY = Variable(
+    "decided_by",
+    "int8",
+    "how the stability class of this point was proved",
+    comment="ball_arithmetic: existence in exact rational arithmetic, index and nullity from the bordered Hessian "
+    "in ball arithmetic (python-flint arb) on the family's closed form; "
+    "exact_rational_arithmetic: the family is absent, or folded onto a line, decided exactly; "
+    "exact_structure: a ring, closed by an exact cyclotomic test, its Hessian cos(2 pi j/n) times a Laplacian; "
+    "interval_newton: no exact closed form (lengths off the pattern by rounding), the equilibrium proved by the "
+    "Krawczyk operator and its inertia in ball arithmetic. These four are proofs; docs/closed.md. "
+    "undecided: not proved, the point has the class undecided",
+    flags=((BY_BALLS, "ball_arithmetic"), (BY_EXACT, "exact_rational_arithmetic"), (BY_STRUCTURE, "exact_structure"),
+           (BY_INTERVAL_NEWTON, "interval_newton"), (BY_NONE, "undecided")),
 )
 INDEX = Variable(
     "index",
     "int16",
     "index of the constrained Hessian: negative eigenvalues on closed configurations modulo rotation",
     units="1",
-    comment=f"{NO_COUNT} where absent",
+    comment=f"proved as the class is; {NO_COUNT} where absent or undecided",
 )
 NULLITY = Variable(
     "nullity",
     "int16",
     "nullity of the constrained Hessian: zero eigenvalues, plus the closure rank a folded loop loses",
     units="1",
-    comment=f"{NO_COUNT} where absent",
+    comment=f"proved as the class is; {NO_COUNT} where absent or undecided",
 )
 ROTATION_INDEX = Variable(
     "rotation_index",
@@ -41,24 +60,25 @@ ROTATION_INDEX = Variable(
     "rotation index (turning number) of the chain: the sum of its joint angles over 2 pi",
     units="1",
     comment=f"ring: its winding j; figure-eight: 0; hinge: -1. {NO_TURNS} where absent or where a joint is folded "
-    "back (a joint angle of +-pi leaves the turning undefined)",
+    "back (a joint angle within 1e-9 rad of +-pi leaves the turning undefined); from the floating-point angles",
 )
 ENERGY = Variable("energy", "float64", "elastic energy U = (c1^2/h) sum (1 - cos(theta_k - theta_(k-1)))", units="J",
-                  comment="NaN where absent")
+                  comment="floating point; NaN where absent")
 RESIDUAL = Variable(
     "residual",
     "float64",
     "largest scaled residual of the equilibrium equations",
     units="1",
-    comment="each torque equation (22) divided by 2 + a_k |R|, each loop's closure by its length sum; NaN where absent",
+    comment="each torque equation (22) divided by 2 + a_k |R|, each loop's closure by its length sum, at the "
+    "floating-point angles and forces; NaN where absent",
 )
 THETA = Variable("theta", "float64", "angle of the axis of each body, e_k = (-sin theta_k, cos theta_k)", units="rad",
-                 comment="NaN where absent and beyond the chain's n bodies", dims=("body",))
+                 comment="floating point; NaN where absent and beyond the chain's n bodies", dims=("body",))
 JOINT_ANGLE = Variable("joint_angle", "float64", "angle of each joint, theta_k - theta_(k-1) in (-pi, pi] (joint 1 joins body n to body 1)",
-                       units="rad", comment="NaN where absent and beyond the chain's n bodies", dims=("body",))
+                       units="rad", comment="floating point; NaN where absent and beyond the chain's n bodies", dims=("body",))
 FORCE_Y = Variable("force_y", "float64", "y component R_y of the joint force of each closing loop", units="N",
-                   comment="loop 1 holds body 1; the hinge's loop 2 holds bodies 2, 3, 4. NaN where absent", dims=("loop",))
+                   comment="floating point; loop 1 holds body 1; the hinge's loop 2 holds bodies 2, 3, 4. NaN where absent", dims=("loop",))
 FORCE_Z = Variable("force_z", "float64", "z component R_z of the joint force of each closing loop", units="N",
                    comment="as force_y", dims=("loop",))
 
-VARIABLES = (STABILITY, EXISTS, INDEX, NULLITY, ROTATION_INDEX, ENERGY, RESIDUAL, THETA, JOINT_ANGLE, FORCE_Y, FORCE_Z)
+VARIABLES = (STABILITY, DECIDED_BY, EXISTS, INDEX, NULLITY, ROTATION_INDEX, ENERGY, RESIDUAL, THETA, JOINT_ANGLE, FORCE_Y, FORCE_Z)

@@ -40,8 +40,8 @@ class Scene(SceneBase):
 
     Lengths are either ``lengths`` (h_1..h_n [m], in the family's pattern) or built from ``h1`` [m] (default 1)
     and ``ratio`` = h2/h1 (default 1 for the ring, whose pattern alternates h1, h2).  ``n`` (ring only) is the
-    number of bodies; ``j`` (ring only, default 1) its winding; ``h`` (default min h_k at each point) the step
-    of the discrete curvature.
+    number of bodies; ``j`` (ring only, default 1) its winding; ``c1sq`` (default 1) the bending stiffness c1^2 [N m^2];
+    ``h`` (default min h_k at each point) the step of the discrete curvature.
     """
 
     system: ClassVar[str] = "closed"
@@ -52,7 +52,7 @@ class Scene(SceneBase):
     h1: float | None = None
     n: int | None = None
     j: int | None = None
-    c1sq: float = 1.0
+    c1sq: float | None = None
     h: float | None = None
     title: str = ""
     grid: tuple[Axis, ...] = field(default=())
@@ -97,10 +97,9 @@ class Scene(SceneBase):
         out = {"title": self.title, "family": self.family}
         if self.lengths:
             out["lengths"] = list(self.lengths)
-        for key in ("ratio", "h1", "n", "j", "h"):
+        for key in ("ratio", "h1", "n", "j", "c1sq", "h"):
             if getattr(self, key) is not None:
                 out[key] = getattr(self, key)
-        out["c1sq"] = self.c1sq
         if self.grid:
             out["grid"] = {a.name: a.to_dict() for a in self.grid}
         return out
@@ -140,7 +139,7 @@ def fixed_values(scene: Scene, all_names: bool = False) -> dict[str, float]:
         if scene.n is not None or scene.lengths:
             out["n"] = float(len(scene.lengths) if scene.lengths else scene.n)
         out["j"] = float(1 if scene.j is None else scene.j)
-    out["c1sq"] = scene.c1sq
+    out["c1sq"] = 1.0 if scene.c1sq is None else scene.c1sq
     if scene.h is not None:
         out["h"] = scene.h
     if all_names:

@@ -18,6 +18,11 @@ The method (docs/closed.md, "search"):
 4. **De-duplication.** Two solutions are the same shape when a rotation, a relabelling of the bodies that
    keeps the lengths (a cyclic shift, the reversed numbering) or a reflection maps one onto the other (joint
    angles equal to 1e-7).
+5. **Proof.** Each shape kept is proved (``proofs.prove_equilibrium``): the Krawczyk operator on the general
+   equations in ball arithmetic shows a unique equilibrium in a small box around it, and the inertia of the
+   constrained Hessian over that box is proved in balls (``decided_by = "interval_newton"``).  A shape for which
+   either fails is still listed, flagged: ``decided_by = "undecided"``, stability ``"undecided"`` (and
+   ``exists = None`` when the Krawczyk test failed).
 
 Nothing guarantees that every equilibrium is found: more ``starts`` find more of those with small basins.
 """
@@ -29,7 +34,7 @@ import math
 import numpy as np
 from scipy.optimize import root
 
-from . import equations
+from . import equations, proofs
 from .checks import can_close, positive
 from .solve import Equilibrium, equilibrium
 
@@ -38,6 +43,7 @@ REGULAR = 1e-10
 FOLDED = 1e-6  # closure rows this close to dependent: the axes lie on one line (to about 1e-6 rad)
 SAME_ANGLES = 1e-7
 NOISE = (0.3, 1.0, math.pi)
+_FLOAT = proofs.Verdict(1, -1, -1, proofs.UNDECIDED)  # a candidate before its proof
 
 
 def _system(x, h_k, rho_scale):
@@ -135,7 +141,8 @@ def search(lengths, *, c1sq: float = 1.0, h: float | None = None, starts: int | 
     -------
     list of Equilibrium
         ``shape = "found"``, each verified (residual <= 1e-12, regular Jacobian) and distinct modulo rotation,
-        relabelling and reflection, sorted by energy.  Method and limits: the module docstring.
+        relabelling and reflection, sorted by energy; each proved (``decided_by = "interval_newton"``) or
+        flagged ``"undecided"``.  Method and limits: the module docstring.
     """
     h_k = np.array([positive(f"lengths[{k + 1}]", v) for k, v in enumerate(lengths)], dtype=float)
     if h_k.size < 3:
@@ -168,8 +175,12 @@ def search(lengths, *, c1sq: float = 1.0, h: float | None = None, starts: int | 
         if sv[1] < FOLDED * sv[0]:
             continue
         forces = np.array([[x[n - 1], x[n]]]) * rho_scale * c1sq / h
-        eq = equilibrium("found", h_k, theta, forces, True, loop_of, c1sq, h)
+        eq = equilibrium("found", h_k, theta, forces, _FLOAT, loop_of, c1sq, h)
         if eq.residual > RESIDUAL or any(_same(other, eq) for other in found):
             continue
         found.append(eq)
-    return sorted(found, key=lambda e: (e.energy, e.index))
+    proved = []
+    for eq in found:  # each kept shape proved: Krawczyk on the general equations, then its inertia in balls
+        verdict = proofs.prove_equilibrium(eq.theta, eq.forces * (h / c1sq), h_k, loop_of)
+        proved.append(equilibrium("found", h_k, eq.theta, eq.forces, verdict, loop_of, c1sq, h))
+    return sorted(proved, key=lambda e: (e.energy, e.index))

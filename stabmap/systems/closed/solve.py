@@ -7,10 +7,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import StabmapError
-from . import checks, equations
-from .decide import ABSENT, DEGENERATE, STABLE, UNSTABLE, decide
+from . import checks, equations, proofs
+from .decide import ABSENT, DEGENERATE, STABLE, UNDECIDED, UNSTABLE, decide
+from .outputs import DECIDED_BY
 
-_CLASS = {STABLE: "stable", UNSTABLE: "unstable", DEGENERATE: "degenerate", ABSENT: "absent"}
+_CLASS = {STABLE: "stable", UNSTABLE: "unstable", DEGENERATE: "degenerate", ABSENT: "absent", UNDECIDED: "undecided"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -25,12 +26,14 @@ class Equilibrium:
         h_1..h_n [m]; body k runs from joint O_k to O_{k+1}, O_{n+1} = O_1.
     c1sq, h : float
         Bending stiffness c1^2 [N m^2] and the step h [m] of the elastic moment (default min h_k).
-    exists : bool
-        False: the family has no equilibrium at these lengths (then the arrays are NaN and the counts -1).
+    exists : bool or None
+        False: the family has no equilibrium at these lengths (then the arrays are NaN and the counts -1); None:
+        not proved either way (``decided_by = "undecided"``; the arrays hold the floating-point closed form).
     theta : ndarray (n,)
-        Axis angles [rad]: the axis of body k is e_k = (-sin theta_k, cos theta_k) in the (y, z) plane.
+        Axis angles [rad] (floating point): the axis of body k is e_k = (-sin theta_k, cos theta_k) in the
+        (y, z) plane.
     forces : ndarray (L, 2)
-        The joint force (R_y, R_z) [N] of each closing loop (one loop but for the hinge).
+        The joint force (R_y, R_z) [N] of each closing loop (one loop but for the hinge), floating point.
     loops : tuple of tuple of int
         The 1-based bodies of each loop, in the order of ``forces``.
     energy : float
@@ -39,18 +42,24 @@ class Equilibrium:
         Largest scaled residual of the equilibrium equations (docs/closed.md).
     index, nullity : int
         Negative and zero eigenvalues of the Hessian on the closed configurations modulo rotation; a folded loop
-        adds its lost closure rank to the nullity.  Stable only when both are 0.
+        adds its lost closure rank to the nullity.  Stable only when both are 0.  Proved (``decided_by``); -1 where
+        absent or undecided.
     rotation_index : int or None
         Turning number of the chain (ring: j, figure-eight: 0, hinge: -1); None where absent or folded.
     eigenvalues : ndarray
-        Of the reduced Hessian, in units of c1^2/h.
+        Of the reduced Hessian, in units of c1^2/h: floating point, for information (the index and nullity are
+        the proved ones).
+    decided_by : str
+        How existence, index and nullity were proved: ``"ball_arithmetic"``, ``"exact_rational_arithmetic"``,
+        ``"exact_structure"``, ``"interval_newton"``; or ``"undecided"``: nothing is proved and the stability
+        is ``"undecided"`` (docs/closed.md, section 5).
     """
 
     shape: str
     lengths: tuple[float, ...]
     c1sq: float
     h: float
-    exists: bool
+    exists: bool | None
     theta: np.ndarray
     forces: np.ndarray
     loops: tuple[tuple[int, ...], ...]
@@ -61,14 +70,22 @@ class Equilibrium:
     rotation_index: int | None
     eigenvalues: np.ndarray = field(repr=False)
     j: int | None = None
+    decided_by: str = "undecided"
 
     @property
     def n(self) -> int:
         return len(self.lengths)
 
     @property
+    def proved(self) -> bool:
+        """Whether existence, index and nullity are proved (``decided_by`` is not ``"undecided"``)."""
+        return self.decided_by != "undecided"
+
+    @property
     def stability(self) -> str:
-        """"stable", "unstable", "degenerate" (nullity > 0) or "absent"."""
+        """"stable", "unstable", "degenerate" (nullity > 0), "absent", or "undecided" (nothing proved)."""
+        if not self.proved:
+            return _CLASS[UNDECIDED]
         if not self.exists:
             return _CLASS[ABSENT]
         return _CLASS[DEGENERATE if self.nullity > 0 else UNSTABLE if self.index > 0 else STABLE]
@@ -88,11 +105,11 @@ class Equilibrium:
         return equations.joints(self.theta[None], np.asarray(self.lengths)[None])[0]
 
     def __repr__(self) -> str:
-        if not self.exists:
-            return f"Equilibrium({self.shape}, lengths={list(self.lengths)}: absent)"
+        if self.exists is False:
+            return f"Equilibrium({self.shape}, lengths={list(self.lengths)}: absent, {self.decided_by})"
         return (
             f"Equilibrium({self.shape}, {self.stability}, index={self.index}, nullity={self.nullity}, "
-            f"rotation_index={self.rotation_index}, U={self.energy:.6g} J, residual={self.residual:.1e})"
+            f"rotation_index={self.rotation_index}, U={self.energy:.6g} J, residual={self.residual:.1e}, {self.decided_by})"
         )
 
 
@@ -102,19 +119,20 @@ def _scalars(lengths: np.ndarray, c1sq, h) -> tuple[float, float]:
     return c1sq, h
 
 
-def equilibrium(shape: str, lengths, theta, forces, exists, loop_of, c1sq: float, h: float, j=None) -> Equilibrium:
-    """The Equilibrium of one configuration, decided like an atlas point."""
+def equilibrium(shape: str, lengths, theta, forces, verdict: proofs.Verdict, loop_of, c1sq: float, h: float, j=None) -> Equilibrium:
+    """The Equilibrium of one configuration with its ``verdict`` (``proofs``), decided like an atlas point."""
     lengths = np.asarray(lengths, dtype=float)
     n = lengths.size
-    d = decide(np.asarray(theta, dtype=float).reshape(1, n), np.asarray(forces, dtype=float)[None], [bool(exists)],
-               lengths[None], loop_of, c1sq, h)
+    d = decide(np.asarray(theta, dtype=float).reshape(1, n), np.asarray(forces, dtype=float)[None], proofs.Verdicts.of([verdict]),
+               lengths[None], loop_of, c1sq, h, eigenvalues=True)
     loops = tuple(tuple(int(k) + 1 for k in np.flatnonzero(loop_of == l)) for l in range(int(loop_of.max()) + 1))
     turns = int(d.rotation_index[0])
+    exists = {1: True, 0: False, -1: None}[int(d.exists[0])]
     return Equilibrium(
-        shape=shape, lengths=tuple(lengths.tolist()), c1sq=c1sq, h=h, exists=bool(d.exists[0]), theta=d.theta[0],
+        shape=shape, lengths=tuple(lengths.tolist()), c1sq=c1sq, h=h, exists=exists, theta=d.theta[0],
         forces=d.forces[0], loops=loops, energy=float(d.energy[0]), residual=float(d.residual[0]),
-        index=int(d.index[0]), nullity=int(d.nullity[0]), rotation_index=None if turns == -128 or not d.exists[0] else turns,
-        eigenvalues=d.eigenvalues[0][~np.isnan(d.eigenvalues[0])], j=j,
+        index=int(d.index[0]), nullity=int(d.nullity[0]), rotation_index=None if turns == -128 or exists is False else turns,
+        eigenvalues=d.eigenvalues[0][~np.isnan(d.eigenvalues[0])], j=j, decided_by=DECIDED_BY.meaning(int(d.decided_by[0])),
     )
 
 
@@ -139,7 +157,8 @@ def solve(shape: str, lengths, *, c1sq: float = 1.0, h: float | None = None, j: 
     Returns
     -------
     Equilibrium
-        ``exists = False`` where the family has no equilibrium at these lengths.
+        ``exists = False`` where the family has no equilibrium at these lengths.  Existence, index and nullity
+        are proved at the exact binary values of the lengths (``decided_by``), or the stability is "undecided".
 
     Raises
     ------
@@ -154,5 +173,13 @@ def solve(shape: str, lengths, *, c1sq: float = 1.0, h: float | None = None, j: 
         j = checks.winding(j, n)
     elif not (isinstance(j, (int, np.integer)) and not isinstance(j, bool) and j == 1):
         raise StabmapError(f"j = {j!r}: the winding j applies to shape = 'ring' only; leave it out for {fam.name!r}")
-    theta, forces, exists = fam.closed_form(h_k[None], c1sq, h, j)
-    return equilibrium(fam.name, h_k, theta[0], forces[0], exists[0], fam.loop_of(n), c1sq, h, j if fam.name == "ring" else None)
+    guess = None
+    if fam.pattern is not None:  # lengths off the pattern by rounding: the Krawczyk operator starts from the closed form
+
+        def guess():
+            theta, forces, _ = fam.closed_form(h_k[None], c1sq, h, j, exists=[True])
+            return theta[0], forces[0] * (h / c1sq)
+
+    verdict = proofs.prove_lengths(fam, j, tuple(h_k.tolist()), guess)
+    theta, forces, _ = fam.closed_form(h_k[None], c1sq, h, j, exists=[verdict.exists != 0])
+    return equilibrium(fam.name, h_k, theta[0], forces[0], verdict, fam.loop_of(n), c1sq, h, j if fam.name == "ring" else None)
