@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 from pathlib import Path
@@ -97,21 +98,34 @@ def write_streamed(ds: xr.Dataset, path: Path) -> Path:
         netCDF4.set_chunk_cache(*previous)
 
 
+READ_CHUNK_POINTS = 1 << 20  # grid points per dask chunk of a lazily opened atlas (a few MiB per variable)
+
+
 def open_atlas(path: str | Path, *, lazy: bool = False) -> xr.Dataset:
     """Open a saved atlas, netCDF or Zarr.
 
     By default it is loaded into memory and the file closed on return.  With ``lazy`` the variables are dask
     arrays read chunk by chunk as they are used (bounded memory for any size); close the Dataset after use.
+    A lazy chunk holds whole chunks of the file, about ``READ_CHUNK_POINTS`` grid points (:func:`read_chunks`),
+    so that neither one chunk nor the number of chunks grows with the atlas.
     """
     path = Path(path)
     zarr = is_zarr(path) and path.is_dir()
     if not (path.is_file() or zarr):
         raise StabmapError(f"atlas file {str(path)!r} does not exist")
+
+    def opened(chunks):
+        if zarr:
+            return xr.open_zarr(path, consolidated=False, chunks=chunks)
+        return xr.open_dataset(path, engine="netcdf4", chunks=chunks, cache=not lazy)
+
     try:
-        chunks = {} if lazy else None  # {}: dask arrays in the file's own chunks
-        ds = xr.open_zarr(path, consolidated=False, chunks=chunks) if zarr else xr.open_dataset(path, engine="netcdf4", chunks=chunks)
-        if not lazy:
-            with ds:
+        if lazy:
+            with opened(None) as plain:  # metadata only: the file's own chunks
+                chunks = read_chunks(plain)
+            ds = opened(chunks)
+        else:
+            with opened(None) as ds:
                 ds = ds.load()
     except (OSError, ValueError, KeyError) as exc:
         raise StabmapError(f"cannot read {str(path)!r} as a {'Zarr' if zarr else 'netCDF'} atlas: {exc}") from None
@@ -119,3 +133,29 @@ def open_atlas(path: str | Path, *, lazy: bool = False) -> xr.Dataset:
         ds.close()
         raise StabmapError(f"{str(path)!r} is a netCDF file but not a stabmap atlas (no stabmap_format_version)")
     return ds
+
+
+def read_chunks(ds: xr.Dataset, points: int = READ_CHUNK_POINTS) -> dict[str, int]:
+    """Dask chunks for reading ``ds`` lazily: whole chunks of the file, grown to about ``points`` grid points.
+
+    The file's chunks (netCDF ``chunksizes``, Zarr ``chunks``) of its largest variable are multiplied along the
+    trailing dimensions first (the order in which stabmap writes, so a read stays contiguous) until a dask chunk
+    holds about ``points`` points; a file chunk already larger is kept as it is.  Every variable is read in the
+    same chunks, so operations between variables need no rechunking.
+    """
+    variables = [v for v in ds.data_vars.values() if v.ndim]
+    if not variables:
+        return {}
+    big = max(variables, key=lambda v: v.size)
+    preferred = big.encoding.get("preferred_chunks") or {}
+    disk = [int(preferred.get(d, n)) for d, n in big.sizes.items()]
+    shape = list(big.sizes.values())
+    chunks = list(disk)
+    for i in reversed(range(len(shape))):
+        rest = math.prod(chunks) // chunks[i]
+        k = max(1, points // max(1, rest * chunks[i]))
+        chunks[i] = min(shape[i], chunks[i] * k)
+    out = dict(zip(big.dims, chunks))
+    for v in variables:  # dimensions of other variables (e.g. per node) are read whole
+        out.update({d: out.get(d, n) for d, n in v.sizes.items()})
+    return out

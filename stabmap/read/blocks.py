@@ -1,0 +1,195 @@
+"""Reading an atlas in chunks: the few passes over its labels that ``info``, ``query`` and ``plot`` need.
+
+Every function here takes plain arrays, numpy or dask (a lazily opened atlas, ``open_atlas(path, lazy=True)``),
+and runs over them one chunk at a time (dask's synchronous scheduler), so the memory they use is bounded by a few
+chunks, whatever the size of the atlas. Their results are small: counts, one value per line or per pixel block,
+or the positions of the label's changes (as many as there are boundaries).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import dask
+import dask.array as da
+import numpy as np
+
+
+def compute(*objects):
+    """``objects`` (dask, xarray or numpy) computed together, one chunk in memory at a time; numpy passes through.
+
+    Objects that read the same variable share its reads: each chunk is read once for all of them.
+    """
+    with dask.config.set(scheduler="synchronous"):
+        return dask.compute(*objects)
+
+
+def as_dask(a) -> da.Array:
+    """A dask array of ``a``: itself if it is one, else one chunk of it (the same code runs on both)."""
+    return a if isinstance(a, da.Array) else da.from_array(np.asarray(a), chunks=-1)
+
+
+# ---------------------------------------------------------------------------------------------------- along lines
+def changes(values, flags) -> tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Every change of ``values`` between neighbours along the last axis, in C order.
+
+    Parameters
+    ----------
+    values : array of int, shape (..., n)
+        A label, the axis searched last.
+    flags : array of bool, same shape
+        A per-point flag carried along (e.g. "inferred").
+
+    Returns
+    -------
+    position, below, above, flag_below, flag_above
+        ``position``: one index array per axis of the change's lower point (its upper point is one further along
+        the last axis); the labels and flags at the two points.
+    """
+    v, f = as_dask(values), as_dask(flags)
+    lo, hi = v[..., :-1], v[..., 1:]
+    flo, fhi = f[..., :-1], f[..., 1:]
+    _, (lo, hi, flo, fhi) = da.core.unify_chunks(*(x for a in (lo, hi, flo, fhi) for x in (a, _index(v.ndim))))
+    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in lo.chunks]
+    parts = []
+    for block in np.ndindex(*lo.numblocks):
+        offset = tuple(int(s[b]) for s, b in zip(starts, block))
+        parts.append(dask.delayed(_block_changes)(*(a.blocks[block] for a in (lo, hi, flo, fhi)), offset))
+    found = compute(*parts)
+    if not found:
+        return tuple(np.zeros(0, dtype=np.intp) for _ in range(v.ndim)), *(np.zeros(0, dtype=a.dtype) for a in (lo, hi, flo, fhi))
+    position = tuple(np.concatenate([p[0][k] for p in found]) for k in range(v.ndim))
+    order = np.lexsort(position[::-1])  # C order: the first axis slowest
+    position = tuple(p[order] for p in position)
+    rest = [np.concatenate([p[k] for p in found])[order] for k in range(1, 5)]
+    return position, *rest
+
+
+def _index(ndim: int) -> str:
+    return "abcdefghijklmnop"[:ndim]
+
+
+def _block_changes(lo, hi, flo, fhi, offset):
+    where = np.nonzero(lo != hi)
+    return tuple(w + o for w, o in zip(where, offset)), lo[where], hi[where], flo[where], fhi[where]
+
+
+@dataclass(frozen=True)
+class FirstTrue:
+    """Per line (all axes but the last) of a mask: where it is first True, and what lies there and just before."""
+
+    has: np.ndarray  # bool: the line holds a True
+    first: np.ndarray  # index of the first True (0 where none)
+    true_to_end: np.ndarray  # bool: True from ``first`` to the end of the line
+    value_before: np.ndarray  # values[first - 1]; ``fill`` where first == 0 or nothing is True
+    flag_at: np.ndarray  # flags[first] (False where nothing is True)
+    flag_before: np.ndarray  # flags[first - 1] (False where there is no such point)
+
+
+def first_true(mask, values, flags, fill) -> FirstTrue:
+    """The first True of ``mask`` along its last axis, per line, with ``values`` and ``flags`` there and before.
+
+    Two passes over the arrays (chunk by chunk): one finds the first True and the last False of every line,
+    the second picks the values at and before it.
+    """
+    m, v, f = as_dask(mask), as_dask(values), as_dask(flags)
+    n = m.shape[-1]
+    index = da.arange(n, chunks=m.chunks[-1])
+    has, first, last_false = compute(m.any(axis=-1), m.argmax(axis=-1), da.where(~m, index, -1).max(axis=-1))
+    before = np.maximum(first - 1, 0)
+    has_before = has & (first > 0)
+
+    def at(i):  # True at index i[line] of every line, in the chunks of the mask
+        return index == da.from_array(i[..., None], chunks=m.chunks[:-1] + (1,))
+
+    lowest = np.iinfo(v.dtype).min if np.issubdtype(v.dtype, np.integer) else -np.inf
+    value, flag_at, flag_before = compute(
+        da.where(at(before), v, lowest).max(axis=-1), (f & at(first)).any(axis=-1), (f & at(before)).any(axis=-1)
+    )
+    return FirstTrue(
+        has=has,
+        first=first,
+        true_to_end=has & (last_false < first),
+        value_before=np.where(has_before, value, fill).astype(v.dtype),
+        flag_at=has & flag_at,
+        flag_before=has_before & flag_before,
+    )
+
+
+# --------------------------------------------------------------------------------------------------- pixel blocks
+@dataclass(frozen=True)
+class Blocks:
+    """A 2-D label map reduced to blocks of ``factors`` = (rows, columns) points (the last ones may be smaller).
+
+    ``low``/``high``: the smallest and largest label in each block (equal where every point of the block has one
+    label); ``mixed_stability``: the block holds stable and not stable points; ``any_flag``: some point of the
+    block is flagged (e.g. inferred).
+    """
+
+    factors: tuple[int, int]
+    low: np.ndarray
+    high: np.ndarray
+    mixed_stability: np.ndarray
+    any_flag: np.ndarray
+
+    @property
+    def mixed(self) -> np.ndarray:
+        """Blocks holding more than one label."""
+        return self.low != self.high
+
+
+def block_factors(shape: tuple[int, int], pixels: tuple[int, int]) -> tuple[int, int]:
+    """Points per block along each axis so that a map of ``shape`` has at most ``pixels`` blocks along each."""
+    return tuple(max(1, math.ceil(n / max(1, p))) for n, p in zip(shape, pixels))
+
+
+def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -> Blocks:
+    """Reduce a 2-D map ``values`` (and its ``flags``, or None) to blocks of ``factors`` points, chunk by chunk.
+
+    The map is padded at its far ends by repeating its last row and column (which adds no label to a block), cut
+    into dask chunks holding whole blocks, and each chunk reduced on its own: one pass over the map.
+    """
+    v = as_dask(values)
+    f = as_dask(np.zeros((1, 1), dtype=bool)) if flags is None else as_dask(flags)
+    fy, fx = factors
+    pad = [(0, -n % k) for n, k in zip(v.shape, factors)]
+    if any(p for _, p in pad):
+        v = da.pad(v, pad, mode="edge")
+        if flags is not None:
+            f = da.pad(f, pad, mode="edge")
+    chunks = tuple(_multiple(c, k, n) for c, k, n in zip(v.chunksize, factors, v.shape))
+    v = v.rechunk(chunks)
+    f = f.rechunk(chunks) if flags is not None else None
+    out_chunks = ((4,),) + tuple(tuple(c // k for c in cs) for cs, k in zip(v.chunks, factors))
+    args = (v,) if f is None else (v, f)
+    reduced = da.map_blocks(_reduce_block, *args, stable=stable, factors=factors, chunks=out_chunks, new_axis=0, dtype=np.int32)
+    (low, high, mixed_stable, flagged), = compute(reduced)
+    return Blocks(factors, low, high, mixed_stable.astype(bool), flagged.astype(bool))
+
+
+def _multiple(chunk: int, k: int, n: int) -> int:
+    """A chunk length near ``chunk`` that holds whole blocks of ``k`` (at most the axis, ``n``)."""
+    return min(n, max(k, round(chunk / k) * k))
+
+
+def _reduce_block(v: np.ndarray, f: np.ndarray | None = None, *, stable, factors) -> np.ndarray:
+    fy, fx = factors
+    ny, nx = v.shape[0] // fy, v.shape[1] // fx
+    cells = v.reshape(ny, fy, nx, fx)
+    out = np.empty((4, ny, nx), dtype=np.int32)
+    out[0] = cells.min(axis=(1, 3))
+    out[1] = cells.max(axis=(1, 3))
+    if stable is None:
+        out[2] = 0
+    else:
+        is_stable = cells == stable
+        out[2] = is_stable.any(axis=(1, 3)) & ~is_stable.all(axis=(1, 3))
+    out[3] = 0 if f is None else f.reshape(ny, fy, nx, fx).any(axis=(1, 3))
+    return out
+
+
+def counts(values) -> dict[int, int]:
+    """How often each value occurs, chunk by chunk."""
+    unique, n = compute(*da.unique(as_dask(values).ravel(), return_counts=True))
+    return {int(u): int(c) for u, c in zip(unique, n)}
