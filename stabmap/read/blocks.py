@@ -124,19 +124,25 @@ class Blocks:
 
     ``low``/``high``: the smallest and largest label in each block (equal where every point of the block has one
     label); ``mixed_stability``: the block holds stable and not stable points; ``any_flag``: some point of the
-    block is flagged (e.g. inferred).
+    block is flagged (e.g. inferred), None without flags. ``counts``: how often each label occurs in the whole
+    map, at full resolution. With factors (1, 1) the blocks are the points themselves.
     """
 
     factors: tuple[int, int]
     low: np.ndarray
     high: np.ndarray
     mixed_stability: np.ndarray
-    any_flag: np.ndarray
+    any_flag: np.ndarray | None
+    counts: dict[int, int]
 
     @property
     def mixed(self) -> np.ndarray:
         """Blocks holding more than one label."""
         return self.low != self.high
+
+    @property
+    def reduced(self) -> bool:
+        return self.factors != (1, 1)
 
 
 def block_factors(shape: tuple[int, int], pixels: tuple[int, int]) -> tuple[int, int]:
@@ -148,24 +154,34 @@ def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -
     """Reduce a 2-D map ``values`` (and its ``flags``, or None) to blocks of ``factors`` points, chunk by chunk.
 
     The map is padded at its far ends by repeating its last row and column (which adds no label to a block), cut
-    into dask chunks holding whole blocks, and each chunk reduced on its own: one pass over the map.
+    into dask chunks holding whole blocks, and each chunk reduced on its own; the counts of the labels come from
+    the same reads: one pass over the map. With factors (1, 1) the map is read as it is.
     """
+    factors = tuple(int(k) for k in factors)
     v = as_dask(values)
-    f = as_dask(np.zeros((1, 1), dtype=bool)) if flags is None else as_dask(flags)
-    fy, fx = factors
+    unique = da.unique(v.ravel(), return_counts=True)
+    if factors == (1, 1):
+        low, flagged, labels, n = compute(v, None if flags is None else as_dask(flags), *unique)
+        return Blocks(factors, low, low, np.zeros(low.shape, dtype=bool), flagged, _histogram(labels, n))
+    f = None if flags is None else as_dask(flags)
     pad = [(0, -n % k) for n, k in zip(v.shape, factors)]
     if any(p for _, p in pad):
         v = da.pad(v, pad, mode="edge")
-        if flags is not None:
-            f = da.pad(f, pad, mode="edge")
+        f = None if f is None else da.pad(f, pad, mode="edge")
     chunks = tuple(_multiple(c, k, n) for c, k, n in zip(v.chunksize, factors, v.shape))
     v = v.rechunk(chunks)
-    f = f.rechunk(chunks) if flags is not None else None
+    f = None if f is None else f.rechunk(chunks)
     out_chunks = ((4,),) + tuple(tuple(c // k for c in cs) for cs, k in zip(v.chunks, factors))
     args = (v,) if f is None else (v, f)
     reduced = da.map_blocks(_reduce_block, *args, stable=stable, factors=factors, chunks=out_chunks, new_axis=0, dtype=np.int32)
-    (low, high, mixed_stable, flagged), = compute(reduced)
-    return Blocks(factors, low, high, mixed_stable.astype(bool), flagged.astype(bool))
+    (low, high, mixed_stable, flagged), labels, n = compute(reduced, *unique)
+    dtype = np.asarray(values).dtype if not isinstance(values, da.Array) else values.dtype
+    return Blocks(factors, low.astype(dtype), high.astype(dtype), mixed_stable.astype(bool), None if flags is None else flagged.astype(bool),
+                  _histogram(labels, n))
+
+
+def _histogram(labels, n) -> dict[int, int]:
+    return {int(u): int(c) for u, c in zip(labels, n)}
 
 
 def _multiple(chunk: int, k: int, n: int) -> int:
@@ -191,5 +207,4 @@ def _reduce_block(v: np.ndarray, f: np.ndarray | None = None, *, stable, factors
 
 def counts(values) -> dict[int, int]:
     """How often each value occurs, chunk by chunk."""
-    unique, n = compute(*da.unique(as_dask(values).ravel(), return_counts=True))
-    return {int(u): int(c) for u, c in zip(unique, n)}
+    return _histogram(*compute(*da.unique(as_dask(values).ravel(), return_counts=True)))
