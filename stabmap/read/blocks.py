@@ -159,10 +159,10 @@ def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -
     """
     factors = tuple(int(k) for k in factors)
     v = as_dask(values)
-    unique = da.unique(v.ravel(), return_counts=True)
+    unique = _block_counts(v)
     if factors == (1, 1):
-        low, flagged, labels, n = compute(v, None if flags is None else as_dask(flags), *unique)
-        return Blocks(factors, low, low, np.zeros(low.shape, dtype=bool), flagged, _histogram(labels, n))
+        low, flagged, *parts = compute(v, None if flags is None else as_dask(flags), *unique)
+        return Blocks(factors, low, low, np.zeros(low.shape, dtype=bool), flagged, _merge(parts))
     f = None if flags is None else as_dask(flags)
     pad = [(0, -n % k) for n, k in zip(v.shape, factors)]
     if any(p for _, p in pad):
@@ -174,14 +174,10 @@ def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -
     out_chunks = ((4,),) + tuple(tuple(c // k for c in cs) for cs, k in zip(v.chunks, factors))
     args = (v,) if f is None else (v, f)
     reduced = da.map_blocks(_reduce_block, *args, stable=stable, factors=factors, chunks=out_chunks, new_axis=0, dtype=np.int32)
-    (low, high, mixed_stable, flagged), labels, n = compute(reduced, *unique)
+    (low, high, mixed_stable, flagged), *parts = compute(reduced, *unique)
     dtype = np.asarray(values).dtype if not isinstance(values, da.Array) else values.dtype
     return Blocks(factors, low.astype(dtype), high.astype(dtype), mixed_stable.astype(bool), None if flags is None else flagged.astype(bool),
-                  _histogram(labels, n))
-
-
-def _histogram(labels, n) -> dict[int, int]:
-    return {int(u): int(c) for u, c in zip(labels, n)}
+                  _merge(parts))
 
 
 def _multiple(chunk: int, k: int, n: int) -> int:
@@ -206,5 +202,20 @@ def _reduce_block(v: np.ndarray, f: np.ndarray | None = None, *, stable, factors
 
 
 def counts(values) -> dict[int, int]:
-    """How often each value occurs, chunk by chunk."""
-    return _histogram(*compute(*da.unique(as_dask(values).ravel(), return_counts=True)))
+    """How often each value occurs, chunk by chunk (``dask.array.unique`` would first ravel the array, which for
+    a transposed map gathers whole rows across chunks)."""
+    return _merge(compute(*_block_counts(values)))
+
+
+def _block_counts(values) -> list:
+    """One delayed ``(values, counts)`` per chunk of ``values``."""
+    v = as_dask(values)
+    return [dask.delayed(np.unique)(block, return_counts=True) for block in v.to_delayed().ravel()]
+
+
+def _merge(parts) -> dict[int, int]:
+    out: dict[int, int] = {}
+    for labels, n in parts:
+        for u, c in zip(labels, n):
+            out[int(u)] = out.get(int(u), 0) + int(c)
+    return dict(sorted(out.items()))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import shutil
@@ -89,13 +90,8 @@ def write_streamed(ds: xr.Dataset, path: Path) -> Path:
     # Synchronous: the chunks are on this machine, and one chunk at a time bounds the memory. Each netCDF
     # chunk is written once, whole, so netCDF's chunk cache (64 MiB a variable by default, the largest use of
     # memory here) only needs to hold one.
-    previous = netCDF4.get_chunk_cache()
-    netCDF4.set_chunk_cache(NETCDF_CHUNK_CACHE)
-    try:
-        with dask.config.set(scheduler="synchronous"):
-            return write_atlas(ds, path)
-    finally:
-        netCDF4.set_chunk_cache(*previous)
+    with _small_chunk_cache(), dask.config.set(scheduler="synchronous"):
+        return write_atlas(ds, path)
 
 
 READ_CHUNK_POINTS = 1 << 20  # grid points per dask chunk of a lazily opened atlas (a few MiB per variable)
@@ -123,7 +119,8 @@ def open_atlas(path: str | Path, *, lazy: bool = False) -> xr.Dataset:
         if lazy:
             with opened(None) as plain:  # metadata only: the file's own chunks
                 chunks = read_chunks(plain)
-            ds = opened(chunks)
+            with _small_chunk_cache():  # netCDF fixes each variable's chunk cache when it opens the file
+                ds = opened(chunks)
         else:
             with opened(None) as ds:
                 ds = ds.load()
@@ -133,6 +130,21 @@ def open_atlas(path: str | Path, *, lazy: bool = False) -> xr.Dataset:
         ds.close()
         raise StabmapError(f"{str(path)!r} is a netCDF file but not a stabmap atlas (no stabmap_format_version)")
     return ds
+
+
+@contextlib.contextmanager
+def _small_chunk_cache():
+    """netCDF's chunk cache lowered to ``NETCDF_CHUNK_CACHE`` for the files opened meanwhile.
+
+    A lazy atlas is read one dask chunk at a time, each chunk of the file once, so the cache gains nothing; at
+    its default size (64 MiB a variable) it would keep up to that much of every variable read.
+    """
+    previous = netCDF4.get_chunk_cache()
+    netCDF4.set_chunk_cache(NETCDF_CHUNK_CACHE)
+    try:
+        yield
+    finally:
+        netCDF4.set_chunk_cache(*previous)
 
 
 def read_chunks(ds: xr.Dataset, points: int = READ_CHUNK_POINTS) -> dict[str, int]:
