@@ -9,6 +9,7 @@ or the positions of the label's changes (as many as there are boundaries).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import dask
@@ -47,18 +48,18 @@ def changes(values, flags) -> tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarr
         ``position``: one index array per axis of the change's lower point (its upper point is one further along
         the last axis); the labels and flags at the two points.
     """
-    v, f = as_dask(values), as_dask(flags)
-    lo, hi = v[..., :-1], v[..., 1:]
-    flo, fhi = f[..., :-1], f[..., 1:]
-    _, (lo, hi, flo, fhi) = da.core.unify_chunks(*(x for a in (lo, hi, flo, fhi) for x in (a, _index(v.ndim))))
-    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in lo.chunks]
+    v = as_dask(values)
+    f = as_dask(flags).rechunk(v.chunks)
+    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in v.chunks]
+    vs, fs = v.to_delayed(), f.to_delayed()
     parts = []
-    for block in np.ndindex(*lo.numblocks):
+    for block in np.ndindex(*v.numblocks):  # each chunk with the last point of the one before it along the line
         offset = tuple(int(s[b]) for s, b in zip(starts, block))
-        parts.append(dask.delayed(_block_changes)(*(a.blocks[block] for a in (lo, hi, flo, fhi)), offset))
+        before = block[:-1] + (block[-1] - 1,) if block and block[-1] > 0 else None
+        parts.append(dask.delayed(_block_changes)(vs[block], fs[block], before and vs[before], before and fs[before], offset))
     found = compute(*parts)
     if not found:
-        return tuple(np.zeros(0, dtype=np.intp) for _ in range(v.ndim)), *(np.zeros(0, dtype=a.dtype) for a in (lo, hi, flo, fhi))
+        return tuple(np.zeros(0, dtype=np.intp) for _ in range(v.ndim)), *(np.zeros(0, dtype=a.dtype) for a in (v, v, f, f))
     position = tuple(np.concatenate([p[0][k] for p in found]) for k in range(v.ndim))
     order = np.lexsort(position[::-1])  # C order: the first axis slowest
     position = tuple(p[order] for p in position)
@@ -66,13 +67,15 @@ def changes(values, flags) -> tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarr
     return position, *rest
 
 
-def _index(ndim: int) -> str:
-    return "abcdefghijklmnop"[:ndim]
-
-
-def _block_changes(lo, hi, flo, fhi, offset):
-    where = np.nonzero(lo != hi)
-    return tuple(w + o for w, o in zip(where, offset)), lo[where], hi[where], flo[where], fhi[where]
+def _block_changes(v, f, v_before, f_before, offset):
+    """The changes along the last axis inside one chunk, and between it and the chunk before (``*_before``)."""
+    if v_before is not None:
+        v = np.concatenate([v_before[..., -1:], v], axis=-1)
+        f = np.concatenate([f_before[..., -1:], f], axis=-1)
+        offset = offset[:-1] + (offset[-1] - 1,)
+    where = np.nonzero(v[..., 1:] != v[..., :-1])
+    above = where[:-1] + (where[-1] + 1,)
+    return tuple(w + o for w, o in zip(where, offset)), v[where], v[above], f[where], f[above]
 
 
 @dataclass(frozen=True)
@@ -100,8 +103,10 @@ def first_true(mask, values, flags, fill) -> FirstTrue:
     before = np.maximum(first - 1, 0)
     has_before = has & (first > 0)
 
-    def at(i):  # True at index i[line] of every line, in the chunks of the mask
-        return index == da.from_array(i[..., None], chunks=m.chunks[:-1] + (1,))
+    def at(i):  # True at index i[line] of every line, in the chunks of the mask (an outer product: chunks multiply)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", da.PerformanceWarning)
+            return index == da.from_array(i[..., None], chunks=m.chunks[:-1] + (1,))
 
     lowest = np.iinfo(v.dtype).min if np.issubdtype(v.dtype, np.integer) else -np.inf
     value, flag_at, flag_before = compute(
@@ -153,31 +158,36 @@ def block_factors(shape: tuple[int, int], pixels: tuple[int, int]) -> tuple[int,
 def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -> Blocks:
     """Reduce a 2-D map ``values`` (and its ``flags``, or None) to blocks of ``factors`` points, chunk by chunk.
 
-    The map is padded at its far ends by repeating its last row and column (which adds no label to a block), cut
-    into dask chunks holding whole blocks, and each chunk reduced on its own; the counts of the labels come from
-    the same reads: one pass over the map. With factors (1, 1) the map is read as it is.
+    The map is padded at its far ends by repeating its last row and column (which adds no label to a block) and
+    cut into dask chunks holding whole blocks; each chunk is reduced and its labels counted (padding left out)
+    by one task, so every chunk is read once and dropped at once: one pass, a few chunks in memory. With
+    factors (1, 1) the blocks are the points.
     """
     factors = tuple(int(k) for k in factors)
     v = as_dask(values)
-    unique = _block_counts(v)
-    if factors == (1, 1):
-        low, flagged, *parts = compute(v, None if flags is None else as_dask(flags), *unique)
-        return Blocks(factors, low, low, np.zeros(low.shape, dtype=bool), flagged, _merge(parts))
     f = None if flags is None else as_dask(flags)
-    pad = [(0, -n % k) for n, k in zip(v.shape, factors)]
+    shape = v.shape
+    pad = [(0, -n % k) for n, k in zip(shape, factors)]
     if any(p for _, p in pad):
         v = da.pad(v, pad, mode="edge")
         f = None if f is None else da.pad(f, pad, mode="edge")
     chunks = tuple(_multiple(c, k, n) for c, k, n in zip(v.chunksize, factors, v.shape))
     v = v.rechunk(chunks)
     f = None if f is None else f.rechunk(chunks)
-    out_chunks = ((4,),) + tuple(tuple(c // k for c in cs) for cs, k in zip(v.chunks, factors))
-    args = (v,) if f is None else (v, f)
-    reduced = da.map_blocks(_reduce_block, *args, stable=stable, factors=factors, chunks=out_chunks, new_axis=0, dtype=np.int32)
-    (low, high, mixed_stable, flagged), *parts = compute(reduced, *unique)
-    dtype = np.asarray(values).dtype if not isinstance(values, da.Array) else values.dtype
-    return Blocks(factors, low.astype(dtype), high.astype(dtype), mixed_stable.astype(bool), None if flags is None else flagged.astype(bool),
-                  _merge(parts))
+    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in v.chunks]
+    grid = v.numblocks
+    vs, fs = v.to_delayed(), None if f is None else f.to_delayed()
+    tasks = []
+    for block in np.ndindex(*grid):
+        valid = tuple(int(min(c[b], n - s[b])) for c, s, b, n in zip(v.chunks, starts, block, shape))
+        tasks.append(dask.delayed(_reduce_block)(vs[block], None if fs is None else fs[block], valid, stable=stable, factors=factors))
+    done = compute(*tasks)
+    parts = np.empty(grid, dtype=object)
+    for block, (reduced, _) in zip(np.ndindex(*grid), done):
+        parts[block] = reduced
+    low, high, mixed_stable, flagged = (np.block([[p[k] for p in row] for row in parts]) for k in range(4))
+    return Blocks(factors, low.astype(v.dtype), high.astype(v.dtype), mixed_stable.astype(bool), None if flags is None else flagged.astype(bool),
+                  _merge(counted for _, counted in done))
 
 
 def _multiple(chunk: int, k: int, n: int) -> int:
@@ -185,7 +195,8 @@ def _multiple(chunk: int, k: int, n: int) -> int:
     return min(n, max(k, round(chunk / k) * k))
 
 
-def _reduce_block(v: np.ndarray, f: np.ndarray | None = None, *, stable, factors) -> np.ndarray:
+def _reduce_block(v: np.ndarray, f: np.ndarray | None, valid: tuple[int, int], *, stable, factors) -> tuple[np.ndarray, tuple]:
+    """One chunk's blocks (low, high, mixed stability, any flag), and the counts of its labels but for padding."""
     fy, fx = factors
     ny, nx = v.shape[0] // fy, v.shape[1] // fx
     cells = v.reshape(ny, fy, nx, fx)
@@ -198,7 +209,7 @@ def _reduce_block(v: np.ndarray, f: np.ndarray | None = None, *, stable, factors
         is_stable = cells == stable
         out[2] = is_stable.any(axis=(1, 3)) & ~is_stable.all(axis=(1, 3))
     out[3] = 0 if f is None else f.reshape(ny, fy, nx, fx).any(axis=(1, 3))
-    return out
+    return out, np.unique(v[: valid[0], : valid[1]], return_counts=True)
 
 
 def counts(values) -> dict[int, int]:

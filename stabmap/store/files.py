@@ -147,14 +147,15 @@ def _small_chunk_cache():
         netCDF4.set_chunk_cache(*previous)
 
 
-def read_chunks(ds: xr.Dataset, points: int = READ_CHUNK_POINTS) -> dict[str, int]:
+def read_chunks(ds: xr.Dataset, points: int | None = None) -> dict[str, int]:
     """Dask chunks for reading ``ds`` lazily: whole chunks of the file, grown to about ``points`` grid points.
 
     The file's chunks (netCDF ``chunksizes``, Zarr ``chunks``) of its largest variable are multiplied along the
     trailing dimensions first (the order in which stabmap writes, so a read stays contiguous) until a dask chunk
-    holds about ``points`` points; a file chunk already larger is kept as it is.  Every variable is read in the
+    holds about ``points`` points (default ``READ_CHUNK_POINTS``); a file chunk already larger is kept as it is.  Every variable is read in the
     same chunks, so operations between variables need no rechunking.
     """
+    points = READ_CHUNK_POINTS if points is None else points
     variables = [v for v in ds.data_vars.values() if v.ndim]
     if not variables:
         return {}
