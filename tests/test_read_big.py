@@ -169,6 +169,23 @@ def test_big_map_is_drawn_in_blocks_no_smaller_than_pixels_and_says_so(big_map):
     assert cols > box.width / 2 and rows > box.height / 2  # ... and not much larger
 
 
+def test_facet_panels_are_drawn_in_blocks_no_smaller_than_pixels(big_map):
+    import xarray as xr
+
+    part = big_map.isel(K_1=slice(0, 900))
+    three = xr.concat([part.assign_coords(m_2=m) for m in (0.5, 1.0, 2.0, 4.0)], dim="m_2").transpose("omega", "K_1", "m_2")
+    three["m_2"].attrs.update(units="kg", long_name="mass of body 2")
+    fig = atlas_figure(three)
+    fig.set_dpi(150)
+    fig.draw_without_rendering()
+    panels = fig.subfigs[0].axes
+    assert len(panels) == 4 and "3,000 × 900 grid points drawn in blocks of" in fig.subfigs[0]._suptitle.get_text().replace("\n", " ")
+    for ax in panels:
+        box = ax.get_window_extent()
+        rows, cols = [a for a in ax.get_children() if a.get_gid() == "mixed-stability-blocks"][0].get_array().shape
+        assert cols <= box.width and rows <= box.height
+
+
 def test_thin_unstable_line_is_black_in_the_picture(big_map):
     """The synthetic atlas has one omega grid value of N_c = 1 across its stable region: a line one grid value
     thin, 1/2.5 of a pixel. Drawn in blocks, it must still cross the whole map in black."""

@@ -2,7 +2,13 @@
 boundaries between classes.
 
 ``atlas_figure`` draws an atlas Dataset into a new matplotlib Figure and computes nothing: it reads
-``n_complex_pairs`` and ``decided_by`` and their coordinates. ``plot_atlas`` saves that figure to PNG or PDF.
+``n_complex_pairs`` and ``decided_by`` and their coordinates, chunk by chunk when the atlas is lazy
+(``open_atlas(path, lazy=True)``). ``plot_atlas`` saves that figure to PNG or PDF.
+
+- A map with more grid points than its pixels is drawn in blocks of grid points, no smaller than a pixel
+  (:func:`stabmap.read.blocks.reduce_blocks`): a block of one class shows it, a block holding stable and unstable
+  points is black (the stability boundary runs through it), one holding several other classes dark grey; the
+  title states the block size and this rule. Every stable/unstable boundary thus stays visible.
 
 - A 1-D atlas is a strip, a 2-D atlas one map, and an atlas with 3 or 4 axes small multiples: one panel per
   value of the third axis (the facet), and with a fourth axis one row per value of it. Evenly spaced values are
@@ -416,6 +422,9 @@ def atlas_figure(
     max_panels: int = MAX_PANELS,
 ):
     """Draw an atlas into a new matplotlib Figure (nothing is saved, nothing computed).
+
+    The atlas may be lazy (``open_atlas(path, lazy=True)``): each panel is read chunk by chunk, and a panel with
+    more grid points than pixels is drawn in blocks (module docstring), so memory stays bounded at any size.
 
     Parameters
     ----------

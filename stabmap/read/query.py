@@ -20,6 +20,10 @@ locates such ends to 1e-10 with proof (docs/critical.md). In an adaptive atlas (
 points were not computed but inferred from their grid cell's corners (``decided_by`` = inferred_from_cell_corners);
 every answer counts or flags them.
 
+**Any size.** Every question also takes a lazily opened atlas (``open_atlas(path, lazy=True)``, as ``stabmap
+query`` opens it) and reads it chunk by chunk (:mod:`stabmap.read.blocks`): memory stays bounded by a few chunks,
+whatever the size of the atlas, and the answers are those of the atlas in memory.
+
 ``stabmap.read.report.render`` turns any answer into the text, CSV or JSON that ``stabmap query`` prints.
 """
 
