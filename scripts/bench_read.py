@@ -124,7 +124,7 @@ RUN = textwrap.dedent(
 def measure(tiny: Path, big: Path, args: list[str]) -> dict:
     """Peak RSS of one command on ``big`` in a fresh process, after the same command on ``tiny``."""
     t0 = time.perf_counter()
-    res = subprocess.run([sys.executable, "-c", RUN, str(tiny), str(big), *args], capture_output=True, text=True)
+    res = subprocess.run([sys.executable, "-c", RUN, str(tiny), str(big), *args], capture_output=True, text=True, check=False)
     seconds = time.perf_counter() - t0
     if res.returncode:
         raise RuntimeError(f"{args}: {res.stderr}")
@@ -133,7 +133,7 @@ def measure(tiny: Path, big: Path, args: list[str]) -> dict:
 
 
 def _side(points: float) -> tuple[int, int]:
-    side = int(round(np.sqrt(points)))
+    side = round(float(np.sqrt(points)))
     return side, side
 
 

@@ -163,7 +163,7 @@ def test_big_map_is_drawn_in_blocks_no_smaller_than_pixels_and_says_so(big_map):
     fig.set_dpi(150)
     fig.draw_without_rendering()
     box = ax.get_window_extent()
-    mesh = [a for a in ax.get_children() if a.get_gid() == "mixed-stability-blocks"][0]
+    mesh = next(a for a in ax.get_children() if a.get_gid() == "mixed-stability-blocks")
     rows, cols = mesh.get_array().shape
     assert cols <= box.width and rows <= box.height  # no block is smaller than a pixel
     assert cols > box.width / 2 and rows > box.height / 2  # ... and not much larger
@@ -182,7 +182,7 @@ def test_facet_panels_are_drawn_in_blocks_no_smaller_than_pixels(big_map):
     assert len(panels) == 4 and "3,000 × 900 grid points drawn in blocks of" in fig.subfigs[0]._suptitle.get_text().replace("\n", " ")
     for ax in panels:
         box = ax.get_window_extent()
-        rows, cols = [a for a in ax.get_children() if a.get_gid() == "mixed-stability-blocks"][0].get_array().shape
+        rows, cols = next(a for a in ax.get_children() if a.get_gid() == "mixed-stability-blocks").get_array().shape
         assert cols <= box.width and rows <= box.height
 
 
@@ -256,7 +256,7 @@ def test_memory_does_not_grow_with_the_atlas(atlases, command, monkeypatch, tmp_
 
     monkeypatch.setattr(files, "READ_CHUNK_POINTS", 1 << 16)  # 128 KiB of labels a chunk
     argv = [a.replace("{png}", str(tmp_path / "map.png")) for a in command[1:]]
-    small, big = (_traced_peak(lambda: main([command[0], str(path), *argv])) for path in atlases)
+    small, big = (_traced_peak(lambda path=path: main([command[0], str(path), *argv])) for path in atlases)
     with stabmap.open_atlas(atlases[1], lazy=True) as ds:
         labels = ds["n_complex_pairs"].nbytes / 2**20
     assert big < small + 3, f"{command}: {small:.1f} MiB traced at 1 M points, {big:.1f} MiB at 4 M"
