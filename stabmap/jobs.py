@@ -83,7 +83,7 @@ def atlas(
             stats += f"; resumed: {report.reused} of {report.chunks} chunks were already done, {report.computed} computed now"
     lines = [f"wrote {output} in {time.perf_counter() - t0:.1f} s: {stats}"]
     if png is not None:
-        with open_atlas(output) as ds:
+        with open_atlas(output, lazy=True) as ds:
             plot_atlas(ds, png)
         lines.append(f"wrote {png}")
     return Done(lines)
@@ -189,7 +189,7 @@ def query(
                 raise StabmapError(f"{option}: name the axis to search along first, e.g. {option} omega K_1=3")
             items.insert(0, axis)
             smallest_stable = "omega"
-    ds = open_atlas(path)
+    ds = open_atlas(path, lazy=True)  # read chunk by chunk: bounded memory at any size
     if ds.attrs.get("stabmap_kind") == "critical values":
         raise StabmapError(f"{path} holds critical values, not an atlas; 'stabmap info {path}' lists its intervals")
     sel = q.parse_selection(items)
@@ -225,7 +225,7 @@ def plot(
     from .read.query import parse_selection
     from .store.files import open_atlas
 
-    ds = open_atlas(path)
+    ds = open_atlas(path, lazy=True)  # read chunk by chunk: bounded memory at any size
     chosen = parse_selection(list(sel), ranges=False, option="--sel")
     if ds.attrs.get("stabmap_kind") == "critical values":
         given = [opt for opt, v in (("--x", x), ("--y", y), ("--facet", facet), ("--max-panels", max_panels)) if v is not None]

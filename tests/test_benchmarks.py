@@ -81,3 +81,12 @@ def test_bench_exact_quick(capsys):
     assert [r["degree"] for r in rows] == [6, 12]
     assert all(r["total"] >= r["roots"] > 0 and r["before"] > 0 for r in rows)
     assert "| n | modes | degree |" in capsys.readouterr().out
+
+
+def test_bench_read_quick(capsys):
+    out = runpy.run_path(str(SCRIPTS / "bench_read.py"))["main"](["--quick"])
+    assert [(r["format"], r["command"]) for r in out["rows"]] == [
+        (f, c) for f in ("nc", "zarr") for c in ("info", "query --boundaries omega", "plot")
+    ]
+    assert all(r["points"] == 1_000_000 and r["peak_mib"] >= r["startup_mib"] > 0 for r in out["rows"])
+    assert "| format | points | command |" in capsys.readouterr().out

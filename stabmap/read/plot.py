@@ -2,7 +2,13 @@
 boundaries between classes.
 
 ``atlas_figure`` draws an atlas Dataset into a new matplotlib Figure and computes nothing: it reads
-``n_complex_pairs`` and ``decided_by`` and their coordinates. ``plot_atlas`` saves that figure to PNG or PDF.
+``n_complex_pairs`` and ``decided_by`` and their coordinates, chunk by chunk when the atlas is lazy
+(``open_atlas(path, lazy=True)``). ``plot_atlas`` saves that figure to PNG or PDF.
+
+- A map with more grid points than its pixels is drawn in blocks of grid points, no smaller than a pixel
+  (:func:`stabmap.read.blocks.reduce_blocks`): a block of one class shows it, a block holding stable and unstable
+  points is black (the stability boundary runs through it), one holding several other classes dark grey; the
+  title states the block size and this rule. Every stable/unstable boundary thus stays visible.
 
 - A 1-D atlas is a strip, a 2-D atlas one map, and an atlas with 3 or 4 axes small multiples: one panel per
   value of the third axis (the facet), and with a fourth axis one row per value of it. Evenly spaced values are
@@ -33,6 +39,7 @@ from ..errors import StabmapError
 from .. import systems
 from ..store.files import check_writable
 from ..store.variables import INFERRED
+from .blocks import block_factors, reduce_blocks
 
 MAX_PANELS = 12  # default limit of small multiples
 _LEGEND_WIDTH = 2.5  # [inch] beside small multiples
@@ -50,6 +57,14 @@ _HATCH_INFERRED = "////"
 _HATCH_DEGENERATE = "xxxx"
 _HATCH_RUNS = 100_000  # more separate runs of inferred cells than this: a light veil instead of a hatch
 _VECTOR_RUNS = 20_000  # a panel with more runs of equal cells along x is filled as an image (lines and text stay vector)
+_DPI = 150  # of a PNG; a map with more grid points than its pixels at this resolution is drawn in blocks
+# Lower bounds of the room the layout leaves a map [inch] (checked against the drawn figures in tests/test_plot.py)
+_SINGLE_MARGIN = 3.6  # a single map: figure width less the legend, the y label and the margins
+_SINGLE_HEIGHT = 3.2  # a single map: figure height less the title (up to 7 lines) and the x label
+_FACET_MARGIN = 0.9  # small multiples: the supylabel and margins
+_PANEL_GAP = 0.35  # between panels, and their tick labels
+_PANEL_HEIGHT = 2.3  # a row of small multiples
+_PANEL_TITLE = 0.75  # the panel's title and tick labels
 
 
 
@@ -238,7 +253,9 @@ def _segments(mask_v: np.ndarray, mask_h: np.ndarray, xe: np.ndarray, ye: np.nda
     return np.concatenate([vertical.reshape(-1, 2, 2), horizontal.reshape(-1, 2, 2)])
 
 
-def cell_edge_boundaries(values: np.ndarray, xedges: np.ndarray, yedges: np.ndarray, stable: int | None = 0) -> tuple[np.ndarray, np.ndarray]:
+def cell_edge_boundaries(
+    values: np.ndarray, xedges: np.ndarray, yedges: np.ndarray, stable: int | None = 0, *, state: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Boundaries of a 2-D class map on the edges of its grid cells.
 
     Parameters
@@ -250,13 +267,18 @@ def cell_edge_boundaries(values: np.ndarray, xedges: np.ndarray, yedges: np.ndar
 
     Returns
     -------
+    state : array of int, shape (ny, nx), optional
+        Stability per cell (default: ``values == stable``); a thick line runs where it differs.
+
+    Returns
+    -------
     stability, classes : arrays of float, shape (k, 2, 2)
         Segments ``[[x0, y0], [x1, y1]]`` on every edge between two neighbouring cells where exactly one is
         stable (N_c = 0), and on every other edge where N_c differs. Collinear neighbouring segments are joined.
     """
     v = np.asarray(values)
     xe, ye = np.asarray(xedges, dtype=float), np.asarray(yedges, dtype=float)
-    stable = v == stable
+    stable = v == stable if state is None else np.asarray(state)
     dv, dh = v[:, 1:] != v[:, :-1], v[1:, :] != v[:-1, :]
     sv, sh = stable[:, 1:] != stable[:, :-1], stable[1:, :] != stable[:-1, :]
     return _segments(sv, sh, xe, ye), _segments(dv & ~sv, dh & ~sh, xe, ye)
@@ -330,6 +352,15 @@ def _overlay(ax, mask: np.ndarray, xe: np.ndarray, ye: np.ndarray, gid: str) -> 
     return False
 
 
+def _paint(ax, mask: np.ndarray, xe: np.ndarray, ye: np.ndarray, colour_: str, gid: str) -> None:
+    """Fill the marked cells in one colour, as an image (blocks of a reduced map: about one pixel each)."""
+    from matplotlib.colors import ListedColormap
+
+    cells = np.ma.masked_where(~mask, np.ones(mask.shape))
+    mesh = ax.pcolormesh(xe, ye, cells, cmap=ListedColormap([colour_]), vmin=0, vmax=1, shading="flat", rasterized=True, zorder=2.5)
+    mesh.set_gid(gid)
+
+
 def _white_cmap():
     from matplotlib.colors import ListedColormap
 
@@ -396,6 +427,9 @@ def atlas_figure(
 ):
     """Draw an atlas into a new matplotlib Figure (nothing is saved, nothing computed).
 
+    The atlas may be lazy (``open_atlas(path, lazy=True)``): each panel is read chunk by chunk, and a panel with
+    more grid points than pixels is drawn in blocks (module docstring), so memory stays bounded at any size.
+
     Parameters
     ----------
     ds : xarray.Dataset
@@ -438,28 +472,14 @@ def atlas_figure(
     order = (plan.y, plan.x) if plan.y else (plan.x,)
     panels = [(r, c) for r in (plan.row_index or (None,)) for c in (plan.facet_index or (None,))]
 
-    def cut(da, r, c):
+    def cut(da, r, c):  # one panel's map as (y, x), still lazy for a lazy atlas
         sl = {}
         if r is not None:
             sl[plan.row] = r
         if c is not None:
             sl[plan.facet] = c
-        a = np.asarray(da.isel(sl).transpose(*order))
+        a = da.isel(sl).transpose(*order).data
         return a if plan.y else a[None, :]
-
-    data = [cut(nc, r, c) for r, c in panels]
-    inferred = [cut(by, r, c) == inferred_value if inferred_value is not None else None for r, c in panels]
-    everything = np.concatenate([d.ravel() for d in data])
-    present = sorted(int(v) for v in np.unique(everything))
-    top = max(1, present[-1])
-    bottom = min(-1, present[0])
-    stable, absent, undecided = system.stable_label, system.absent_label, system.undecided_label
-    cmap = ListedColormap([colour(v, stable, absent, undecided) for v in range(bottom, top + 1)])
-    norm = BoundaryNorm(np.arange(bottom - 0.5, top + 1.5), cmap.N)
-
-    xs = np.asarray(ds[plan.x], dtype=float)
-    xe = _edges(xs, "log" if _log_axis(ds, plan.x) else None)
-    ye = _edges(np.asarray(ds[plan.y], dtype=float), "log" if _log_axis(ds, plan.y) else None) if plan.y else np.array([0.0, 1.0])
 
     if plan.row is not None:
         nrows, ncols = len(plan.row_index), len(plan.facet_index)
@@ -470,7 +490,32 @@ def atlas_figure(
     else:
         nrows = ncols = 1
     width = 7.5 if plan.facet is None else max(3.5, 2.6 * ncols + 0.9) + _LEGEND_WIDTH
-    title = _title(ds, plan, None if stable is None else everything == stable, everything.size, 70 if plan.facet is None else int(12 * (width - _LEGEND_WIDTH)))
+
+    # Each panel is read once, chunk by chunk, and reduced to at most one block of grid points per pixel.
+    stable, absent, undecided = system.stable_label, system.absent_label, system.undecided_label
+    shape = (ds.sizes[plan.y] if plan.y else 1, ds.sizes[plan.x])
+    factors = block_factors(shape, panel_pixels(width, nrows, ncols, facets=plan.facet is not None, strip=plan.y is None))
+    data = [
+        reduce_blocks(cut(nc, r, c), None if inferred_value is None else cut(by, r, c) == inferred_value, stable, factors)
+        for r, c in panels
+    ]
+    totals: dict[int, int] = {}
+    for d in data:
+        for v, n in d.counts.items():
+            totals[v] = totals.get(v, 0) + n
+    present = sorted(totals)
+    points = sum(totals.values())
+    top = max(1, present[-1])
+    bottom = min(-1, present[0])
+    cmap = ListedColormap([colour(v, stable, absent, undecided) for v in range(bottom, top + 1)])
+    norm = BoundaryNorm(np.arange(bottom - 0.5, top + 1.5), cmap.N)
+
+    xs = np.asarray(ds[plan.x], dtype=float)
+    xe = _edges(xs, "log" if _log_axis(ds, plan.x) else None)
+    ye = _edges(np.asarray(ds[plan.y], dtype=float), "log" if _log_axis(ds, plan.y) else None) if plan.y else np.array([0.0, 1.0])
+    xe, ye = _block_edges(xe, factors[1]), _block_edges(ye, factors[0]) if plan.y else ye
+    n_stable = None if stable is None else totals.get(stable, 0)
+    title = _title(ds, plan, n_stable, points, 70 if plan.facet is None else int(12 * (width - _LEGEND_WIDTH)), factors, shape)
     lines = title.count("\n") + 1
     if plan.facet is None:
         size = (width, 5.2) if plan.y else (width, max(1.4 + 0.17 * lines, 0.22 * (len(present) + 4)) + 0.6)
@@ -487,13 +532,18 @@ def atlas_figure(
         ax.remove()
 
     drawn = {"stability": False, "classes": False, "inferred": False, "light": False}
-    for ax, values, inf, (r, c) in zip(axes, data, inferred, panels):
+    for ax, blocks, (r, c) in zip(axes, data, panels):
+        values, mixed = blocks.low, blocks.mixed
         _fill(ax, values, xe, ye, cmap, norm, stable, absent, undecided)
-        for mask, gid in ((inf, "inferred-cells"), ((values < 0) & (values != absent), "degenerate-cells")):
+        for mask, gid in ((blocks.any_flag, "inferred-cells"), ((values < 0) & (values != absent) & ~mixed, "degenerate-cells")):
             if mask is not None and mask.any():
                 drawn["inferred"] |= gid == "inferred-cells"
                 drawn["light"] |= _overlay(ax, mask, xe, ye, gid)
-        stab, other = cell_edge_boundaries(values, xe, ye, stable)
+        codes, state = _block_classes(blocks, stable)
+        for mask, col, gid in ((mixed & ~blocks.mixed_stability, _CLASS_EDGE, "mixed-class-blocks"), (blocks.mixed_stability, _BOUNDARY, "mixed-stability-blocks")):
+            if mask.any():
+                _paint(ax, mask, xe, ye, col, gid)
+        stab, other = cell_edge_boundaries(codes, xe, ye, stable, state=state)
         for segs, width, col, gid in ((other, 0.6, _CLASS_EDGE, "class-boundary"), (stab, 1.5, _BOUNDARY, "stability-boundary")):
             lines = LineCollection(segs, colors=col, linewidths=width, capstyle="projecting", joinstyle="miter", zorder=3 + (gid == "stability-boundary"))
             lines.set_gid(gid)
@@ -505,7 +555,7 @@ def atlas_figure(
             if plan.row is not None:
                 parts.append(_value_text(ds, plan.row, float(ds[plan.row][r])))
             if stable is not None:
-                parts.append(f"{100 * float(np.mean(values == stable)):.0f} % stable")
+                parts.append(f"{100 * blocks.counts.get(stable, 0) / sum(blocks.counts.values()):.0f} % stable")
                 ax.set_title("\n".join([", ".join(parts[:-1]), parts[-1]]) if plan.row is not None else f"{parts[0]}  ({parts[1]})", fontsize=9)
             else:  # a system without stability: the panel's coordinates only
                 ax.set_title("\n".join(parts), fontsize=9)
@@ -564,13 +614,15 @@ def atlas_figure(
     return fig
 
 
-def _title(ds: xr.Dataset, plan: FigurePlan, stable: np.ndarray | None, points: int, chars: int) -> str:
-    """The atlas title, the stable fraction of the ``points`` shown (``stable``: a mask of them; None for a
-    system without stability), the fixed axes, the panels and the notes."""
+def _title(
+    ds: xr.Dataset, plan: FigurePlan, stable: int | None, points: int, chars: int, factors: tuple[int, int] = (1, 1), shape: tuple[int, int] = (1, 1)
+) -> str:
+    """The atlas title, the stable fraction of the ``points`` shown (``stable``: how many are stable; None for a
+    system without stability), the fixed axes, the panels, the notes and the rule that reduced a large grid."""
     title = [textwrap.fill(ds.attrs.get("title", "") or "stabmap atlas", chars)]
     part = plan.facet is not None or bool(plan.fixed)
     if stable is not None:
-        title.append(f"{100 * float(np.mean(stable)):.1f} % of {'the ' if part else ''}{points:,} grid points{' shown' if part else ''} stable")
+        title.append(f"{100 * stable / points:.1f} % of {'the ' if part else ''}{points:,} grid points{' shown' if part else ''} stable")
     else:
         title.append(f"{points:,} grid points{' shown' if part else ''}")
     if plan.fixed:
@@ -584,7 +636,57 @@ def _title(ds: xr.Dataset, plan: FigurePlan, stable: np.ndarray | None, points: 
     if plan.facet is not None:
         title.append(textwrap.fill("panels: " + " × ".join(axis_label(ds, d, width=500) for d in (plan.facet, plan.row) if d), chars))
     title.extend(textwrap.fill(note, chars) for note in plan.notes)
+    if factors != (1, 1):
+        title.append(textwrap.fill(reduction_note(ds, plan, factors, shape), chars))
     return "\n".join(title)
+
+
+def reduction_note(ds: xr.Dataset, plan: FigurePlan, factors: tuple[int, int], shape: tuple[int, int]) -> str:
+    """The caption line of a reduced map: how many grid points a block holds and how a block is coloured."""
+    fy, fx = factors
+    size = f"{fx} × {fy}" if plan.y else f"{fx}"
+    grid = f"{shape[1]:,} × {shape[0]:,}" if plan.y else f"{shape[1]:,}"
+    stable = systems.of_atlas(ds.attrs).stable_label is not None
+    mixed = "black if it holds stable and unstable points, dark grey if several other classes" if stable else "dark grey if it holds several classes"
+    return f"{grid} grid points drawn in blocks of {size}: a block shows its class where all its points agree, {mixed}"
+
+
+def panel_pixels(width: float, nrows: int, ncols: int, *, facets: bool, strip: bool, dpi: int = _DPI) -> tuple[int, int]:
+    """Pixels of one map of a figure ``width`` inches wide, along (y, x): a lower bound of what the layout gives.
+
+    A map of more grid points than this is drawn in blocks (:func:`stabmap.read.blocks.block_factors`), so that
+    no block is smaller than a pixel and none can vanish between pixels.
+    """
+    if not facets:
+        maps = (1 if strip else _SINGLE_HEIGHT, width - _SINGLE_MARGIN)
+    else:
+        maps = ((_PANEL_HEIGHT - _PANEL_TITLE) * 1.0, (width - _LEGEND_WIDTH - _FACET_MARGIN) / ncols - _PANEL_GAP)
+    return tuple(max(1, int(dpi * v)) for v in maps)
+
+
+def _block_edges(edges: np.ndarray, k: int) -> np.ndarray:
+    """Edges of blocks of ``k`` cells from the cells' edges: every k-th edge and the last."""
+    n = len(edges) - 1
+    return edges[np.r_[0:n:k, n]]
+
+
+def _block_classes(blocks, stable: int | None) -> tuple[np.ndarray, np.ndarray]:
+    """Codes and stability states of the blocks, for drawing boundaries between blocks.
+
+    A block of one label keeps it as its code; a block of several labels gets a code of its own (one for those
+    holding stable and unstable points, one for the others), so that a line runs wherever the codes of
+    neighbouring blocks differ. The state is 1 for a stable block, 2 for a block holding stable and unstable
+    points, 0 otherwise: a thick line runs wherever the states differ, so a block holding a stability boundary is
+    drawn black between two thick lines.
+    """
+    codes = blocks.low.astype(np.int64)
+    top = int(max(blocks.high.max(initial=0), 0))
+    codes[blocks.mixed] = top + 1
+    codes[blocks.mixed_stability] = top + 2
+    if stable is None:
+        return codes, np.zeros(codes.shape, dtype=np.int8)
+    state = np.where(blocks.mixed_stability, 2, (blocks.low == stable) & ~blocks.mixed).astype(np.int8)
+    return codes, state
 
 
 def plot_atlas(

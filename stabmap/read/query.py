@@ -20,6 +20,10 @@ locates such ends to 1e-10 with proof (docs/critical.md). In an adaptive atlas (
 points were not computed but inferred from their grid cell's corners (``decided_by`` = inferred_from_cell_corners);
 every answer counts or flags them.
 
+**Any size.** Every question also takes a lazily opened atlas (``open_atlas(path, lazy=True)``, as ``stabmap
+query`` opens it) and reads it chunk by chunk (:mod:`stabmap.read.blocks`): memory stays bounded by a few chunks,
+whatever the size of the atlas, and the answers are those of the atlas in memory.
+
 ``stabmap.read.report.render`` turns any answer into the text, CSV or JSON that ``stabmap query`` prints.
 """
 
@@ -34,6 +38,7 @@ import xarray as xr
 from .. import systems
 from ..errors import StabmapError
 from ..store.variables import INFERRED
+from .blocks import changes, compute, first_true
 
 CRITICAL_HINT = "'stabmap critical SCENE --along {along}' locates the ends to 1e-10 (docs/critical.md)"
 
@@ -224,7 +229,7 @@ def select(ds: xr.Dataset, sel: dict, *, along: str | None = None) -> tuple[xr.D
                     f"{name} in [{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}] holds no grid "
                     f"value; the {grid.size} grid values of {name} run from {grid.min():.8g} to {grid.max():.8g} {units}".rstrip()
                 )
-            index[name] = np.flatnonzero(keep)
+            index[name] = _contiguous(np.flatnonzero(keep))
             axes[name] = AxisSelection(name, units, requested, tuple(float(v) for v in grid[keep]))
         else:
             if name == along:
@@ -240,6 +245,13 @@ def select(ds: xr.Dataset, sel: dict, *, along: str | None = None) -> tuple[xr.D
         if d not in axes:
             axes[d] = AxisSelection(d, str(ds[d].attrs.get("units", "")), None, tuple(float(v) for v in ds[d].values))
     return (ds.isel(index) if index else ds), {d: axes[d] for d in dims}
+
+
+def _contiguous(index: np.ndarray) -> np.ndarray | slice:
+    """A run of consecutive indices as a slice (a lazy atlas then reads only that part of each chunk)."""
+    if index.size and index[-1] - index[0] == index.size - 1:
+        return slice(int(index[0]), int(index[-1]) + 1)
+    return index
 
 
 def _fixed_names(axes: dict[str, AxisSelection]) -> str:
@@ -275,6 +287,7 @@ def label_at(ds: xr.Dataset, **point: float) -> Label:
         d for d in dims if not float(ds[d].min()) <= float(point[d]) <= float(ds[d].max())
     )
     system = systems.of_atlas(ds.attrs)
+    sel, = compute(sel)  # one point of every variable: a lazy atlas reads one chunk of each
     values = {}
     for v in system.variables:
         if v.name in sel:
@@ -313,20 +326,27 @@ def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
     """
     sub, axes = select(ds, sel)
     system = _stable_system(ds, "the stable fraction")
-    nc = np.asarray(sub[system.label].values).ravel()
-    inferred = _inferred(sub, system).values.ravel()
+    nc = sub[system.label].data
+    inferred = _inferred(sub, system).data
     stable = nc == system.stable_label
+    absent = nc == system.absent_label if system.absent_label is not None else np.zeros((), dtype=bool)
+    undecided = nc == system.undecided_label if system.undecided_label is not None else np.zeros((), dtype=bool)
+    # One pass over the slice, chunk by chunk: every count reads the same chunks.
+    counts = compute(stable.sum(), (~stable & (nc >= 0)).sum(), ((nc < 0) & ~absent & ~undecided).sum(), inferred.sum(),
+                     (inferred & stable).sum(), absent.sum(), undecided.sum())
+    n_stable, unstable, degenerate, n_inferred, inferred_stable, n_absent, n_undecided = (int(c) for c in counts)
+    points = int(nc.size)
     return StableFraction(
-        fraction=float(stable.mean()),
-        stable=int(stable.sum()),
-        points=int(nc.size),
-        unstable=int((~stable & (nc >= 0)).sum()),
-        degenerate=int(((nc < 0) & (nc != system.absent_label) & (nc != system.undecided_label)).sum()),
-        inferred=int(inferred.sum()),
-        inferred_stable=int((inferred & stable).sum()),
+        fraction=n_stable / points,
+        stable=n_stable,
+        points=points,
+        unstable=unstable,
+        degenerate=degenerate,
+        inferred=n_inferred,
+        inferred_stable=inferred_stable,
         axes=axes,
-        absent=int((nc == system.absent_label).sum()) if system.absent_label is not None else None,
-        undecided=int((nc == system.undecided_label).sum()) if system.undecided_label is not None else None,
+        absent=n_absent if system.absent_label is not None else None,
+        undecided=n_undecided if system.undecided_label is not None else None,
     )
 
 
@@ -344,13 +364,17 @@ def _stable_system(ds: xr.Dataset, question: str):
     return system
 
 
-def _lines(sub: xr.Dataset, along: str) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray]:
-    """Other axes, the ascending grid of ``along``, and the label and the inferred flag as (other axes..., along)."""
+def _lines(sub: xr.Dataset, along: str) -> tuple[list[str], np.ndarray, object, object]:
+    """Other axes, the ascending grid of ``along``, and the label and the inferred flag as (other axes..., along).
+
+    The two arrays are those of the Dataset, transposed: dask arrays (not read yet) for a lazy atlas.
+    """
     system = systems.of_atlas(sub.attrs)
-    sub = sub.sortby(along)
+    if not sub.indexes[along].is_monotonic_increasing:
+        sub = sub.sortby(along)
     others = [d for d in sub[system.label].dims if d != along]
-    nc = sub[system.label].transpose(*others, along).values
-    inferred = _inferred(sub, system).transpose(*others, along).values
+    nc = sub[system.label].transpose(*others, along).data
+    inferred = _inferred(sub, system).transpose(*others, along).data
     return others, np.asarray(sub[along].values, dtype=np.float64), nc, inferred
 
 
@@ -408,9 +432,9 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
     others, x, nc, inferred = _lines(sub, along)
     lab = systems.of_atlas(ds.attrs).label
     shape = nc.shape[:-1]
-    nc2, inf2 = nc.reshape(-1, x.size), inferred.reshape(-1, x.size)
-    line, k = np.nonzero(nc2[:, 1:] != nc2[:, :-1])
-    position = np.unravel_index(line, shape) if others else ()
+    where, below, above, inferred_below, inferred_above = changes(nc, inferred)  # chunk by chunk
+    position, k = where[:-1], where[-1]
+    line = np.ravel_multi_index(position, shape) if others else np.zeros(k.size, dtype=np.intp)
     units = str(ds[along].attrs.get("units", ""))
 
     def var(values, long_name, **attrs):
@@ -422,10 +446,10 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
         {
             "boundary_lower": var(x[k], f"{along} at the grid value below the change of {lab}", units=units),
             "boundary_upper": var(x[k + 1], f"{along} at the grid value above the change of {lab}", units=units),
-            f"{lab}_below": var(nc2[line, k], f"{lab} at boundary_lower", units="1"),
-            f"{lab}_above": var(nc2[line, k + 1], f"{lab} at boundary_upper", units="1"),
-            "inferred_below": var(inf2[line, k], "boundary_lower was not computed (inferred from its grid cell's corners)"),
-            "inferred_above": var(inf2[line, k + 1], "boundary_upper was not computed (inferred from its grid cell's corners)"),
+            f"{lab}_below": var(below, f"{lab} at boundary_lower", units="1"),
+            f"{lab}_above": var(above, f"{lab} at boundary_upper", units="1"),
+            "inferred_below": var(inferred_below, "boundary_lower was not computed (inferred from its grid cell's corners)"),
+            "inferred_above": var(inferred_above, "boundary_upper was not computed (inferred from its grid cell's corners)"),
         },
         coords=coords,
     )
@@ -508,17 +532,10 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
                 f"smallest_stable over {over!r}: fix the other axes as well ({example}, or any grid value), "
                 "or leave out over to get one answer per point of every remaining axis"
             )
-    stable = nc == system.stable_label
-    has = stable.any(axis=-1)
-    first = np.argmax(stable, axis=-1)
+    found = first_true(nc == system.stable_label, nc, inferred, label.fill)  # two passes, chunk by chunk
+    has, first = found.has, found.first
     below = np.maximum(first - 1, 0)
     has_below = has & (first > 0)
-
-    def at(a, i):
-        return np.take_along_axis(a, i[..., None], axis=-1)[..., 0]
-
-    # stable from each grid value to the end of the scan
-    tail = np.flip(np.logical_and.accumulate(np.flip(stable, axis=-1), axis=-1), axis=-1)
     units = str(ds[along].attrs.get("units", ""))
 
     def var(values, long_name, **attrs):
@@ -531,12 +548,12 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
             "smallest_stable": var(np.where(has, x[first], np.nan), f"smallest stable {along}", units=units),
             "unstable_below": var(np.where(has_below, x[below], np.nan), f"unstable {along} just below the smallest stable one", units=units),
             f"{label.name}_below": var(
-                np.where(has_below, at(nc, below), label.fill).astype(nc.dtype), f"{label.name} at unstable_below", units="1",
+                found.value_before, f"{label.name} at unstable_below", units="1",
                 comment=f"{label.fill} where there is no unstable_below",
             ),
-            "stable_to_scan_end": var(has & at(tail, first), f"stable at every grid value of {along} from smallest_stable to the end of the searched range"),
-            "inferred": var(has & at(inferred, first), "smallest_stable was not computed (inferred from its grid cell's corners)"),
-            "inferred_below": var(has_below & at(inferred, below), "unstable_below was not computed (inferred from its grid cell's corners)"),
+            "stable_to_scan_end": var(found.true_to_end, f"stable at every grid value of {along} from smallest_stable to the end of the searched range"),
+            "inferred": var(found.flag_at, "smallest_stable was not computed (inferred from its grid cell's corners)"),
+            "inferred_below": var(found.flag_before, "unstable_below was not computed (inferred from its grid cell's corners)"),
         },
         coords=coords,
     )

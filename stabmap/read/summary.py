@@ -2,23 +2,16 @@
 
 from __future__ import annotations
 
-import numpy as np
 import xarray as xr
 
 from .. import systems
 
 
 def _counts(values) -> dict[int, int]:
-    """How often each value occurs; a dask array is counted chunk by chunk."""
-    if hasattr(values, "dask"):
-        import dask
-        import dask.array as da
+    """How often each value occurs; a dask array is counted chunk by chunk (:func:`stabmap.read.blocks.counts`)."""
+    from .blocks import counts
 
-        with dask.config.set(scheduler="synchronous"):  # one chunk in memory at a time
-            unique, counts = dask.compute(*da.unique(values.ravel(), return_counts=True))
-    else:
-        unique, counts = np.unique(np.asarray(values), return_counts=True)
-    return {int(v): int(c) for v, c in zip(unique, counts)}
+    return counts(values)
 
 
 def summary(ds: xr.Dataset) -> dict:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import math
 import os
 import shutil
 from pathlib import Path
@@ -88,13 +90,11 @@ def write_streamed(ds: xr.Dataset, path: Path) -> Path:
     # Synchronous: the chunks are on this machine, and one chunk at a time bounds the memory. Each netCDF
     # chunk is written once, whole, so netCDF's chunk cache (64 MiB a variable by default, the largest use of
     # memory here) only needs to hold one.
-    previous = netCDF4.get_chunk_cache()
-    netCDF4.set_chunk_cache(NETCDF_CHUNK_CACHE)
-    try:
-        with dask.config.set(scheduler="synchronous"):
-            return write_atlas(ds, path)
-    finally:
-        netCDF4.set_chunk_cache(*previous)
+    with _small_chunk_cache(), dask.config.set(scheduler="synchronous"):
+        return write_atlas(ds, path)
+
+
+READ_CHUNK_POINTS = 1 << 20  # grid points per dask chunk of a lazily opened atlas (a few MiB per variable)
 
 
 def open_atlas(path: str | Path, *, lazy: bool = False) -> xr.Dataset:
@@ -102,16 +102,27 @@ def open_atlas(path: str | Path, *, lazy: bool = False) -> xr.Dataset:
 
     By default it is loaded into memory and the file closed on return.  With ``lazy`` the variables are dask
     arrays read chunk by chunk as they are used (bounded memory for any size); close the Dataset after use.
+    A lazy chunk holds whole chunks of the file, about ``READ_CHUNK_POINTS`` grid points (:func:`read_chunks`),
+    so that neither one chunk nor the number of chunks grows with the atlas.
     """
     path = Path(path)
     zarr = is_zarr(path) and path.is_dir()
     if not (path.is_file() or zarr):
         raise StabmapError(f"atlas file {str(path)!r} does not exist")
+
+    def opened(chunks):
+        if zarr:
+            return xr.open_zarr(path, consolidated=False, chunks=chunks)
+        return xr.open_dataset(path, engine="netcdf4", chunks=chunks, cache=not lazy)
+
     try:
-        chunks = {} if lazy else None  # {}: dask arrays in the file's own chunks
-        ds = xr.open_zarr(path, consolidated=False, chunks=chunks) if zarr else xr.open_dataset(path, engine="netcdf4", chunks=chunks)
-        if not lazy:
-            with ds:
+        if lazy:
+            with opened(None) as plain:  # metadata only: the file's own chunks
+                chunks = read_chunks(plain)
+            with _small_chunk_cache():  # netCDF fixes each variable's chunk cache when it opens the file
+                ds = opened(chunks)
+        else:
+            with opened(None) as ds:
                 ds = ds.load()
     except (OSError, ValueError, KeyError) as exc:
         raise StabmapError(f"cannot read {str(path)!r} as a {'Zarr' if zarr else 'netCDF'} atlas: {exc}") from None
@@ -119,3 +130,45 @@ def open_atlas(path: str | Path, *, lazy: bool = False) -> xr.Dataset:
         ds.close()
         raise StabmapError(f"{str(path)!r} is a netCDF file but not a stabmap atlas (no stabmap_format_version)")
     return ds
+
+
+@contextlib.contextmanager
+def _small_chunk_cache():
+    """netCDF's chunk cache lowered to ``NETCDF_CHUNK_CACHE`` for the files opened meanwhile.
+
+    A lazy atlas is read one dask chunk at a time, each chunk of the file once, so the cache gains nothing; at
+    its default size (64 MiB a variable) it would keep up to that much of every variable read.
+    """
+    previous = netCDF4.get_chunk_cache()
+    netCDF4.set_chunk_cache(NETCDF_CHUNK_CACHE)
+    try:
+        yield
+    finally:
+        netCDF4.set_chunk_cache(*previous)
+
+
+def read_chunks(ds: xr.Dataset, points: int | None = None) -> dict[str, int]:
+    """Dask chunks for reading ``ds`` lazily: whole chunks of the file, grown to about ``points`` grid points.
+
+    The file's chunks (netCDF ``chunksizes``, Zarr ``chunks``) of its largest variable are multiplied along the
+    trailing dimensions first (the order in which stabmap writes, so a read stays contiguous) until a dask chunk
+    holds about ``points`` points (default ``READ_CHUNK_POINTS``); a file chunk already larger is kept as it is.  Every variable is read in the
+    same chunks, so operations between variables need no rechunking.
+    """
+    points = READ_CHUNK_POINTS if points is None else points
+    variables = [v for v in ds.data_vars.values() if v.ndim]
+    if not variables:
+        return {}
+    big = max(variables, key=lambda v: v.size)
+    preferred = big.encoding.get("preferred_chunks") or {}
+    disk = [int(preferred.get(d, n)) for d, n in big.sizes.items()]
+    shape = list(big.sizes.values())
+    chunks = list(disk)
+    for i in reversed(range(len(shape))):
+        rest = math.prod(chunks) // chunks[i]
+        k = max(1, points // max(1, rest * chunks[i]))
+        chunks[i] = min(shape[i], chunks[i] * k)
+    out = dict(zip(big.dims, chunks))
+    for v in variables:  # dimensions of other variables (e.g. per node) are read whole
+        out.update({d: out.get(d, n) for d, n in v.sizes.items()})
+    return out

@@ -1,0 +1,232 @@
+"""Reading an atlas in chunks: the few passes over its labels that ``info``, ``query`` and ``plot`` need.
+
+Every function here takes plain arrays, numpy or dask (a lazily opened atlas, ``open_atlas(path, lazy=True)``),
+and runs over them one chunk at a time (dask's synchronous scheduler), so the memory they use is bounded by a few
+chunks, whatever the size of the atlas. Their results are small: counts, one value per line or per pixel block,
+or the positions of the label's changes (as many as there are boundaries).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import dask
+import dask.array as da
+import numpy as np
+
+
+def compute(*objects):
+    """``objects`` (dask, xarray or numpy) computed together, one chunk in memory at a time; numpy passes through.
+
+    Objects that read the same variable share its reads: each chunk is read once for all of them.
+    """
+    with dask.config.set(scheduler="synchronous"):
+        return dask.compute(*objects)
+
+
+def as_dask(a) -> da.Array:
+    """A dask array of ``a``: itself if it is one, else one chunk of it (the same code runs on both)."""
+    return a if isinstance(a, da.Array) else da.from_array(np.asarray(a), chunks=-1)
+
+
+# ---------------------------------------------------------------------------------------------------- along lines
+def changes(values, flags) -> tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Every change of ``values`` between neighbours along the last axis, in C order.
+
+    Parameters
+    ----------
+    values : array of int, shape (..., n)
+        A label, the axis searched last.
+    flags : array of bool, same shape
+        A per-point flag carried along (e.g. "inferred").
+
+    Returns
+    -------
+    position, below, above, flag_below, flag_above
+        ``position``: one index array per axis of the change's lower point (its upper point is one further along
+        the last axis); the labels and flags at the two points.
+    """
+    v = as_dask(values)
+    f = as_dask(flags).rechunk(v.chunks)
+    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in v.chunks]
+    vs, fs = v.to_delayed(), f.to_delayed()
+    parts = []
+    for block in np.ndindex(*v.numblocks):  # each chunk with the last point of the one before it along the line
+        offset = tuple(int(s[b]) for s, b in zip(starts, block))
+        before = block[:-1] + (block[-1] - 1,) if block and block[-1] > 0 else None
+        parts.append(dask.delayed(_block_changes)(vs[block], fs[block], before and vs[before], before and fs[before], offset))
+    found = compute(*parts)
+    if not found:
+        return tuple(np.zeros(0, dtype=np.intp) for _ in range(v.ndim)), *(np.zeros(0, dtype=a.dtype) for a in (v, v, f, f))
+    position = tuple(np.concatenate([p[0][k] for p in found]) for k in range(v.ndim))
+    order = np.lexsort(position[::-1])  # C order: the first axis slowest
+    position = tuple(p[order] for p in position)
+    rest = [np.concatenate([p[k] for p in found])[order] for k in range(1, 5)]
+    return position, *rest
+
+
+def _block_changes(v, f, v_before, f_before, offset):
+    """The changes along the last axis inside one chunk, and between it and the chunk before (``*_before``)."""
+    if v_before is not None:
+        v = np.concatenate([v_before[..., -1:], v], axis=-1)
+        f = np.concatenate([f_before[..., -1:], f], axis=-1)
+        offset = offset[:-1] + (offset[-1] - 1,)
+    where = np.nonzero(v[..., 1:] != v[..., :-1])
+    above = where[:-1] + (where[-1] + 1,)
+    return tuple(w + o for w, o in zip(where, offset)), v[where], v[above], f[where], f[above]
+
+
+@dataclass(frozen=True)
+class FirstTrue:
+    """Per line (all axes but the last) of a mask: where it is first True, and what lies there and just before."""
+
+    has: np.ndarray  # bool: the line holds a True
+    first: np.ndarray  # index of the first True (0 where none)
+    true_to_end: np.ndarray  # bool: True from ``first`` to the end of the line
+    value_before: np.ndarray  # values[first - 1]; ``fill`` where first == 0 or nothing is True
+    flag_at: np.ndarray  # flags[first] (False where nothing is True)
+    flag_before: np.ndarray  # flags[first - 1] (False where there is no such point)
+
+
+def first_true(mask, values, flags, fill) -> FirstTrue:
+    """The first True of ``mask`` along its last axis, per line, with ``values`` and ``flags`` there and before.
+
+    Two passes over the arrays (chunk by chunk): one finds the first True and the last False of every line,
+    the second picks the values at and before it.
+    """
+    m, v, f = as_dask(mask), as_dask(values), as_dask(flags)
+    n = m.shape[-1]
+    index = da.arange(n, chunks=m.chunks[-1])
+    has, first, last_false = compute(m.any(axis=-1), m.argmax(axis=-1), da.where(~m, index, -1).max(axis=-1))
+    before = np.maximum(first - 1, 0)
+    has_before = has & (first > 0)
+
+    def at(i):  # True at index i[line] of every line, in the chunks of the mask (an outer product: chunks multiply)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", da.PerformanceWarning)
+            return index == da.from_array(i[..., None], chunks=m.chunks[:-1] + (1,))
+
+    lowest = np.iinfo(v.dtype).min if np.issubdtype(v.dtype, np.integer) else -np.inf
+    value, flag_at, flag_before = compute(
+        da.where(at(before), v, lowest).max(axis=-1), (f & at(first)).any(axis=-1), (f & at(before)).any(axis=-1)
+    )
+    return FirstTrue(
+        has=has,
+        first=first,
+        true_to_end=has & (last_false < first),
+        value_before=np.where(has_before, value, fill).astype(v.dtype),
+        flag_at=has & flag_at,
+        flag_before=has_before & flag_before,
+    )
+
+
+# --------------------------------------------------------------------------------------------------- pixel blocks
+@dataclass(frozen=True)
+class Blocks:
+    """A 2-D label map reduced to blocks of ``factors`` = (rows, columns) points (the last ones may be smaller).
+
+    ``low``/``high``: the smallest and largest label in each block (equal where every point of the block has one
+    label); ``mixed_stability``: the block holds stable and not stable points; ``any_flag``: some point of the
+    block is flagged (e.g. inferred), None without flags. ``counts``: how often each label occurs in the whole
+    map, at full resolution. With factors (1, 1) the blocks are the points themselves.
+    """
+
+    factors: tuple[int, int]
+    low: np.ndarray
+    high: np.ndarray
+    mixed_stability: np.ndarray
+    any_flag: np.ndarray | None
+    counts: dict[int, int]
+
+    @property
+    def mixed(self) -> np.ndarray:
+        """Blocks holding more than one label."""
+        return self.low != self.high
+
+    @property
+    def reduced(self) -> bool:
+        return self.factors != (1, 1)
+
+
+def block_factors(shape: tuple[int, int], pixels: tuple[int, int]) -> tuple[int, int]:
+    """Points per block along each axis so that a map of ``shape`` has at most ``pixels`` blocks along each."""
+    return tuple(max(1, math.ceil(n / max(1, p))) for n, p in zip(shape, pixels))
+
+
+def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -> Blocks:
+    """Reduce a 2-D map ``values`` (and its ``flags``, or None) to blocks of ``factors`` points, chunk by chunk.
+
+    The map is padded at its far ends by repeating its last row and column (which adds no label to a block) and
+    cut into dask chunks holding whole blocks; each chunk is reduced and its labels counted (padding left out)
+    by one task, so every chunk is read once and dropped at once: one pass, a few chunks in memory. With
+    factors (1, 1) the blocks are the points.
+    """
+    factors = tuple(int(k) for k in factors)
+    v = as_dask(values)
+    f = None if flags is None else as_dask(flags)
+    shape = v.shape
+    pad = [(0, -n % k) for n, k in zip(shape, factors)]
+    if any(p for _, p in pad):
+        v = da.pad(v, pad, mode="edge")
+        f = None if f is None else da.pad(f, pad, mode="edge")
+    chunks = tuple(_multiple(c, k, n) for c, k, n in zip(v.chunksize, factors, v.shape))
+    v = v.rechunk(chunks)
+    f = None if f is None else f.rechunk(chunks)
+    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in v.chunks]
+    grid = v.numblocks
+    vs, fs = v.to_delayed(), None if f is None else f.to_delayed()
+    tasks = []
+    for block in np.ndindex(*grid):
+        valid = tuple(int(min(c[b], n - s[b])) for c, s, b, n in zip(v.chunks, starts, block, shape))
+        tasks.append(dask.delayed(_reduce_block)(vs[block], None if fs is None else fs[block], valid, stable=stable, factors=factors))
+    done = compute(*tasks)
+    parts = np.empty(grid, dtype=object)
+    for block, (reduced, _) in zip(np.ndindex(*grid), done):
+        parts[block] = reduced
+    low, high, mixed_stable, flagged = (np.block([[p[k] for p in row] for row in parts]) for k in range(4))
+    return Blocks(factors, low.astype(v.dtype), high.astype(v.dtype), mixed_stable.astype(bool), None if flags is None else flagged.astype(bool),
+                  _merge(counted for _, counted in done))
+
+
+def _multiple(chunk: int, k: int, n: int) -> int:
+    """A chunk length near ``chunk`` that holds whole blocks of ``k`` (at most the axis, ``n``)."""
+    return min(n, max(k, round(chunk / k) * k))
+
+
+def _reduce_block(v: np.ndarray, f: np.ndarray | None, valid: tuple[int, int], *, stable, factors) -> tuple[np.ndarray, tuple]:
+    """One chunk's blocks (low, high, mixed stability, any flag), and the counts of its labels but for padding."""
+    fy, fx = factors
+    ny, nx = v.shape[0] // fy, v.shape[1] // fx
+    cells = v.reshape(ny, fy, nx, fx)
+    out = np.empty((4, ny, nx), dtype=np.int32)
+    out[0] = cells.min(axis=(1, 3))
+    out[1] = cells.max(axis=(1, 3))
+    if stable is None:
+        out[2] = 0
+    else:
+        is_stable = cells == stable
+        out[2] = is_stable.any(axis=(1, 3)) & ~is_stable.all(axis=(1, 3))
+    out[3] = 0 if f is None else f.reshape(ny, fy, nx, fx).any(axis=(1, 3))
+    return out, np.unique(v[: valid[0], : valid[1]], return_counts=True)
+
+
+def counts(values) -> dict[int, int]:
+    """How often each value occurs, chunk by chunk (``dask.array.unique`` would first ravel the array, which for
+    a transposed map gathers whole rows across chunks)."""
+    return _merge(compute(*_block_counts(values)))
+
+
+def _block_counts(values) -> list:
+    """One delayed ``(values, counts)`` per chunk of ``values``."""
+    v = as_dask(values)
+    return [dask.delayed(np.unique)(block, return_counts=True) for block in v.to_delayed().ravel()]
+
+
+def _merge(parts) -> dict[int, int]:
+    out: dict[int, int] = {}
+    for labels, n in parts:
+        for u, c in zip(labels, n):
+            out[int(u)] = out.get(int(u), 0) + int(c)
+    return dict(sorted(out.items()))
