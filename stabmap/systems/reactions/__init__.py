@@ -3,7 +3,8 @@
 Two rigid bodies joined by n ideal point nodes; which reactions do the nodes carry, and which node carries the
 most, for which load and layout? The pipeline's part is the ``System`` below; the physics is beside it:
 
-- ``solver``: the least-norm reactions (numpy's SVD, vectorised), public as ``stabmap.reactions``;
+- ``solver``: the least-norm reactions, every label proved, public as ``stabmap.reactions``: ``floats`` (vectorised
+  floating point with a proved error bound) decides most points, ``exact`` (rational arithmetic) the others;
 - ``scene``, ``parameters``: what a scene holds, how it is checked, what a grid can scan;
 - ``load``: a scene and a block of its grid -> node positions, F and M;
 - ``outputs``: the variables written.
@@ -15,7 +16,7 @@ import numpy as np
 
 from ..base import Cost, System
 from . import scene as _scene
-from .outputs import COMPONENT_DIM, COMPONENTS, CRITICAL_NODE, NODE_DIM, VARIABLES
+from .outputs import COMPONENT_DIM, COMPONENTS, CRITICAL_NODE, DECIDED_BY, NODE_DIM, VARIABLES
 from .scene import Body, Load, Release, Scene
 
 REFERENCES = (
@@ -37,7 +38,7 @@ class Reactions(System):
     label_symbol = "critical node"
     label_title = "node carrying the\nlargest reaction"
     stable_label = None
-    provenance = None
+    provenance = DECIDED_BY.name
     symbols = {"F": "F", "M": "M", "c": "c", "g": "g", "a": "a", "omega": r"\omega", "alpha": r"\alpha", "x": "x", "y": "y", "z": "z"}
 
     def scene_from_dict(self, table, base_dir=None) -> Scene:
@@ -80,12 +81,12 @@ class Reactions(System):
 
     def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         from .load import load, node_positions
-        from .solver import carried_basis, least_norm
+        from .solver import least_norm, prepare_releases
 
         shape = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()
         F, M = load(scene, values)
-        Q = carried_basis(scene.n, [(r.node, np.asarray(r.direction) / np.linalg.norm(r.direction)) for r in scene.releases])
-        out = least_norm(node_positions(scene, values), F, M, Q)
+        releases = prepare_releases(scene.n, [(r.node, r.direction) for r in scene.releases])
+        out = least_norm(node_positions(scene, values), F, M, releases)
 
         def full(a, extra=()):
             return np.ascontiguousarray(np.broadcast_to(a, shape + extra))
@@ -100,6 +101,7 @@ class Reactions(System):
             "free_motions": full(out.free_motions),
             "compatible": full(out.compatible.astype(np.int8)),
             "balance_residual": full(out.residual),
+            "decided_by": full(out.decided_by),
         }
 
     def class_name(self, value: int) -> str:
