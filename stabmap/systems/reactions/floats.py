@@ -33,7 +33,7 @@ A bound computed in floats is itself rounded. ``hi`` and ``lo`` widen each such 
 more than the gamma_k of the few thousand operations behind it) and an absolute 2^-960 (far more than every
 underflow together). A non-finite bound decides nothing. sigma > 0 proves that C' has full row rank: rank =
 6 + releases, every load compatible. The critical node is proved when its |R_i| minus the bound exceeds every
-other node's |R_i| plus the bound (``separated``).
+other node's |R_i| plus the bound, each widened by the rounding of the norm, a few u (``separated``).
 """
 
 from __future__ import annotations
@@ -196,13 +196,18 @@ class Layouts:
 
 def separated(norms: np.ndarray, delta: np.ndarray) -> np.ndarray:
     """True where the node with the largest float |R_i| (norms, shape S + (n,)) provably carries the most: its
-    |R_i| - delta exceeds every other node's |R_i| + delta, each widened by the rounding of the norm."""
+    |R_i| - delta exceeds every other node's |R_i| + delta.
+
+    A float norm nu of a 3-vector is within 3u of its exact value (3 products, 2 sums, a square root), and each
+    of the two operations below rounds by at most u more: (nu + delta)(1 + 8u) >= |R_i| + delta, and
+    nu (1 - 8u) - delta, rounded, is <= |R_i| - delta (TINY covers underflow).
+    """
     n = norms.shape[-1]
     with np.errstate(all="ignore"):
         if n == 1:
             return np.isfinite(delta)
         top = np.argmax(norms, axis=-1)
-        upper = hi(hi(norms) + delta[..., None])
-        low_top = lo(lo(np.take_along_axis(norms, top[..., None], -1)[..., 0]) - delta)
+        upper = (norms + delta[..., None]) * (1 + 8 * U) + TINY
+        low_top = (np.take_along_axis(norms, top[..., None], -1)[..., 0] * (1 - 8 * U) - delta) - TINY
         others = np.where(np.arange(n) == top[..., None], -np.inf, upper).max(axis=-1)
         return np.isfinite(delta) & (low_top > others)

@@ -209,13 +209,15 @@ def least_norm(x: np.ndarray, F: np.ndarray, M: np.ndarray, releases) -> Batch:
         norms = np.linalg.norm(R, axis=-1)
         proved = floats.separated(norms, delta) & (delta <= ERROR_RTOL * norms.max(axis=-1))
 
-    R = np.array(np.broadcast_to(R, shape + (n, 3)))
-    norms = np.array(np.broadcast_to(norms, shape + (n,)))
-    compatible = np.ones(shape, dtype=bool)
+    # Flat over the points while the exact ones are filled in.
+    P = int(np.prod(shape, dtype=int))
+    R = np.array(np.broadcast_to(R, shape + (n, 3))).reshape(P, n, 3)
+    norms = np.array(np.broadcast_to(norms, shape + (n,))).reshape(P, n)
+    compatible = np.ones(P, dtype=bool)
     critical = np.argmax(norms, axis=-1).astype(np.int16)
-    n_critical = np.ones(shape, dtype=np.int16)
-    rank = np.full(shape, BALANCE_ROWS + len(releases), dtype=np.int16)
-    decided = np.zeros(shape, dtype=np.int8)
+    n_critical = np.ones(P, dtype=np.int16)
+    rank = np.full(P, BALANCE_ROWS + len(releases), dtype=np.int16)
+    decided = np.zeros(P, dtype=np.int8)
 
     # The rest exactly, each distinct layout factored once.
     todo = np.flatnonzero(~np.broadcast_to(proved, shape).ravel())
@@ -224,16 +226,16 @@ def least_norm(x: np.ndarray, F: np.ndarray, M: np.ndarray, releases) -> Batch:
         xs = x.reshape((-1, n, 3))
         Fs = np.broadcast_to(F, shape + (3,)).reshape(-1, 3)
         Ms = np.broadcast_to(M, shape + (3,)).reshape(-1, 3)
-        Rv, normv = R.reshape(-1, n, 3), norms.reshape(-1, n)
-        compv, critv, ncritv, rankv, decv = (a.reshape(-1) for a in (compatible, critical, n_critical, rank, decided))
         factored: dict[int, exact.Layout] = {}
         for i in todo:
             j = int(layout_of[i])
             if j not in factored:
                 factored[j] = exact.Layout(xs[j], releases)
             point = factored[j].solve(Fs[i], Ms[i])
-            Rv[i], normv[i], compv[i] = point.R, point.norms, point.compatible
-            critv[i], ncritv[i], rankv[i], decv[i] = point.critical_node, point.n_critical, factored[j].rank, 1
+            R[i], norms[i], compatible[i] = point.R, point.norms, point.compatible
+            critical[i], n_critical[i], rank[i], decided[i] = point.critical_node, point.n_critical, factored[j].rank, 1
+    R, norms = R.reshape(shape + (n, 3)), norms.reshape(shape + (n,))
+    compatible, critical, n_critical, rank, decided = (a.reshape(shape) for a in (compatible, critical, n_critical, rank, decided))
 
     # Balance as achieved, relative to the load scale s (forces, moments about the centroid over ell).
     centroid = x.mean(axis=-2)
