@@ -16,7 +16,14 @@ import numpy as np
 
 from ..base import Cost, System
 from . import scene as _scene
-from .outputs import COMPONENT_DIM, COMPONENTS, CRITICAL_NODE, DECIDED_BY, NODE_DIM, VARIABLES
+from .outputs import (
+    COMPONENT_DIM,
+    COMPONENTS,
+    CRITICAL_NODE,
+    DECIDED_BY,
+    NODE_DIM,
+    VARIABLES,
+)
 from .scene import Body, Load, Release, Scene
 
 REFERENCES = (

@@ -173,7 +173,6 @@ class Layouts:
         """The float reactions R (shape S + (n, 3)) and delta >= |R* - R| (shape S; 2-norm over all nodes and
         components; NaN where nothing is proved). F, M of shape S' + (3,) broadcast against the layouts' L."""
         n = self.l.shape[-2]
-        m = self.C.shape[-2]
         with np.errstate(all="ignore"):
             d, ed = self._load(F, M)
             y = self._solve_gram(d)
