@@ -66,12 +66,12 @@ def _fro(a, axes=(-2, -1)):
 
 def _mv(A: np.ndarray, v: np.ndarray) -> np.ndarray:
     """A v over stacks: A of shape L + (m, k), v of shape S + (k,), L and S broadcasting."""
-    return v @ A.T if A.ndim == 2 else np.einsum("...ij,...j->...i", A, v)
+    return v @ A.T if A.ndim == 2 else (A @ v[..., None])[..., 0]
 
 
 def _mtv(A: np.ndarray, v: np.ndarray) -> np.ndarray:
     """A^T v over stacks."""
-    return v @ A if A.ndim == 2 else np.einsum("...ji,...j->...i", A, v)
+    return v @ A if A.ndim == 2 else (v[..., None, :] @ A)[..., 0, :]
 
 
 def _join(parts: list[np.ndarray]) -> np.ndarray:
