@@ -31,9 +31,11 @@ REFERENCES = (
     "of a constrained rigid body (in Russian), Uchenye Zapiski TsAGI 18(6), 1987: equations (1)-(17); the "
     "collinear case corrected (docs/reactions.md)"
 )
-# Seconds per point on one core (scripts/reactions_figure.py --bench: 14, 1.9 and 3.6 us): one SVD per point
-# when two or more node coordinates are scanned; with one, an SVD per value of it; with none, one per block.
-SECONDS_LAYOUT, SECONDS_LOAD = 1.4e-5, 4e-6
+# CPU seconds per point (scripts/reactions_figure.py --bench: 9, 1.4 and 1.3 us, and 37 us where every point is
+# exact): a layout factored per point when two or more node coordinates are scanned; with one, per value of it;
+# with none, once per block. A rank-deficient layout (n <= 2, collinear nodes, releases that free the body)
+# has every point decided in exact arithmetic.
+SECONDS_LAYOUT, SECONDS_LOAD, SECONDS_EXACT = 1e-5, 2e-6, 5e-5
 
 
 class Reactions(System):
@@ -83,8 +85,18 @@ class Reactions(System):
         }
 
     def cost(self, scene: Scene) -> Cost:
+        from .exact import Layout
+        from .solver import prepare_releases
+
         layouts = sum(scene.key(a.name)[0] == "node" for a in scene.grid)
-        return Cost(seconds=SECONDS_LAYOUT if layouts >= 2 else SECONDS_LOAD, bytes=8 * (3 * scene.n + 6))
+        seconds = SECONDS_LAYOUT if layouts >= 2 else SECONDS_LOAD
+        if scene.n <= 2:
+            seconds = SECONDS_EXACT
+        elif not layouts:
+            rows = prepare_releases(scene.n, [(r.node, r.direction) for r in scene.releases])
+            if Layout(np.array(scene.nodes, dtype=np.float64), rows).rank < 6 + len(rows):
+                seconds = SECONDS_EXACT
+        return Cost(seconds=seconds, bytes=8 * (3 * scene.n + 6))
 
     def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         from .load import load, node_positions

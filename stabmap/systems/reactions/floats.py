@@ -179,16 +179,22 @@ class Layouts:
             R = _mtv(self.C, y)
             y = y + self._solve_gram(d - _mv(self.C, R))  # one step of iterative refinement
             R = _mtv(self.C, y)
-            # r = d' - C' R against its float value d'' - C'' R: the load's rounding, C'' - C', and the
-            # rounding of the sum of 3n + 1 terms.
+            # r = d' - C' R, as computed: the load's rounding, C'' - C', and the sum's rounding bounded by er.
             r = d - _mv(self.C, R)
             er = ed + gamma(3 * n + 1) * np.abs(d) + _mv(self.ER, np.abs(R))
-            r_hi = hi(np.sqrt(np.sum(r * r, axis=-1)) + np.sqrt(np.sum(er * er, axis=-1)))
-            # z = fl(C''^T y) - C'^T y: the product's rounding and C'' - C'.
-            ez = _mtv(self.EZ, np.abs(y))
-            z_hi = hi(np.sqrt(np.sum(ez * ez, axis=-1)))
-            a = hi(r_hi / self.sigma)
-            delta = hi(np.sqrt(hi(a * a + z_hi * z_hi)))
+            # C'^+ r = C'^T w + C'^+ (r - C' C'^T w) for the float w = G^-1 r: the correction a further step of
+            # refinement would make, and what that step would leave, over sigma. q = fl(C''^T w) is within
+            # EZ^T |w| of C'^T w; s = fl(r - C'' q) within es of r - C' C'^T w.
+            w = self._solve_gram(r)
+            q = _mtv(self.C, w)
+            eq = _mtv(self.EZ, np.abs(w))
+            s = r - _mv(self.C, q)
+            es = _mv(self.ER, np.abs(q)) + gamma(3 * n + 1) * np.abs(r) + _mv(self.aC + self.EC, eq)
+            norm = lambda v: np.sqrt(np.sum(v * v, axis=-1))  # noqa: E731
+            a = hi(hi(norm(q) + norm(eq)) + hi(hi(norm(s) + norm(es) + norm(er)) / self.sigma))
+            # z = fl(C''^T y) - C'^T y: the product's rounding and C'' - C'; P z is the part of R off the row space.
+            z = hi(norm(_mtv(self.EZ, np.abs(y))))
+            delta = hi(np.sqrt(hi(a * a + z * z)))
             R = R.reshape(R.shape[:-1] + (n, 3))
             return R, np.where(np.isfinite(delta) & (self.sigma > 0), delta, np.nan)
 

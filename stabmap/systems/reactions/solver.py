@@ -33,7 +33,7 @@ import numpy as np
 from ...errors import StabmapError
 from . import exact, floats
 
-ERROR_RTOL = 1e-12  # a float point is kept only when its proved error |R - R*| is at most this times R_max
+ERROR_RTOL = 1e-10  # a float point is kept only when its proved error |R - R*| is at most this times R_max
 BALANCE_ROWS = 6
 DECIDED_BY = ("float_with_bound", "exact_rational")  # the flag values 0 and 1 of decided_by
 
