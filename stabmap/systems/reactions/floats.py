@@ -80,6 +80,11 @@ def _join(parts: list[np.ndarray]) -> np.ndarray:
     return np.concatenate([np.broadcast_to(a, lead + a.shape[-1:]) for a in parts], axis=-1)
 
 
+def norm(v: np.ndarray) -> np.ndarray:
+    """The 2-norm along the last axis."""
+    return np.sqrt(np.sum(v * v, axis=-1))
+
+
 def _cross_abs(a, b):
     """|a| (x) |b|: the sum of |terms| of each component of a x b."""
     a, b = np.abs(a), np.abs(b)
@@ -190,7 +195,6 @@ class Layouts:
             eq = _mtv(self.EZ, np.abs(w))
             s = r - _mv(self.C, q)
             es = _mv(self.ER, np.abs(q)) + gamma(3 * n + 1) * np.abs(r) + _mv(self.aC + self.EC, eq)
-            norm = lambda v: np.sqrt(np.sum(v * v, axis=-1))  # noqa: E731
             a = hi(hi(norm(q) + norm(eq)) + hi(hi(norm(s) + norm(es) + norm(er)) / self.sigma))
             # z = fl(C''^T y) - C'^T y: the product's rounding and C'' - C'; P z is the part of R off the row space.
             z = hi(norm(_mtv(self.EZ, np.abs(y))))
