@@ -64,14 +64,33 @@ def _fro(a, axes=(-2, -1)):
     return np.sqrt(np.sum(a * a, axis=axes))
 
 
+def _stacked(v: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """v B over stacks: v of shape S + (k,), B of shape L + (k, m), L broadcasting against S.
+
+    The axes where L has size one (trailing ones, as when a grid's last axes scan the load only) become rows of
+    one matrix product per layout, instead of one small product per point.
+    """
+    if B.ndim == 2:
+        return v @ B
+    L = B.shape[:-2]
+    t = len(L) - len(np.trim_zeros(np.array(L) != 1, "b"))  # trailing axes of size one in L
+    t = min(t, v.ndim - 1)
+    if not t:
+        return (v[..., None, :] @ B)[..., 0, :]
+    tail = v.shape[v.ndim - 1 - t : -1]
+    rows = v.reshape(v.shape[: v.ndim - 1 - t] + (-1, v.shape[-1]))
+    out = rows @ B.reshape(L[: len(L) - t] + B.shape[-2:])
+    return out.reshape(out.shape[:-2] + tail + out.shape[-1:])
+
+
 def _mv(A: np.ndarray, v: np.ndarray) -> np.ndarray:
     """A v over stacks: A of shape L + (m, k), v of shape S + (k,), L and S broadcasting."""
-    return v @ A.T if A.ndim == 2 else (A @ v[..., None])[..., 0]
+    return _stacked(v, np.swapaxes(A, -1, -2))
 
 
 def _mtv(A: np.ndarray, v: np.ndarray) -> np.ndarray:
     """A^T v over stacks."""
-    return v @ A if A.ndim == 2 else (v[..., None, :] @ A)[..., 0, :]
+    return _stacked(v, A)
 
 
 def _join(parts: list[np.ndarray]) -> np.ndarray:
@@ -106,8 +125,8 @@ class Layouts:
 
     ``releases`` are ``exact.release_rows``. Attributes: ``p`` (L, 3), ``ell`` (L), ``l`` = fl(x - p)
     (L, n, 3), the rounded matrix ``C`` (L, m, 3n) and its entrywise error bound ``EC``, the eigendecomposition
-    ``lam``, ``V`` of the Gram matrix, and ``sigma`` (L): a proved lower bound of sigma_min(C'), NaN where
-    none (then C' may not have full row rank, and the layout is for ``exact``).
+    ``lam``, ``V`` of the Gram matrix G and its float inverse ``Ginv``, and ``sigma`` (L): a proved lower bound
+    of sigma_min(C'), NaN where none (then C' may not have full row rank, and the layout is for ``exact``).
     """
 
     def __init__(self, x: np.ndarray, releases) -> None:
@@ -161,7 +180,9 @@ class Layouts:
             w = lo(lo(h / vmax) - eG)  # <= lambda_min(C'' C''^T)
             sigma = lo(lo(np.sqrt(np.where(w > 0, w, 0.0))) - eC)
             self.sigma = np.where(finite & (h > 0) & (w > 0) & (sigma > 0), sigma, np.nan)
-            self.inv_lam = np.where(self.lam > 0, 1.0 / self.lam, 0.0)
+            inv_lam = np.where(self.lam > 0, 1.0 / self.lam, 0.0)  # zero along non-positive eigenvalues
+            self.Ginv = (V * inv_lam[..., None, :]) @ Vt  # G^-1 in floats (for the solve; no rigour needed)
+            self.EA = self.aC + self.EC  # >= |C'|
 
     def _load(self, F: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """d'' = fl(d') at every point (forces, moments about p over ell, releases) and a bound of |d'' - d'|."""
@@ -171,8 +192,8 @@ class Layouts:
         return _join([-F, dM, zero]), _join([np.zeros(F.shape), eM, zero])
 
     def _solve_gram(self, v):
-        """G^-1 v by the eigendecomposition (zero along non-positive eigenvalues: those layouts are not used)."""
-        return _mv(self.V, _mtv(self.V, v) * self.inv_lam)
+        """G^-1 v (those layouts whose G is not positive definite are not used)."""
+        return _mv(self.Ginv, v)
 
     def solve(self, F: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The float reactions R (shape S + (n, 3)) and delta >= |R* - R| (shape S; 2-norm over all nodes and
@@ -194,7 +215,7 @@ class Layouts:
             q = _mtv(self.C, w)
             eq = _mtv(self.EZ, np.abs(w))
             s = r - _mv(self.C, q)
-            es = _mv(self.ER, np.abs(q)) + gamma(3 * n + 1) * np.abs(r) + _mv(self.aC + self.EC, eq)
+            es = _mv(self.ER, np.abs(q)) + gamma(3 * n + 1) * np.abs(r) + _mv(self.EA, eq)
             a = hi(hi(norm(q) + norm(eq)) + hi(hi(norm(s) + norm(es) + norm(er)) / self.sigma))
             # z = fl(C''^T y) - C'^T y: the product's rounding and C'' - C'; P z is the part of R off the row space.
             z = hi(norm(_mtv(self.EZ, np.abs(y))))
