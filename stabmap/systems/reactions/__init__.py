@@ -31,7 +31,7 @@ REFERENCES = (
     "of a constrained rigid body (in Russian), Uchenye Zapiski TsAGI 18(6), 1987: equations (1)-(17); the "
     "collinear case corrected (docs/reactions.md)"
 )
-# CPU seconds per point (scripts/reactions_figure.py --bench: 9, 1.4 and 1.3 us, and 37 us where every point is
+# CPU seconds per point (scripts/reactions_figure.py --bench: 8.9, 1.2 and 1.3 us, and 37 us where every point is
 # exact): a layout factored per point when two or more node coordinates are scanned; with one, per value of it;
 # with none, once per block. A rank-deficient layout (n <= 2, collinear nodes, releases that free the body)
 # has every point decided in exact arithmetic.

@@ -2,7 +2,7 @@
 
 Node positions, loads and release directions are binary floats, so each is an exact rational, and so is the
 least-norm solution. This module works with those exact values. It is the fallback for every point that the
-floating-point bound (``bound``) cannot decide, and it decides those points exactly.
+floating-point bound (``floats``) cannot decide, and it decides those points exactly.
 
 The constraint system stays rational. It has one unknown per node and component (3n), six balance rows
 (sum R_i = -F, sum x_i x R_i = -M, about the origin of the x_i) and one row e . R_k = 0 per independent

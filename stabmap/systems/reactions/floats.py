@@ -8,15 +8,20 @@ order one. Neither step needs to be exact in floating point, because each roundi
 
 **The solve.** R = C''^T y with G y = d'': the least-norm solution through the Gram matrix G = C'' C''^T of
 the rounded C'' (an eigendecomposition per distinct layout), followed by one step of iterative refinement on the
-residual. R lies in the row space of C'' by construction. G squares the condition number, but a layout for which
-that matters fails the bound below, and its points are solved exactly.
+residual. R lies in the row space of C'' up to the rounding of that product (z below). G squares the condition
+number, but a layout for which that matters fails the bound below, and its points are solved exactly.
 
 **The bound.** For float multipliers y and R = fl(C''^T y), let z = R - C'^T y (only rounding). Then
 
-    R* - R = C'^+ (d' - C' R) - P z,          P the projector onto the null space of C',
-    |R* - R| <= delta = sqrt((|r| / sigma)^2 + |z|^2),    r = d' - C' R,  sigma <= sigma_min(C').
+    R* - R = C'^+ r - P z,        r = d' - C' R,  P the projector onto the null space of C',
 
-The two terms are orthogonal. Each quantity on the right is bounded from above (|r|, |z|) or from below (sigma):
+and the two terms are orthogonal, so |R* - R| <= delta = sqrt(a^2 + |z|^2) for any a >= |C'^+ r|. With a float
+w ~ G^-1 r (the correction one more step of refinement would make), C'^+ r = C'^T w + C'^+ (r - C' C'^T w), so
+
+    a = |C'^T w| + |r - C' C'^T w| / sigma + |r - r''| / sigma,      sigma <= sigma_min(C'),
+
+r'' the computed residual. Bounding |C'^+ r| by |r| / sigma alone would make delta grow like kappa^2 u; this
+way it grows like kappa u. Each quantity is bounded from above (the norms) or from below (sigma):
 
 - C'' is C' rounded (x_i - p rounds; the rest is exact), and each entry's error is at most 2u |C''| [u = 2^-53];
 - every sum of products of floats has the classical a priori error gamma_k sum |terms| (Higham, *Accuracy and
