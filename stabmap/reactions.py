@@ -12,9 +12,8 @@ public name.
 from __future__ import annotations
 
 from .systems.reactions.solver import (
-    BALANCE_RTOL,
-    RANK_RTOL,
-    TIE_RTOL,
+    DECIDED_BY,
+    ERROR_RTOL,
     Batch,
     Reactions,
     closed_form,
@@ -22,4 +21,4 @@ from .systems.reactions.solver import (
     solve_batch,
 )
 
-__all__ = ["BALANCE_RTOL", "RANK_RTOL", "TIE_RTOL", "Batch", "Reactions", "closed_form", "solve", "solve_batch"]
+__all__ = ["DECIDED_BY", "ERROR_RTOL", "Batch", "Reactions", "closed_form", "solve", "solve_batch"]

@@ -239,7 +239,7 @@ def test_figure_script_and_its_benchmark_run(tmp_path, capsys):
     for name in ("reactions-square-plate.png", "reactions-spinning-stage.png"):
         assert (tmp_path / name).read_bytes()[:4] == b"\x89PNG"
     script["main"](["--bench", "--quick"])
-    assert capsys.readouterr().out.count("us per point") == 3
+    assert capsys.readouterr().out.count("us per point") == 5
 
 
 @pytest.mark.slow

@@ -3,7 +3,8 @@
 Two rigid bodies joined by n ideal point nodes; which reactions do the nodes carry, and which node carries the
 most, for which load and layout? The pipeline's part is the ``System`` below; the physics is beside it:
 
-- ``solver``: the least-norm reactions (numpy's SVD, vectorised), public as ``stabmap.reactions``;
+- ``solver``: the least-norm reactions, every label proved, public as ``stabmap.reactions``: ``floats`` (vectorised
+  floating point with a proved error bound) decides most points, ``exact`` (rational arithmetic) the others;
 - ``scene``, ``parameters``: what a scene holds, how it is checked, what a grid can scan;
 - ``load``: a scene and a block of its grid -> node positions, F and M;
 - ``outputs``: the variables written.
@@ -15,7 +16,14 @@ import numpy as np
 
 from ..base import Cost, System
 from . import scene as _scene
-from .outputs import COMPONENT_DIM, COMPONENTS, CRITICAL_NODE, NODE_DIM, VARIABLES
+from .outputs import (
+    COMPONENT_DIM,
+    COMPONENTS,
+    CRITICAL_NODE,
+    DECIDED_BY,
+    NODE_DIM,
+    VARIABLES,
+)
 from .scene import Body, Load, Release, Scene
 
 REFERENCES = (
@@ -23,9 +31,11 @@ REFERENCES = (
     "of a constrained rigid body (in Russian), Uchenye Zapiski TsAGI 18(6), 1987: equations (1)-(17); the "
     "collinear case corrected (docs/reactions.md)"
 )
-# Seconds per point on one core (scripts/reactions_figure.py --bench: 14, 1.9 and 3.6 us): one SVD per point
-# when two or more node coordinates are scanned; with one, an SVD per value of it; with none, one per block.
-SECONDS_LAYOUT, SECONDS_LOAD = 1.4e-5, 4e-6
+# CPU seconds per point (scripts/reactions_figure.py --bench: 8.9, 1.2 and 1.3 us, and 37 us where every point is
+# exact): a layout factored per point when two or more node coordinates are scanned; with one, per value of it;
+# with none, once per block. A rank-deficient layout (n <= 2, collinear nodes, releases that free the body)
+# has every point decided in exact arithmetic.
+SECONDS_LAYOUT, SECONDS_LOAD, SECONDS_EXACT = 1e-5, 2e-6, 5e-5
 
 
 class Reactions(System):
@@ -37,7 +47,7 @@ class Reactions(System):
     label_symbol = "critical node"
     label_title = "node carrying the\nlargest reaction"
     stable_label = None
-    provenance = None
+    provenance = DECIDED_BY.name
     symbols = {"F": "F", "M": "M", "c": "c", "g": "g", "a": "a", "omega": r"\omega", "alpha": r"\alpha", "x": "x", "y": "y", "z": "z"}
 
     def scene_from_dict(self, table, base_dir=None) -> Scene:
@@ -75,17 +85,27 @@ class Reactions(System):
         }
 
     def cost(self, scene: Scene) -> Cost:
+        from .exact import Layout
+        from .solver import prepare_releases
+
         layouts = sum(scene.key(a.name)[0] == "node" for a in scene.grid)
-        return Cost(seconds=SECONDS_LAYOUT if layouts >= 2 else SECONDS_LOAD, bytes=8 * (3 * scene.n + 6))
+        seconds = SECONDS_LAYOUT if layouts >= 2 else SECONDS_LOAD
+        if scene.n <= 2:
+            seconds = SECONDS_EXACT
+        elif not layouts:
+            rows = prepare_releases(scene.n, [(r.node, r.direction) for r in scene.releases])
+            if Layout(np.array(scene.nodes, dtype=np.float64), rows).rank < 6 + len(rows):
+                seconds = SECONDS_EXACT
+        return Cost(seconds=seconds, bytes=8 * (3 * scene.n + 6))
 
     def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         from .load import load, node_positions
-        from .solver import carried_basis, least_norm
+        from .solver import least_norm, prepare_releases
 
         shape = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()
         F, M = load(scene, values)
-        Q = carried_basis(scene.n, [(r.node, np.asarray(r.direction) / np.linalg.norm(r.direction)) for r in scene.releases])
-        out = least_norm(node_positions(scene, values), F, M, Q)
+        releases = prepare_releases(scene.n, [(r.node, r.direction) for r in scene.releases])
+        out = least_norm(node_positions(scene, values), F, M, releases)
 
         def full(a, extra=()):
             return np.ascontiguousarray(np.broadcast_to(a, shape + extra))
@@ -100,6 +120,7 @@ class Reactions(System):
             "free_motions": full(out.free_motions),
             "compatible": full(out.compatible.astype(np.int8)),
             "balance_residual": full(out.residual),
+            "decided_by": full(out.decided_by),
         }
 
     def class_name(self, value: int) -> str:

@@ -6,19 +6,21 @@ A rigid body is held by n ideal point nodes (forces only). The reactions R_i on 
 
 and a released node k carries no force along e_k (e_k . R_k = 0). Among all reactions that do, the nodes take the
 one with the least sum_i |R_i|^2: what n equal, isotropic, stiff springs carry. That is the minimum-norm solution
-of an underdetermined linear system, computed here by a singular value decomposition of a well-scaled form of it:
+of an underdetermined linear system. The inputs are binary floats, so the system and its solution are exact
+rationals, and every label (rank, compatibility, the critical node and its ties) is a statement about them,
+proved at every point in one of two ways (``decided_by``):
 
-- moments are taken about the nodes' centroid and lengths measured in their RMS distance from it, so that every
-  column of the balance matrix has entries of order one and its singular values compare as numbers;
-- a released node's reaction is written in an orthonormal basis of the directions it still carries, so the
-  releases are kept exactly and the least norm is unchanged (the basis is orthonormal);
-- singular values below ``RANK_RTOL`` times the largest count as zero (the layout cannot resist that load
-  pattern: collinear nodes cannot take a moment about their line, releases may free the body); the load is
-  *compatible* when its part outside the balance matrix's range is below ``BALANCE_RTOL`` of the load, and
-  then the reactions are unique; otherwise there are none, and they are reported as NaN, never "solved".
+- ``float_with_bound``: ``floats`` solves a well-scaled form of the system in floating point (moments about
+  the nodes' centroid, lengths in a power of two near their RMS distance from it), proves that the exact system
+  has full row rank (so every load is compatible), and bounds the distance delta from the float reactions to
+  the exact ones. The point is decided when the largest |R_i| exceeds every other by more than the bound
+  allows, and the bound is at most ``ERROR_RTOL`` of it;
+- ``exact_rational``: otherwise (rank-deficient layouts, ties, near-ties, loads too small for the bound),
+  ``exact`` solves the point in rational arithmetic, factoring each distinct layout once. The reported R is
+  the exact one rounded to floats, and ties are exact equalities.
 
 Everything works on stacks: ``nodes`` of shape (..., n, 3) and loads of shape (..., 3) broadcast against each
-other, and each distinct layout is factored once (a grid over load axes only costs one SVD).
+other, and each distinct layout is factored once (a grid over load axes only costs one factorisation).
 """
 
 from __future__ import annotations
@@ -29,11 +31,11 @@ from numbers import Integral
 import numpy as np
 
 from ...errors import StabmapError
+from . import exact, floats
 
-RANK_RTOL = 1e-10  # singular values of the scaled balance matrix below this times the largest count as zero
-BALANCE_RTOL = 1e-12  # a load whose part outside the range exceeds this times the load is incompatible
-TIE_RTOL = 1e-9  # nodes within this relative distance of the largest |R_i| all carry it (ties on symmetric layouts)
+ERROR_RTOL = 1e-10  # a float point is kept only when its proved error |R - R*| is at most this times R_max
 BALANCE_ROWS = 6
+DECIDED_BY = ("float_with_bound", "exact_rational")  # the flag values 0 and 1 of decided_by
 
 
 @dataclass(frozen=True)
@@ -51,9 +53,9 @@ class Reactions:
     max_norm : float
         The largest |R_i| (NaN when incompatible).
     critical_node : int or None
-        The node carrying ``max_norm`` (0-based; the lowest-numbered one when several carry it to ``TIE_RTOL``).
+        The node carrying ``max_norm`` (0-based; the lowest-numbered one when several carry exactly as much).
     n_critical : int
-        How many nodes carry ``max_norm`` to within ``TIE_RTOL`` (0 when incompatible).
+        How many nodes carry exactly ``max_norm`` (0 when incompatible).
     norms : ndarray of shape (n,)
         |R_i| (NaN when incompatible).
     free_motions : int
@@ -63,6 +65,9 @@ class Reactions:
         (|sum R + F| + |sum l x R + M_c| / ell) / s: the balance achieved, relative to the load scale
         s = sqrt(|F|^2 + |M_c|^2 / ell^2), M_c the moment about the nodes' centroid and ell their RMS distance
         from it (NaN when incompatible).
+    decided_by : str
+        How the labels were proved: ``"float_with_bound"`` (R within ``ERROR_RTOL`` of R_max of the exact
+        reactions) or ``"exact_rational"`` (R the exact reactions rounded). Module docstring.
     """
 
     R: np.ndarray | None
@@ -74,6 +79,7 @@ class Reactions:
     norms: np.ndarray
     free_motions: int
     residual: float
+    decided_by: str
 
 
 @dataclass(frozen=True)
@@ -81,7 +87,8 @@ class Batch:
     """The reactions of a stack of problems (``solve_batch``): arrays over the broadcast shape S of the inputs.
 
     ``R`` has shape S + (n, 3) and ``norms`` S + (n,), NaN where incompatible; ``max_norm`` and ``residual``
-    are NaN there, ``critical_node`` is -1 and ``n_critical`` 0. Other fields as in ``Reactions``.
+    are NaN there, ``critical_node`` is -1 and ``n_critical`` 0. ``decided_by`` holds 0 (float_with_bound) or 1
+    (exact_rational), the index in ``DECIDED_BY``. Other fields as in ``Reactions``.
     """
 
     R: np.ndarray
@@ -93,6 +100,7 @@ class Batch:
     norms: np.ndarray
     free_motions: np.ndarray
     residual: np.ndarray
+    decided_by: np.ndarray
 
 
 # ---------------------------------------------------------------------------------------------------- input checks
@@ -133,7 +141,8 @@ def check_vector(value, where: str) -> np.ndarray:
 
 
 def check_releases(releases, n: int, where: str = "releases") -> tuple[tuple[int, np.ndarray], ...]:
-    """``(node_index, direction)`` pairs: a 0-based index below n and a finite nonzero 3-vector, made unit."""
+    """``(node_index, direction)`` pairs: a 0-based index below n and a finite nonzero 3-vector (as given, not
+    normalised: the exact problem is the one with the given direction)."""
     if isinstance(releases, (str, bytes)) or not hasattr(releases, "__iter__"):
         raise StabmapError(f"{where} must be a sequence of (node_index, direction) pairs, got {releases!r}")
     out = []
@@ -152,40 +161,15 @@ def check_releases(releases, n: int, where: str = "releases") -> tuple[tuple[int
         length = float(np.linalg.norm(e))
         if length == 0.0:
             raise StabmapError(f"{here} direction is zero; give the direction along which node {node} carries no force, e.g. [1.0, 0.0, 0.0]")
-        out.append((int(node), e / length))
+        out.append((int(node), e))
     return tuple(out)
 
 
 # ---------------------------------------------------------------------------------------------------- the solve
-def carried_basis(n: int, releases) -> np.ndarray:
-    """Block-diagonal (3n, m) matrix whose node-i block is an orthonormal basis of the directions node i carries.
-
-    A node with releases carries the orthogonal complement of their span (found by SVD, so parallel or
-    dependent release directions count once); a node released in three independent directions carries nothing.
-    """
-    blocks = []
-    for i in range(n):
-        dirs = np.array([e for k, e in releases if k == i]).reshape(-1, 3)
-        if not len(dirs):
-            blocks.append(np.eye(3))
-            continue
-        _, s, vt = np.linalg.svd(dirs, full_matrices=True)
-        released = int(np.sum(s > RANK_RTOL))  # unit rows: an absolute tolerance is a relative one
-        blocks.append(vt[released:].T)
-    m = sum(b.shape[1] for b in blocks)
-    Q = np.zeros((3 * n, m))
-    col = 0
-    for i, b in enumerate(blocks):
-        Q[3 * i : 3 * i + 3, col : col + b.shape[1]] = b
-        col += b.shape[1]
-    return Q
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    """[v]x of shape (..., 3, 3): [v]x r = v x r."""
-    z = np.zeros(v.shape[:-1])
-    x, y, w = v[..., 0], v[..., 1], v[..., 2]
-    return np.stack([np.stack([z, -w, y], -1), np.stack([w, z, -x], -1), np.stack([-y, x, z], -1)], -2)
+def prepare_releases(n: int, releases) -> tuple[tuple[int, np.ndarray], ...]:
+    """The independent release rows (``exact.release_rows``) of checked ``(node, direction)`` pairs
+    (``check_releases``: directions as given); they define the exact problem."""
+    return exact.release_rows(n, releases)
 
 
 def solve_batch(nodes, F, M, *, releases=()) -> Batch:
@@ -207,67 +191,76 @@ def solve_batch(nodes, F, M, *, releases=()) -> Batch:
         Arrays over the broadcast shape of ``nodes[..., 0, 0]``, ``F[..., 0]`` and ``M[..., 0]``.
     """
     x = check_nodes(nodes)
-    return least_norm(x, check_vector(F, "F"), check_vector(M, "M"), carried_basis(x.shape[-2], check_releases(releases, x.shape[-2])))
-
-
-def least_norm(x: np.ndarray, F: np.ndarray, M: np.ndarray, Q: np.ndarray) -> Batch:
-    """``solve_batch`` on checked float arrays, with the releases as ``carried_basis`` (no checks: the atlas's scene
-    was checked once, and its grid cannot put two nodes at one point)."""
     n = x.shape[-2]
-    released_rank = 3 * n - Q.shape[1]
+    return least_norm(x, check_vector(F, "F"), check_vector(M, "M"), prepare_releases(n, check_releases(releases, n)))
 
-    # The layout, factored once per distinct layout (the nodes' own batch shape L).
+
+def least_norm(x: np.ndarray, F: np.ndarray, M: np.ndarray, releases) -> Batch:
+    """``solve_batch`` on checked float arrays, with ``prepare_releases`` (no checks: the atlas's scene was
+    checked once, and its grid cannot put two nodes at one point). Module docstring: how each label is proved."""
+    n = x.shape[-2]
+    L = x.shape[:-2]
+
+    # Floats with a proved bound: which points they decide.
+    layouts = floats.Layouts(x, releases)
+    R, delta = layouts.solve(F, M)
+    shape = R.shape[:-2]
+    with np.errstate(invalid="ignore"):
+        norms = np.linalg.norm(R, axis=-1)
+        proved = floats.separated(norms, delta) & (delta <= ERROR_RTOL * norms.max(axis=-1))
+
+    # Flat over the points while the exact ones are filled in.
+    P = int(np.prod(shape, dtype=int))
+    R = np.array(np.broadcast_to(R, shape + (n, 3))).reshape(P, n, 3)
+    norms = np.array(np.broadcast_to(norms, shape + (n,))).reshape(P, n)
+    compatible = np.ones(P, dtype=bool)
+    critical = np.argmax(norms, axis=-1).astype(np.int16)
+    n_critical = np.ones(P, dtype=np.int16)
+    rank = np.full(P, BALANCE_ROWS + len(releases), dtype=np.int16)
+    decided = np.zeros(P, dtype=np.int8)
+
+    # The rest exactly, each distinct layout factored once.
+    todo = np.flatnonzero(~np.broadcast_to(proved, shape).ravel())
+    if todo.size:
+        layout_of = np.broadcast_to(np.arange(int(np.prod(L, dtype=int))).reshape(L), shape).ravel()
+        xs = x.reshape((-1, n, 3))
+        Fs = np.broadcast_to(F, shape + (3,)).reshape(-1, 3)
+        Ms = np.broadcast_to(M, shape + (3,)).reshape(-1, 3)
+        factored: dict[int, exact.Layout] = {}
+        for i in todo:
+            j = int(layout_of[i])
+            if j not in factored:
+                factored[j] = exact.Layout(xs[j], releases)
+            point = factored[j].solve(Fs[i], Ms[i])
+            R[i], norms[i], compatible[i] = point.R, point.norms, point.compatible
+            critical[i], n_critical[i], rank[i], decided[i] = point.critical_node, point.n_critical, factored[j].rank, 1
+    R, norms = R.reshape(shape + (n, 3)), norms.reshape(shape + (n,))
+    compatible, critical, n_critical, rank, decided = (a.reshape(shape) for a in (compatible, critical, n_critical, rank, decided))
+
+    # Balance as achieved, relative to the load scale s (forces, moments about the centroid over ell).
     centroid = x.mean(axis=-2)
     l = x - centroid[..., None, :]
     ell = np.sqrt(np.mean(np.sum(l * l, axis=-1), axis=-1))
-    ell = np.where(ell > 0, ell, 1.0)  # one node: any length scale will do
-    B = np.concatenate([np.broadcast_to(np.eye(3), l.shape[:-1] + (3, 3)), _skew(l / ell[..., None, None])], axis=-2)  # (L, n, 6, 3)
-    A = np.moveaxis(B, -3, -2).reshape(l.shape[:-2] + (BALANCE_ROWS, 3 * n)) @ Q  # (L, 6, m)
-    if A.shape[-1]:
-        U, s, Vt = np.linalg.svd(A, full_matrices=False)
-    else:  # every node released in every direction: nothing carried
-        U, s, Vt = np.zeros(A.shape[:-1] + (0,)), np.zeros(A.shape[:-2] + (0,)), np.zeros(A.shape[:-2] + (0, 0))
-    smax = s[..., :1] if s.shape[-1] else np.zeros(s.shape[:-1] + (1,))
-    kept = (s > RANK_RTOL * smax) & (s > 0)
-    balance_rank = kept.sum(axis=-1)
-
-    # The load about the centroid, scaled like the matrix: b = -(F, M_c / ell).
+    ell = np.where(ell > 0, ell, 1.0)[..., None]  # one node: any length scale will do
     Mc = M - np.cross(centroid, F)
-    b = -np.concatenate([np.broadcast_to(F, np.broadcast_shapes(F.shape, Mc.shape)), Mc / ell[..., None]], axis=-1)
-    scale = np.linalg.norm(b, axis=-1)
-    coef = np.einsum("...ij,...i->...j", U, b) * kept  # components of b along the kept left singular vectors
-    outside = np.linalg.norm(b - np.einsum("...ij,...j->...i", U, coef), axis=-1)
-    compatible = outside <= BALANCE_RTOL * scale
-    inv = np.divide(1.0, s, out=np.zeros_like(s), where=kept)
-    rho = np.einsum("...ji,...j->...i", Vt, coef * inv)
-    # One step of iterative refinement on what the first solve left unbalanced (within the range, as the part
-    # outside cannot be carried): it takes the rounding of the SVD's factors out of the balance.
-    left = b - np.einsum("...ij,...j->...i", A, rho)
-    rho = rho + np.einsum("...ji,...j->...i", Vt, np.einsum("...ij,...i->...j", U, left) * kept * inv)
-    R = (rho @ Q.T).reshape(rho.shape[:-1] + (n, 3))
-
-    # Balance as achieved, in the same scaled form (forces, and moments about the centroid over ell).
-    l_b = np.broadcast_to(l, R.shape)
+    scale = np.sqrt(np.sum(F * F, axis=-1) + np.sum(Mc * Mc, axis=-1) / ell[..., 0] ** 2)
     force = np.sum(R, axis=-2) + F
-    moment = (np.sum(np.cross(l_b, R), axis=-2) + Mc) / ell[..., None]
+    moment = (np.sum(np.cross(np.broadcast_to(l, R.shape), R), axis=-2) + Mc) / ell
     residual = (np.linalg.norm(force, axis=-1) + np.linalg.norm(moment, axis=-1)) / np.where(scale > 0, scale, 1.0)
 
-    norms = np.linalg.norm(R, axis=-1)
-    shape = norms.shape[:-1]
-    compatible = np.broadcast_to(compatible, shape)
-    rmax = norms.max(axis=-1)
-    tied = norms >= rmax[..., None] * (1.0 - TIE_RTOL)
-    nan = np.where(compatible, 0.0, np.nan)
+    with np.errstate(invalid="ignore"):
+        top = np.take_along_axis(norms, np.maximum(critical, 0)[..., None].astype(np.intp), -1)[..., 0]
     return Batch(
-        R=R + nan[..., None, None],
-        rank=np.broadcast_to(balance_rank + released_rank, shape).astype(np.int16),
-        compatible=compatible.copy(),
-        max_norm=rmax + nan,
-        critical_node=np.where(compatible, np.argmax(tied, axis=-1), -1).astype(np.int16),
-        n_critical=np.where(compatible, tied.sum(axis=-1), 0).astype(np.int16),
-        norms=norms + nan[..., None],
-        free_motions=np.broadcast_to(BALANCE_ROWS - balance_rank, shape).astype(np.int16),
-        residual=np.broadcast_to(residual, shape) + nan,
+        R=R,
+        rank=rank,
+        compatible=compatible,
+        max_norm=np.where(compatible, top, np.nan),
+        critical_node=np.where(compatible, critical, -1).astype(np.int16),
+        n_critical=np.where(compatible, n_critical, 0).astype(np.int16),
+        norms=norms,
+        free_motions=(BALANCE_ROWS - (rank - len(releases))).astype(np.int16),
+        residual=np.where(compatible, np.broadcast_to(residual, shape), np.nan),
+        decided_by=decided,
     )
 
 
@@ -324,6 +317,7 @@ def solve(nodes, F, M, *, releases=()) -> Reactions:
         norms=out.norms,
         free_motions=int(out.free_motions),
         residual=float(out.residual),
+        decided_by=DECIDED_BY[int(out.decided_by)],
     )
 
 
@@ -338,11 +332,11 @@ def closed_form(nodes, F, M) -> np.ndarray:
     c = x.mean(axis=0)
     l = x - c
     J = np.sum(l * l) * np.eye(3) - l.T @ l
-    if np.linalg.cond(J) > 1.0 / RANK_RTOL:
+    if np.linalg.cond(J) > 1e10:
         raise StabmapError("closed_form: the nodes are collinear (J is singular); use solve, the least-norm rule")
     y = np.linalg.solve(J, M - np.cross(c, F))
     return -F / len(x) + np.cross(l, y)
 
 
-__all__ = ["BALANCE_RTOL", "RANK_RTOL", "TIE_RTOL", "Batch", "Reactions", "carried_basis", "check_nodes",
-           "check_releases", "check_vector", "closed_form", "least_norm", "solve", "solve_batch"]
+__all__ = ["DECIDED_BY", "ERROR_RTOL", "Batch", "Reactions", "check_nodes", "check_releases", "check_vector", "closed_form",
+           "least_norm", "prepare_releases", "solve", "solve_batch"]
