@@ -31,7 +31,7 @@ sys.modules["stabmap"] = package
 
 def _run(code: str, package: Path, env: dict) -> subprocess.CompletedProcess:
     out = subprocess.run([sys.executable, "-c", _STUB + textwrap.dedent(code), str(package)],
-                         env=env, capture_output=True, text=True, timeout=600)
+                         env=env, capture_output=True, text=True, timeout=600, check=False)
     assert out.returncode == 0, out.stderr
     return out
 
@@ -120,3 +120,26 @@ def test_kernels_compile_and_run_when_the_cache_dir_cannot_be_written(tmp_path):
     assert any("cannot write the kernel cache" in w for w in out["warned"])
     assert out["told"] == ["compiling kernels (once, ~20 s)"]  # once per process, not once per kernel
     assert not (package / "kernels" / "__pycache__").exists() or not list((package / "kernels" / "__pycache__").glob("*.nb?"))
+
+
+@pytest.mark.skipif(not options.CACHE or os.environ.get("NUMBA_CACHE_DIR"), reason="needs stabmap's own kernel cache")
+def test_atlas_refine_and_critical_call_only_the_precompiled_signatures():
+    """A second signature would compile the whole kernel again on its first call (refine once passed read-only E)."""
+    code = """
+        import json
+        import stabmap
+        from stabmap.kernels import decide_block, precompile
+        from stabmap.scene.grid import resample
+        scene = stabmap.example("paper-n3-fixed")
+        small = resample(scene, **{a.name: 9 for a in scene.grid})
+        stabmap.compute_atlas(small, progress=False, threads=1)
+        stabmap.compute_refined(resample(scene, **{a.name: 17 for a in scene.grid}), progress=False, threads=1)
+        stabmap.critical(small, "omega", progress=False, threads=1)
+        print(json.dumps({"called": sorted(map(str, decide_block.signatures)),
+                          "precompiled": sorted(str(sig) for _, sig in precompile.signatures())}))
+    """
+    out = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True, timeout=600,
+                         check=False, env=_clean_env())
+    assert out.returncode == 0, out.stderr
+    seen = json.loads(out.stdout)
+    assert seen["called"] == seen["precompiled"]
