@@ -125,7 +125,7 @@ def seed(cache_path: str | os.PathLike | None, shipped: Path = SHIPPED) -> int:
 def kernel(func):
     """Compile ``func`` as a serial, GIL-free kernel (dask threads run them in parallel)."""
     global _seeded
-    options = dict(nogil=True, fastmath=False, error_model="numpy")
+    options = {"nogil": True, "fastmath": False, "error_model": "numpy"}
     if _CACHE_DIR is None:
         dispatcher = numba.njit(cache=CACHE, **options)(func)
     elif not _CACHE_DIR:
