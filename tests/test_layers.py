@@ -126,3 +126,5 @@ def test_the_wheel_has_no_top_level_kernels_package(tmp_path):
     names = zipfile.ZipFile(next(tmp_path.glob("stabmap-*.whl"))).namelist()
     assert "stabmap/kernels/block.py" in names
     assert not [n for n in names if n.startswith("kernels/")]
+    # the build compiled the kernels into the package (setup.py): the first run loads them
+    assert [n for n in names if n.startswith("stabmap/kernels/_cache/kernels-") and "block.decide_block-" in n and n.endswith(".nbi")]

@@ -20,12 +20,22 @@ def decided_by_from_status(status: np.ndarray) -> np.ndarray:
     return by
 
 
+def kernel_args(points: PointArrays) -> tuple:
+    """``points.kernel_args()`` as writable C-contiguous arrays: the types ``pip install`` compiled the kernel for.
+
+    A read-only or strided array (a broadcast view, say) is another numba signature, and
+    so a second compilation of the whole kernel on the first call (about 20 s); copying
+    the few such arrays is cheap (kernels/precompile.py).
+    """
+    return tuple(np.require(a, requirements=("C", "W")) if isinstance(a, np.ndarray) else a for a in points.kernel_args())
+
+
 def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
     """Return (n_complex_pairs int16, decided_by int8) for every point; -1 marks p identically zero."""
     npts = points.body.shape[0]
     nc = np.empty(npts, dtype=np.int16)
     status = np.empty(npts, dtype=np.int8)
-    decide_block(*points.kernel_args(), nc, status)
+    decide_block(*kernel_args(points), nc, status)
     undecided = np.flatnonzero(status == UNDECIDED)
     if undecided.size:
         nc[undecided] = exact.decide_points(*points.kernel_args(), undecided)
