@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
@@ -179,13 +180,13 @@ def main(argv: list[str] | None = None) -> int:
         cli.main(args=argv, prog_name="stabmap", standalone_mode=False)
     except StabmapError as exc:
         click.echo(f"stabmap: error: {exc}", err=True)
-        return 2
+        return getattr(exc, "exit_status", 2)  # 2: bad input; 3: the dask scheduler was lost
     except click.ClickException as exc:
         exc.show()
-        return exc.exit_code
+        return _leave(exc.exit_code, argv)
     except (KeyboardInterrupt, click.Abort):
         click.echo("stabmap: interrupted", err=True)
-        return 130
+        return _leave(130, argv)
     except BrokenPipeError:  # output piped into e.g. head, which stopped reading
         sys.stdout = None
         return 0
@@ -193,6 +194,18 @@ def main(argv: list[str] | None = None) -> int:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
     return 0
+
+
+def _leave(status: int, argv) -> int:
+    """After Ctrl-C: the command's process (``argv`` None: run as ``stabmap ...``) exits now, even while a thread
+    still runs a task it cannot stop (every finished chunk is already saved); a call from Python returns."""
+    if status == 130 and argv is None:
+        others = [t for t in threading.enumerate() if t is not threading.main_thread() and not t.daemon and t.is_alive()]
+        if others:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(status)
+    return status
 
 
 def _interrupt(signum, frame):

@@ -1,14 +1,17 @@
 """Atlases on a real dask.distributed cluster (scheduler and workers as processes on loopback), streamed to
-files, surviving a killed worker, and resumed after an interrupted run."""
+files, surviving killed, stopped, restarted and late workers and a lost scheduler, and resumed after an
+interrupted run."""
 
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,7 +23,9 @@ from stabmap import cli
 from stabmap.run import atlas
 from stabmap.run import runner as cluster
 from stabmap.run.atlas import compute, compute_to_file
-from stabmap.run.chunks import chunk_locations, chunk_shape, default_chunk_points
+from stabmap.run.chunks import MIN_CHUNK_POINTS, TASK_SECONDS, chunk_locations, chunk_points_for, chunk_shape, probe_points
+from stabmap.run.runner import FIRST_TASK_POINTS, Pace
+from stabmap.run.tasks import point_order, probe
 from stabmap.store.files import open_atlas
 from stabmap.store.checkpoint import Checkpoint, partial_dir
 
@@ -86,34 +91,70 @@ def slow_local(slow_scene_file):
 
 
 class LoopbackCluster:
-    """``dask scheduler`` and ``dask worker`` processes on 127.0.0.1 (workers without nanny: one pid each)."""
+    """``dask scheduler`` and ``dask worker`` processes on 127.0.0.1, importing this checkout of stabmap.
 
-    def __init__(self, tmp_path, workers: int):
-        self.file = tmp_path / "scheduler.json"
-        self.procs = [self._start("scheduler", "--host", "127.0.0.1", "--port", "0", "--scheduler-file", str(self.file))]
+    ``nanny=False`` starts each worker as one process; ``nanny=True`` the default way, a nanny process that starts
+    the worker process and restarts it when it dies.  ``worker_pid(i)`` is the process that runs the tasks.
+    """
+
+    def __init__(self, tmp_path, workers: int, nanny: bool = False, wait: bool = True):
+        self.tmp, self.nanny = Path(tmp_path), nanny
+        self.file = self.tmp / "scheduler.json"
+        self.file.unlink(missing_ok=True)
+        self.scheduler = self._start("scheduler", "--host", "127.0.0.1", "--port", "0", "--scheduler-file", str(self.file))
+        self.procs = [self.scheduler]
         deadline = time.monotonic() + 60
         while not self.file.exists():
             assert time.monotonic() < deadline, "the dask scheduler did not start"
             time.sleep(0.1)
+        time.sleep(0.2)  # the file is written whole, but give it a moment
         self.address = json.loads(self.file.read_text())["address"]
-        self.workers = [
-            self._start("worker", self.address, "--nthreads", "1", "--no-nanny", "--name", f"w{i}") for i in range(workers)
-        ]
-        self.procs += self.workers
+        self.workers = []
+        for _ in range(workers):
+            self.add_worker()
+        if wait:
+            self.wait_for(workers)
+
+    def add_worker(self) -> subprocess.Popen:
+        extra = [] if self.nanny else ["--no-nanny"]
+        p = self._start("worker", self.address, "--nthreads", "1", *extra, "--name", f"w{len(self.workers)}")
+        self.workers.append(p)
+        self.procs.append(p)
+        return p
+
+    def wait_for(self, n: int) -> None:
         from distributed import Client
 
-        with Client(self.address, timeout=60) as c:
-            c.wait_for_workers(workers, timeout=120)
+        with Client(self.address, timeout=60, set_as_default=False) as c:
+            c.wait_for_workers(n, timeout=120)
+
+    def worker_pid(self, i: int) -> int:
+        """The pid of worker ``i``'s task-running process (under its nanny, if it has one)."""
+        if not self.nanny:
+            return self.workers[i].pid
+        import psutil
+
+        deadline = time.monotonic() + 60
+        while True:
+            children = [c for c in psutil.Process(self.workers[i].pid).children() if "spawn" in " ".join(c.cmdline())]
+            if children:
+                return children[0].pid
+            assert time.monotonic() < deadline, "the nanny started no worker"
+            time.sleep(0.1)
 
     @staticmethod
     def _start(*args):
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(stabmap.__file__).parents[1]), os.environ.get("PYTHONPATH", "")]))
         return subprocess.Popen(
-            [sys.executable, "-m", "dask", *args, "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+            [sys.executable, "-m", "dask", *args, "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            env=env,
         )
 
     def close(self):
         for p in reversed(self.procs):
             if p.poll() is None:
+                with __import__("contextlib").suppress(OSError):
+                    os.kill(p.pid, signal.SIGCONT)
                 p.terminate()
         for p in self.procs:
             try:
@@ -139,15 +180,41 @@ def test_chunk_layout_covers_the_grid_once():
         assert int(np.prod(chunks)) <= points
 
 
-def test_default_chunks_bounded_by_time_memory_and_balance(slow_scene_file):
+def test_chunks_follow_the_measured_cost(slow_scene_file):
     scene = stabmap.load_scene(slow_scene_file)
-    small = default_chunk_points(scene, threads=2)
-    assert 1024 <= small <= 38400 // 8  # at least four tasks a thread, never tiny ones
     big = resample(scene, omega=4000, m_2=4000)
-    # 16 M points of degree 18: the time bound (about half a second on a core) decides, not the grid.
-    assert 256 <= default_chunk_points(big, threads=2) <= 16384
-    dry = stabmap.example("paper-n1-fixed-dry")  # degree 2: over a million points a second; the cap decides
-    assert default_chunk_points(resample(dry, **{a.name: 4000 for a in dry.grid}), threads=2) == 1 << 18
+    # 16 M points: the time rule decides, a chunk being an eighth of a second at the measured cost.
+    assert chunk_points_for(big, 1e-4, threads=2) == 1250
+    assert chunk_points_for(big, 1e-3, threads=2) == 125
+    assert chunk_points_for(big, 1.0, threads=2) == MIN_CHUNK_POINTS  # never tiny chunks, however slow the points
+    assert chunk_points_for(big, 1e-9, threads=2) == (64 << 20) // 400  # 64 MiB of inputs (400 bytes a point)
+    dry = stabmap.example("paper-n1-fixed-dry")  # degree 2: small inputs, so the cap on points decides
+    assert chunk_points_for(resample(dry, **{a.name: 4000 for a in dry.grid}), 1e-9, threads=2) == 1 << 18
+    assert chunk_points_for(scene, 1e-6, threads=2) == 38400 // 16  # a small grid: at least eight chunks a thread
+
+
+def test_task_size_follows_the_measured_pace():
+    pace = Pace()
+    assert pace.task_points(10**6, 2) == FIRST_TASK_POINTS  # nothing timed yet: a small first task
+    for cost in (1e-5, 1e-2):  # a scene turns out cheap, then a region 1000x dearer (exact fallbacks, say)
+        for _ in range(60):
+            points = pace.task_points(10**9, 2)
+            pace.record(points, points * cost)
+        assert pace.task_points(10**9, 2) == pytest.approx(TASK_SECONDS / cost, rel=1e-3)
+    # The end of a batch: tasks shrink so the threads finish together, down to an eighth of a full task.
+    assert pace.task_points(40, 2) == 10 and pace.task_points(8, 2) == int(TASK_SECONDS / 1e-2 / 8)
+    assert Pace(1e-3).task_points(10**9, 4) == pytest.approx(TASK_SECONDS / 1e-3)  # a probe's measurement
+
+
+def test_probe_times_neighbouring_points_spread_over_the_grid(slow_scene_file):
+    scene = stabmap.load_scene(slow_scene_file)
+    values = probe_points(scene, point_order(scene))
+    assert set(values) == {"omega", "m_2"} and len(values["omega"]) == 512
+    assert np.isin(values["omega"], scene.grid[0].array).all() and np.isin(values["m_2"], scene.grid[1].array).all()
+    assert len(np.unique(values["m_2"])) > 16  # spread over the grid ...
+    assert (np.diff(values["omega"].reshape(32, 16), axis=1) > 0).all()  # ... in runs along the fastest axis
+    points, seconds = probe(scene, values)
+    assert 1 <= points <= 512 and seconds > 0
 
 
 def test_cluster_equals_in_process(loopback, slow_scene_file, slow_local):
