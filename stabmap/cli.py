@@ -73,12 +73,14 @@ def cli() -> None:
 def atlas(scene, example, output, png, threads, workers, scheduler, chunk_points, resume, refine, coarse_stride, margin, quiet):
     """Compute an atlas from a scene and write netCDF4 or Zarr, here or on a dask cluster."""
     from . import jobs
+    from .run.runner import quiet_dask_logs
 
     try:
-        _report(jobs.atlas(
-            jobs.scene(scene, example), output, png=png, refine=refine, coarse_stride=coarse_stride, margin=margin,
-            resume=resume, chunk_points=chunk_points, progress=not quiet, **_where(scheduler, workers, threads),
-        ))
+        with quiet_dask_logs(scheduler is not None or workers is not None):
+            _report(jobs.atlas(
+                jobs.scene(scene, example), output, png=png, refine=refine, coarse_stride=coarse_stride, margin=margin,
+                resume=resume, chunk_points=chunk_points, progress=not quiet, **_where(scheduler, workers, threads),
+            ))
     except KeyboardInterrupt:
         raise Interrupted(jobs.interrupted(output)) from None
 
@@ -153,12 +155,14 @@ def plot(atlas, items, output, x, y, sel, facet, max_panels):
 def critical(scene, example, along, output, png, rtol, threads, workers, scheduler, chunk_points, quiet):
     """Stable intervals of one parameter (e.g. the critical spin rates), ends to 1e-10."""
     from . import jobs
+    from .run.runner import quiet_dask_logs
 
     try:
-        _report(jobs.critical(
-            jobs.scene(scene, example), output, along=along, rtol=rtol, png=png, chunk_points=chunk_points,
-            listing=not quiet, progress=not quiet, **_where(scheduler, workers, threads),
-        ))
+        with quiet_dask_logs(scheduler is not None or workers is not None):
+            _report(jobs.critical(
+                jobs.scene(scene, example), output, along=along, rtol=rtol, png=png, chunk_points=chunk_points,
+                listing=not quiet, progress=not quiet, **_where(scheduler, workers, threads),
+            ))
     except KeyboardInterrupt:
         raise Interrupted("no output file was written") from None
 

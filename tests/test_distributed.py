@@ -99,6 +99,7 @@ class LoopbackCluster:
 
     def __init__(self, tmp_path, workers: int, nanny: bool = False, wait: bool = True):
         self.tmp, self.nanny = Path(tmp_path), nanny
+        self.tmp.mkdir(parents=True, exist_ok=True)
         self.file = self.tmp / "scheduler.json"
         self.file.unlink(missing_ok=True)
         self.scheduler = self._start("scheduler", "--host", "127.0.0.1", "--port", "0", "--scheduler-file", str(self.file))
@@ -268,40 +269,128 @@ def test_refine_and_critical_on_the_cluster_equal_in_process(loopback, tmp_path,
     _same_atlas(open_atlas(tmp_path / "refined.nc"), stabmap.compute_refined(scan, threads=1, progress=False))
 
 
+def _in_thread(fn):
+    """Run ``fn()`` in a thread; returns the thread and a dict that gets its 'result' or 'error'."""
+    out = {}
+
+    def run():
+        try:
+            out["result"] = fn()
+        except BaseException as exc:  # noqa: BLE001 - handed to the test thread
+            out["error"] = exc
+
+    t = threading.Thread(target=run)
+    t.start()
+    return t, out
+
+
+def _wait_until(condition, t, out, timeout=180):
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline and t.is_alive(), out
+        time.sleep(0.02)
+
+
+def _finished_run(t, out):
+    t.join(300)
+    assert not t.is_alive(), "the run did not finish"
+    assert "error" not in out, out.get("error")
+    return out["result"]
+
+
 @pytest.mark.slow
-def test_killed_worker_does_not_lose_the_atlas(tmp_path, slow_scene_file, slow_local):
-    c = LoopbackCluster(tmp_path, workers=2)
+@pytest.mark.parametrize("nanny", [False, True], ids=["no-nanny", "nanny"])
+def test_killed_worker_does_not_lose_the_atlas(nanny, tmp_path, slow_scene_file, slow_local):
+    """The issue's reproduction: SIGKILL of a 'dask worker' process mid-run (with a nanny: the nanny itself)."""
+    c = LoopbackCluster(tmp_path, workers=2, nanny=nanny)
     try:
         out = tmp_path / "a.nc"
-        result = {}
-
-        def run():
-            try:
-                result["report"] = compute_to_file(
-                    stabmap.load_scene(slow_scene_file), out, client=c.address, chunk_points=SLOW_CHUNK, progress=False
-                )
-            except BaseException as exc:  # noqa: BLE001 - handed to the test thread
-                result["error"] = exc
-
-        t = threading.Thread(target=run)
-        t.start()
         saved = partial_dir(out)
-        deadline = time.monotonic() + 120
-        while len(_finished(saved)) < 4:
-            assert time.monotonic() < deadline and t.is_alive(), result
-            time.sleep(0.02)
+        t, result = _in_thread(lambda: compute_to_file(
+            stabmap.load_scene(slow_scene_file), out, client=c.address, chunk_points=SLOW_CHUNK, progress=False
+        ))
+        _wait_until(lambda: len(_finished(saved)) >= 4, t, result)
         victim = c.workers[0]
         victim.send_signal(signal.SIGKILL)
         done_at_kill = len(_finished(saved))
-        t.join(300)
+        report = _finished_run(t, result)
         assert victim.wait(10) == -signal.SIGKILL
-        assert "error" not in result, result.get("error")
-        report = result["report"]
         assert done_at_kill < report.chunks  # the worker died with chunks still to do
         assert report.computed == report.chunks
         _same_atlas(open_atlas(out), slow_local)
     finally:
         c.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("nanny", [False, True], ids=["no-nanny", "nanny"])
+def test_late_frozen_lost_and_restarted_workers_do_not_change_the_atlas(nanny, tmp_path, slow_scene_file, slow_local):
+    """A run that starts on a cluster without workers: the first worker joins during start-up, is frozen (SIGSTOP)
+    mid-run, a second one joins, and the frozen one is killed (with a nanny: restarted).  The run's probe and
+    default task sizes are used, so every kind of task meets the faults."""
+    c = LoopbackCluster(tmp_path, workers=0, nanny=nanny, wait=False)
+    try:
+        out = tmp_path / "a.nc"
+        saved = partial_dir(out)
+        t, result = _in_thread(lambda: compute_to_file(stabmap.load_scene(slow_scene_file), out, client=c.address, progress=False))
+        time.sleep(1.0)  # the run waits for a worker
+        c.add_worker()
+        _wait_until(lambda: len(_finished(saved)) >= 2, t, result)
+        first = c.worker_pid(0)
+        os.kill(first, signal.SIGSTOP)  # its tasks hang: the scheduler still counts it
+        c.add_worker()
+        c.wait_for(2)
+        os.kill(first, signal.SIGKILL)  # now it is lost, its tasks go to the late worker (and, with a nanny, its restart)
+        report = _finished_run(t, result)
+        assert report.computed == report.chunks
+        _same_atlas(open_atlas(out), slow_local)
+    finally:
+        c.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("nanny", [False, True], ids=["no-nanny", "nanny"])
+def test_worker_that_dies_during_start_up_is_not_asked_anything(nanny, tmp_path, slow_scene_file, slow_local):
+    """Before this change the start-up version check went to every worker (Client.run) and failed the run with
+    CommClosedError when one died meanwhile; a frozen worker made it hang.  Now no call goes to every worker."""
+    c = LoopbackCluster(tmp_path, workers=2, nanny=nanny)
+    try:
+        victim = c.worker_pid(0)
+        os.kill(victim, signal.SIGSTOP)
+        threading.Timer(2.0, os.kill, (victim, signal.SIGKILL)).start()
+        ds = compute(stabmap.load_scene(slow_scene_file), client=c.address, progress=False)
+        _same_atlas(ds, slow_local)
+    finally:
+        c.close()
+
+
+@pytest.mark.slow
+def test_lost_scheduler_ends_the_run_and_resume_on_a_new_one_finishes_it(tmp_path, slow_scene_file, slow_local):
+    out = tmp_path / "a.nc"
+    saved = partial_dir(out)
+    args = ["atlas", str(slow_scene_file), "-o", str(out), "--chunk-points", str(SLOW_CHUNK), "-q"]
+    first = LoopbackCluster(tmp_path / "first", workers=1)
+    try:
+        proc = _start_cli(args + ["--scheduler", first.address])
+        _wait_for_chunks(saved, proc, 3)
+        first.scheduler.send_signal(signal.SIGKILL)
+        stdout, stderr = proc.communicate(timeout=120)
+    finally:
+        first.close()
+    assert proc.returncode == 3, stderr
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1, stderr  # one line, no traceback or log
+    assert lines[0].startswith(f"stabmap: error: lost the dask scheduler at {first.address}")
+    assert "--resume" in lines[0] and str(saved) in lines[0]
+    done = _finished(saved)
+    assert len(done) >= 3
+    second = LoopbackCluster(tmp_path / "second", workers=1)
+    try:
+        assert cli.main(args + ["--resume", "--scheduler", second.address]) == 0
+    finally:
+        second.close()
+    assert not saved.exists()
+    _same_atlas(open_atlas(out), slow_local)
 
 
 def _start_cli(args, **kw):
@@ -322,13 +411,28 @@ def _wait_for_chunks(saved, proc, n):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("how", [signal.SIGKILL, signal.SIGINT, signal.SIGTERM])
-def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(how, tmp_path, slow_scene_file, slow_local, monkeypatch, capsys):
+@pytest.mark.parametrize(
+    "how,where,sizing",
+    [
+        (signal.SIGKILL, "threads", "fixed"),
+        (signal.SIGINT, "threads", "fixed"),
+        (signal.SIGTERM, "threads", "fixed"),
+        (signal.SIGINT, "threads", "measured"),
+        (signal.SIGINT, "cluster", "measured"),
+    ],
+)
+def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(
+    how, where, sizing, request, tmp_path, slow_scene_file, slow_local, monkeypatch, capsys
+):
     out = tmp_path / "a.nc"
     saved = partial_dir(out)
-    args = ["atlas", str(slow_scene_file), "-o", str(out), "--threads", "1", "--chunk-points", str(SLOW_CHUNK), "-q"]
-    proc = _start_cli(args)
+    args = ["atlas", str(slow_scene_file), "-o", str(out), "-q"]
+    if sizing == "fixed":
+        args += ["--chunk-points", str(SLOW_CHUNK)]
+    here = ["--threads", "1"]
+    proc = _start_cli(args + (here if where == "threads" else ["--scheduler", request.getfixturevalue("loopback").address]))
     _wait_for_chunks(saved, proc, 3)
+    before = len(_finished(saved))
     proc.send_signal(how)
     stdout, stderr = proc.communicate(timeout=60)
     if how == signal.SIGKILL:
@@ -339,17 +443,20 @@ def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(how, t
     assert not out.exists()
     assert [p.name for p in tmp_path.iterdir()] == [saved.name]  # no temporary file left beside it
     done = _finished(saved)
-    total = len(chunk_locations((240, 160), chunk_shape((240, 160), SLOW_CHUNK)))
-    assert 3 <= len(done) < total
+    chunks = Checkpoint.open(saved).chunks
+    total = len(chunk_locations((240, 160), chunks))
+    assert before <= len(done) < total
+    if sizing == "fixed":
+        assert chunks == chunk_shape((240, 160), SLOW_CHUNK)
 
     # Without --resume the finished work is not thrown away silently.
-    assert cli.main(args) == 2
+    assert cli.main(args + here) == 2
     assert "--resume" in capsys.readouterr().err
-    # --resume computes exactly the missing chunks (counted at the task function itself).
+    # --resume computes exactly the missing chunks (counted at the task function itself), in this process.
     calls = []
-    task = atlas.evaluate_block
-    monkeypatch.setattr(atlas, "evaluate_block", lambda scene, loc: calls.append(loc) or task(scene, loc))
-    assert cli.main(args + ["--resume"]) == 0
+    task = atlas.evaluate_blocks
+    monkeypatch.setattr(atlas, "evaluate_blocks", lambda scene, locs: calls.extend(locs) or task(scene, locs))
+    assert cli.main(args + here + ["--resume"]) == 0
     err = capsys.readouterr().err
     assert len(calls) == total - len(done)
     assert f"resumed: {len(done)} of {total} chunks were already done" in err

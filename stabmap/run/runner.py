@@ -223,9 +223,7 @@ class Runner:
     def _check_scheduler(self, exc: BaseException | None = None) -> None:
         """Raise SchedulerLost if the client has lost its scheduler (its futures are then cancelled)."""
         if self.client is not None and getattr(self.client, "status", "running") != "running":
-            raise SchedulerLost(
-                f"lost the dask scheduler at {self.address} ({type(exc).__name__ if exc else 'disconnected'})"
-            ) from None
+            raise SchedulerLost(f"lost the dask scheduler at {self.address} mid-run") from None
         if isinstance(exc, CancelledError) and self.client is not None:
             raise StabmapError(
                 f"the dask scheduler at {self.address} cancelled this run's tasks (was the cluster restarted?)"
@@ -255,6 +253,26 @@ def start(client=None, *, workers: int | None = None, threads: int | None = None
                 file=sys.stderr,
             )
         yield runner
+
+
+@contextlib.contextmanager
+def quiet_dask_logs(enabled: bool = True) -> Iterator[None]:
+    """Silence the client-side logs of dask.distributed (and tornado) in this process while inside: the command
+    line reports a lost worker or scheduler in its own words.  The scheduler's and workers' own logs are untouched."""
+    if not enabled:
+        yield
+        return
+    import distributed  # noqa: F401 - sets up its loggers' handlers
+
+    handlers = [h for name in ("distributed", "tornado") for h in logging.getLogger(name).handlers]
+    levels = [h.level for h in handlers]
+    for h in handlers:
+        h.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for h, level in zip(handlers, levels):
+            h.setLevel(level)
 
 
 @contextlib.contextmanager
@@ -305,4 +323,4 @@ def wait_for_workers(client) -> None:
             f"start some with 'dask worker {client.scheduler.address}'"
         ) from None
     except Exception as exc:  # noqa: BLE001 - the scheduler went away while we waited
-        raise SchedulerLost(f"lost the dask scheduler at {client.scheduler.address} ({type(exc).__name__}: {exc})") from None
+        raise SchedulerLost(f"lost the dask scheduler at {client.scheduler.address} ({type(exc).__name__})") from None
