@@ -81,3 +81,9 @@ def test_bench_exact_quick(capsys):
     assert [r["degree"] for r in rows] == [6, 12]
     assert all(r["total"] >= r["roots"] > 0 and r["before"] > 0 for r in rows)
     assert "| n | modes | degree |" in capsys.readouterr().out
+
+
+def test_bench_progress_quick(capsys):
+    out = runpy.run_path(str(SCRIPTS / "bench_progress.py"))["main"](["--quick"])
+    assert [r["code"] for r in out["first"]] == ["this"] and out["first"][0]["run s"] > 0
+    assert "| scene | code | first line s |" in capsys.readouterr().out
