@@ -46,6 +46,12 @@ def resample_scene(example: str, sizes: dict[str, int], path: Path, code: Path) 
     return path
 
 
+def _default_sigint() -> None:
+    """In the child: Ctrl-C acts as in a terminal even when this script runs in the background (where a shell
+    starts it with SIGINT ignored, which a child inherits)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _env(code: Path) -> dict:
     return dict(os.environ, PYTHONPATH=str(code))
 
@@ -55,7 +61,8 @@ class Watched:
 
     def __init__(self, cmd: list[str], code: Path, cwd: Path):
         self.t0 = time.perf_counter()
-        self.proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, env=_env(code), cwd=cwd)
+        self.proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, env=_env(code), cwd=cwd,
+                                     preexec_fn=_default_sigint)
         self.lines: list[tuple[float, str]] = []
         self.reader = threading.Thread(target=self._read, daemon=True)
         self.reader.start()
@@ -179,7 +186,7 @@ def killed_worker(scene: Path, code: Path, tmp: Path, kill_at: float, which: str
 
 def _table(rows: list[dict]) -> str:
     keys = list(rows[0])
-    fmt = lambda v: f"{v:.1f}" if isinstance(v, float) else f"{v:,}" if isinstance(v, int) else str(v)  # noqa: E731
+    fmt = lambda v: f"{v:.1f}" if isinstance(v, float) else f"{v:,}" if isinstance(v, int) else str(v)
     return "\n".join(["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
                      + ["| " + " | ".join(fmt(r[k]) for k in keys) + " |" for r in rows])
 

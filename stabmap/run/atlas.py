@@ -22,7 +22,14 @@ from ..store.dataset import atlas_dataset, empty_arrays
 from ..store.files import check_writable, write_streamed
 from ..systems.base import SceneBase
 from . import runner
-from .chunks import MIN_CHUNK_POINTS, check_chunk_points, chunk_locations, chunk_points_for, chunk_shape, probe_points
+from .chunks import (
+    MIN_CHUNK_POINTS,
+    check_chunk_points,
+    chunk_locations,
+    chunk_points_for,
+    chunk_shape,
+    probe_points,
+)
 from .progress import ProgressLine, Rate, wanted
 from .tasks import evaluate_blocks, evaluate_points, point_order, probe
 
@@ -193,27 +200,30 @@ def compute_to_file(
                 f"resume it, or delete {str(where)!r} to start over"
             )
     chunk_points = check_chunk_points(chunk_points)
-    with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run, _Layout(
-        run, scene, progress, chunk_points, checkpoint
-    ) as layout:
+    try:
+        with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run, _Layout(
+            run, scene, progress, chunk_points, checkpoint
+        ) as layout:
+            if checkpoint is None:
+                checkpoint = Checkpoint.create(where, system, scene, layout.chunks)
+            done = checkpoint.done()
+            todo = [i for i in range(len(layout.locations)) if i not in done]
+            try:
+                layout.run(todo, lambda i, block: checkpoint.save(i, layout.locations[i], block))
+            except (StabmapError, KeyboardInterrupt):
+                raise
+            except Exception as exc:
+                raise StabmapError(
+                    f"the run failed ({type(exc).__name__}: {exc}); {len(checkpoint.done())} of {len(layout.locations)} "
+                    f"chunks are saved in {str(where)!r}; fix the cause and run again with --resume"
+                ) from exc
+    except runner.SchedulerLost as exc:
         if checkpoint is None:
-            checkpoint = Checkpoint.create(where, system, scene, layout.chunks)
-        done = checkpoint.done()
-        todo = [i for i in range(len(layout.locations)) if i not in done]
-        try:
-            layout.run(todo, lambda i, block: checkpoint.save(i, layout.locations[i], block))
-        except runner.SchedulerLost as exc:
-            raise runner.SchedulerLost(
-                f"{exc}; {len(checkpoint.done())} of {len(layout.locations)} chunks are saved in {str(where)!r}: start a "
-                "scheduler and workers and run the same command with --resume (and the new --scheduler ADDRESS)"
-            ) from None
-        except (StabmapError, KeyboardInterrupt):
-            raise
-        except Exception as exc:
-            raise StabmapError(
-                f"the run failed ({type(exc).__name__}: {exc}); {len(checkpoint.done())} of {len(layout.locations)} chunks are "
-                f"saved in {str(where)!r}; fix the cause and run again with --resume"
-            ) from exc
+            raise runner.SchedulerLost(f"{exc}; nothing was saved yet: run the same command again on a working cluster") from None
+        raise runner.SchedulerLost(
+            f"{exc}; {len(checkpoint.done()):,} of {len(chunk_locations(checkpoint.shape, checkpoint.chunks)):,} chunks are saved in {str(where)!r}: start a "
+            "scheduler and workers and run the same command with --resume (and the new --scheduler ADDRESS)"
+        ) from None
     arrays, store = checkpoint.arrays()
     with store:
         write_streamed(atlas_dataset(system, scene, arrays), path)
@@ -236,19 +246,24 @@ class _Layout:
         self.total = math.prod(scene.shape)
         self.done_before = 0  # points finished by an earlier, interrupted run
         self.batch = chunk_points is None
+        order = point_order(scene)
         if checkpoint is not None:
             chunks = checkpoint.chunks
-            if chunk_points is not None and chunk_shape(scene.shape, chunk_points) != chunks:
+            if chunk_points is not None and chunk_shape(scene.shape, chunk_points, order) != chunks:
                 raise StabmapError(
                     f"chunk_points {chunk_points} gives other chunks than the interrupted run's {list(chunks)}; "
                     "leave chunk_points (--chunk-points) out to resume"
                 )
         elif chunk_points is not None:
-            chunks = chunk_shape(scene.shape, chunk_points)
+            chunks = chunk_shape(scene.shape, chunk_points, order)
         elif self.total // (8 * run.slots()) <= MIN_CHUNK_POINTS:  # a small grid: balance decides, not time
-            chunks = chunk_shape(scene.shape, chunk_points_for(scene, 0.0, run.slots()))
+            chunks = chunk_shape(scene.shape, chunk_points_for(scene, 0.0, run.slots()), order)
         else:
-            chunks = chunk_shape(scene.shape, chunk_points_for(scene, self._probe(), run.slots()))
+            try:
+                chunks = chunk_shape(scene.shape, chunk_points_for(scene, self._probe(), run.slots()), order)
+            except BaseException:
+                self.progress.close()
+                raise
         self.chunks = chunks
         self.locations = chunk_locations(scene.shape, chunks)
 

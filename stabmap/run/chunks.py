@@ -2,7 +2,7 @@
 
 Nothing here models what a point costs: a dense atlas first times a probe of a
 few hundred points spread over the grid (``stabmap.run.tasks.probe``), and
-cuts the grid into chunks of about BLOCK_SECONDS of work each.  The runner then
+cuts the grid into chunks of about BLOCK_SECONDS of work each, long along the axes the kernels run fastest.  The runner then
 hands out tasks of several chunks (or, for lists of points, of several points),
 sized from the run times of the tasks that finished (``stabmap.run.runner.Pace``),
 so each task lasts about TASK_SECONDS whatever the scene: long enough that the
@@ -22,11 +22,11 @@ from ..errors import StabmapError
 from ..systems.base import SceneBase
 
 TASK_SECONDS = 0.5  # aimed-for run time of one task on one core
-BLOCK_SECONDS = TASK_SECONDS / 4  # aimed-for run time of one chunk of the grid (a task holds one or several)
+BLOCK_SECONDS = TASK_SECONDS / 2  # aimed-for run time of one chunk of the grid (a task holds one or several)
 MAX_CHUNK_POINTS = 1 << 18
 MAX_CHUNK_BYTES = 64 << 20  # the points' input arrays of one task
 MIN_CHUNK_POINTS = 16  # the time rule never cuts chunks smaller than this (balance may, on tiny grids)
-PROBE_RUNS, PROBE_RUN = 32, 16  # the probe: 32 runs of 16 neighbouring points along the fastest axis
+PROBE_RUNS, PROBE_RUN = 8, 64  # the probe: 8 runs of 64 neighbouring points along the fastest axis
 
 
 def chunk_points_for(scene: SceneBase, seconds_per_point: float, threads: int, npoints: int | None = None) -> int:
@@ -67,15 +67,20 @@ def check_chunk_points(value, option: str = "chunk_points") -> int | None:
     return int(value)
 
 
-def chunk_shape(shape: tuple[int, ...], points: int) -> tuple[int, ...]:
-    """Chunk sizes per axis holding about ``points`` points, trailing axes kept whole first."""
-    chunks = []
+def chunk_shape(shape: tuple[int, ...], points: int, order: tuple[int, ...] | None = None) -> tuple[int, ...]:
+    """Chunk sizes per axis holding about ``points`` points, the axes last in ``order`` kept whole first.
+
+    ``order`` is the order the kernels visit the axes, the fastest last (``stabmap.run.tasks.point_order``;
+    default: the grid's): a chunk then holds long runs along the fastest axes, the runs the kernels are quick
+    on (work shared by neighbouring points, such as a cavity's liquid modes or a chain's matrices).
+    """
+    order = tuple(range(len(shape))) if order is None else tuple(order)
+    chunks = list(shape)
     budget = max(1, points)
-    for size in reversed(shape):
-        c = max(1, min(size, budget))
-        chunks.append(c)
-        budget = max(1, budget // c)
-    return tuple(reversed(chunks))
+    for d in reversed(order):
+        chunks[d] = max(1, min(shape[d], budget))
+        budget = max(1, budget // chunks[d])
+    return tuple(chunks)
 
 
 def chunk_locations(shape: tuple[int, ...], chunks: tuple[int, ...]) -> list[tuple[tuple[int, int], ...]]:
