@@ -177,7 +177,9 @@ def checkpoint_saves(cases: list[tuple[int, int, int]]) -> list[dict]:
 def _n_tasks(scene, cp: int) -> int:
     from stabmap.run.chunks import chunk_locations, chunk_shape
 
-    return len(chunk_locations(scene.shape, chunk_shape(scene.shape, cp)))
+    from stabmap.run.tasks import point_order
+
+    return len(chunk_locations(scene.shape, chunk_shape(scene.shape, cp, point_order(scene))))
 
 
 PEAK = textwrap.dedent(

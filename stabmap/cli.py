@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
@@ -72,12 +73,14 @@ def cli() -> None:
 def atlas(scene, example, output, png, threads, workers, scheduler, chunk_points, resume, refine, coarse_stride, margin, quiet):
     """Compute an atlas from a scene and write netCDF4 or Zarr, here or on a dask cluster."""
     from . import jobs
+    from .run.runner import quiet_dask_logs
 
     try:
-        _report(jobs.atlas(
-            jobs.scene(scene, example), output, png=png, refine=refine, coarse_stride=coarse_stride, margin=margin,
-            resume=resume, chunk_points=chunk_points, progress=not quiet, **_where(scheduler, workers, threads),
-        ))
+        with quiet_dask_logs(scheduler is not None or workers is not None):
+            _report(jobs.atlas(
+                jobs.scene(scene, example), output, png=png, refine=refine, coarse_stride=coarse_stride, margin=margin,
+                resume=resume, chunk_points=chunk_points, progress=not quiet, **_where(scheduler, workers, threads),
+            ))
     except KeyboardInterrupt:
         raise Interrupted(jobs.interrupted(output)) from None
 
@@ -152,12 +155,14 @@ def plot(atlas, items, output, x, y, sel, facet, max_panels):
 def critical(scene, example, along, output, png, rtol, threads, workers, scheduler, chunk_points, quiet):
     """Stable intervals of one parameter (e.g. the critical spin rates), ends to 1e-10."""
     from . import jobs
+    from .run.runner import quiet_dask_logs
 
     try:
-        _report(jobs.critical(
-            jobs.scene(scene, example), output, along=along, rtol=rtol, png=png, chunk_points=chunk_points,
-            listing=not quiet, progress=not quiet, **_where(scheduler, workers, threads),
-        ))
+        with quiet_dask_logs(scheduler is not None or workers is not None):
+            _report(jobs.critical(
+                jobs.scene(scene, example), output, along=along, rtol=rtol, png=png, chunk_points=chunk_points,
+                listing=not quiet, progress=not quiet, **_where(scheduler, workers, threads),
+            ))
     except KeyboardInterrupt:
         raise Interrupted("no output file was written") from None
 
@@ -179,13 +184,13 @@ def main(argv: list[str] | None = None) -> int:
         cli.main(args=argv, prog_name="stabmap", standalone_mode=False)
     except StabmapError as exc:
         click.echo(f"stabmap: error: {exc}", err=True)
-        return 2
+        return getattr(exc, "exit_status", 2)  # 2: bad input; 3: the dask scheduler was lost
     except click.ClickException as exc:
         exc.show()
-        return exc.exit_code
+        return _leave(exc.exit_code, argv)
     except (KeyboardInterrupt, click.Abort):
         click.echo("stabmap: interrupted", err=True)
-        return 130
+        return _leave(130, argv)
     except BrokenPipeError:  # output piped into e.g. head, which stopped reading
         sys.stdout = None
         return 0
@@ -193,6 +198,18 @@ def main(argv: list[str] | None = None) -> int:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
     return 0
+
+
+def _leave(status: int, argv) -> int:
+    """After Ctrl-C: the command's process (``argv`` None: run as ``stabmap ...``) exits now, even while a thread
+    still runs a task it cannot stop (every finished chunk is already saved); a call from Python returns."""
+    if status == 130 and argv is None:
+        others = [t for t in threading.enumerate() if t is not threading.main_thread() and not t.daemon and t.is_alive()]
+        if others:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(status)
+    return status
 
 
 def _interrupt(signum, frame):

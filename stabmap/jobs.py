@@ -7,6 +7,7 @@ can fail runs before any work starts, so bad input leaves no file.
 
 from __future__ import annotations
 
+import contextlib
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -72,7 +73,8 @@ def atlas(
     if refine:
         options = {"coarse_stride": refining.check_coarse_stride(coarse_stride, "--coarse-stride")}
         options["margin"] = refining.check_margin(refining.DEFAULT_MARGIN if margin is None else margin, "--margin")
-        ds = refining.compute_refined(scene, **options, **where)
+        with _no_checkpoint():
+            ds = refining.compute_refined(scene, **options, **where)
         write_atlas(ds, output)
         stats = summary_line(system, summary(ds), ds.attrs.get("n_evaluated_points"))
     else:
@@ -87,6 +89,17 @@ def atlas(
             plot_atlas(ds, png)
         lines.append(f"wrote {png}")
     return Done(lines)
+
+
+@contextlib.contextmanager
+def _no_checkpoint():
+    """A lost scheduler in a run that keeps no checkpoint (--refine, critical): say that it must start over."""
+    from .run.runner import SchedulerLost
+
+    try:
+        yield
+    except SchedulerLost as exc:
+        raise SchedulerLost(f"{exc}; nothing was written (this kind of run keeps no checkpoint): run it again") from None
 
 
 def summary_line(system, s: dict, evaluated=None) -> str:
@@ -138,7 +151,9 @@ def critical(
             )
     t0 = time.perf_counter()
     rtol = located.DEFAULT_RTOL if rtol is None else rtol
-    ds = located.critical(scene, along, rtol=rtol, client=client, workers=workers, threads=threads, progress=progress, chunk_points=chunk_points)
+    with _no_checkpoint():
+        ds = located.critical(scene, along, rtol=rtol, client=client, workers=workers, threads=threads, progress=progress,
+                              chunk_points=chunk_points)
     write_atlas(ds, output)
     lines = [f"wrote {output} in {time.perf_counter() - t0:.1f} s"]
     if png is not None:

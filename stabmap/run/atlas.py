@@ -9,11 +9,11 @@ interrupted run resumes where it stopped.
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
 
 from .. import systems
 from ..errors import StabmapError
@@ -22,9 +22,16 @@ from ..store.dataset import atlas_dataset, empty_arrays
 from ..store.files import check_writable, write_streamed
 from ..systems.base import SceneBase
 from . import runner
-from .chunks import check_chunk_points, chunk_locations, chunk_shape, default_chunk_points, spans
-from .progress import ProgressLine, wanted
-from .tasks import evaluate_block, evaluate_points
+from .chunks import (
+    MIN_CHUNK_POINTS,
+    check_chunk_points,
+    chunk_locations,
+    chunk_points_for,
+    chunk_shape,
+    probe_points,
+)
+from .progress import ProgressLine, Rate, wanted
+from .tasks import evaluate_blocks, evaluate_points, point_order, probe
 
 
 def compute(
@@ -52,7 +59,8 @@ def compute(
     progress : bool, optional
         Progress line on stderr for runs over two seconds (default: when stderr is a terminal).
     chunk_points : int, optional
-        Points per task (default: about half a second of work, see ``stabmap.run.chunks``).
+        Points per chunk of the grid and per task (default: chunks of about an eighth of a second of work, as
+        timed by a probe, and tasks of several chunks, about half a second each; see ``stabmap.run.chunks``).
     """
     chunk_points = check_chunk_points(chunk_points)
     with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run:
@@ -78,24 +86,66 @@ def decide_points(run: runner.Runner, scene: SceneBase, values: dict[str, np.nda
                   on_progress=None) -> dict[str, np.ndarray]:
     """Every variable at points given by equal-length 1-D arrays of grid-axis values, in tasks on ``run``.
 
-    ``on_progress(points_done)`` is called as tasks finish (refinement's progress line).
+    Tasks hold ``chunk_points`` points each, or (default) as many as ``run``'s measured pace puts in about half a
+    second.  ``on_progress(points_done)`` is called as tasks finish (refinement's progress line).
     """
     npts = len(next(iter(values.values())))
-    bounds = spans(npts, chunk_points or default_chunk_points(scene, run.threads, npts))
     out = {}
     done = [0]
 
-    def keep(i, result):
-        a, b = bounds[i]
+    def keep(bounds, result):
+        a, b = bounds
         for k, v in result.items():
             out.setdefault(k, np.empty((npts,) + v.shape[1:], dtype=v.dtype))[a:b] = v
         done[0] += b - a
         if on_progress is not None:
             on_progress(done[0])
 
-    args = [(scene, {k: v[a:b] for k, v in values.items()}) for a, b in bounds]
-    run.run(evaluate_points, args, list(range(len(bounds))), keep)
+    run.run(evaluate_points, scene, _Points(values, npts, chunk_points), keep)
     return out
+
+
+class _Points:
+    """A list of points, handed out as runs of consecutive points (``chunk_points`` each, or as asked)."""
+
+    def __init__(self, values: dict[str, np.ndarray], npts: int, fixed: int | None):
+        self.values, self.fixed, self.start, self.remaining = values, fixed, 0, npts
+
+    def take(self, points: int):
+        a = self.start
+        b = a + min(self.remaining, max(1, self.fixed or points))
+        self.start, self.remaining = b, self.remaining - (b - a)
+        return ({k: v[a:b] for k, v in self.values.items()},), (a, b), b - a
+
+
+class _Chunks:
+    """Chunks of the grid, handed out as tasks of one chunk or (``batch``) of as many as fit the points asked."""
+
+    def __init__(self, locations: list, todo: list[int], batch: bool):
+        self.locations, self.batch = locations, batch
+        self.size = {i: math.prod(b - a for a, b in locations[i]) for i in todo}
+        self.queue = deque(todo)
+        self.remaining = sum(self.size.values())
+
+    def take(self, points: int):
+        chunks = [self.queue.popleft()]
+        n = self.size[chunks[0]]
+        while self.batch and self.queue and n + self.size[self.queue[0]] <= points:
+            chunks.append(self.queue.popleft())
+            n += self.size[chunks[-1]]
+        self.remaining -= n
+        return ([self.locations[i] for i in chunks],), chunks, n
+
+
+class _Once:
+    """One task (the probe)."""
+
+    def __init__(self, *args):
+        self.args, self.remaining = args, 1
+
+    def take(self, points: int):
+        self.remaining = 0
+        return self.args, None, 0
 
 
 @dataclass
@@ -150,23 +200,30 @@ def compute_to_file(
                 f"resume it, or delete {str(where)!r} to start over"
             )
     chunk_points = check_chunk_points(chunk_points)
-    with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run, _Layout(
-        run, scene, progress, chunk_points, checkpoint
-    ) as layout:
+    try:
+        with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run, _Layout(
+            run, scene, progress, chunk_points, checkpoint
+        ) as layout:
+            if checkpoint is None:
+                checkpoint = Checkpoint.create(where, system, scene, layout.chunks)
+            done = checkpoint.done()
+            todo = [i for i in range(len(layout.locations)) if i not in done]
+            try:
+                layout.run(todo, lambda i, block: checkpoint.save(i, layout.locations[i], block))
+            except (StabmapError, KeyboardInterrupt):
+                raise
+            except Exception as exc:
+                raise StabmapError(
+                    f"the run failed ({type(exc).__name__}: {exc}); {len(checkpoint.done())} of {len(layout.locations)} "
+                    f"chunks are saved in {str(where)!r}; fix the cause and run again with --resume"
+                ) from exc
+    except runner.SchedulerLost as exc:
         if checkpoint is None:
-            checkpoint = Checkpoint.create(where, system, scene, layout.chunks)
-        done = checkpoint.done()
-        todo = [i for i in range(len(layout.locations)) if i not in done]
-        layout.done_before = len(done)
-        try:
-            layout.run(todo, lambda i, block: checkpoint.save(i, layout.locations[i], block))
-        except (StabmapError, KeyboardInterrupt):
-            raise
-        except Exception as exc:
-            raise StabmapError(
-                f"the run failed ({type(exc).__name__}: {exc}); {len(checkpoint.done())} of {len(layout.locations)} chunks are "
-                f"saved in {str(where)!r}; fix the cause and run again with --resume"
-            ) from exc
+            raise runner.SchedulerLost(f"{exc}; nothing was saved yet: run the same command again on a working cluster") from None
+        raise runner.SchedulerLost(
+            f"{exc}; {len(checkpoint.done()):,} of {len(chunk_locations(checkpoint.shape, checkpoint.chunks)):,} chunks are saved in {str(where)!r}: start a "
+            "scheduler and workers and run the same command with --resume (and the new --scheduler ADDRESS)"
+        ) from None
     arrays, store = checkpoint.arrays()
     with store:
         write_streamed(atlas_dataset(system, scene, arrays), path)
@@ -175,23 +232,40 @@ def compute_to_file(
 
 
 class _Layout:
-    """The blocks of one run's grid (a resumed run keeps its checkpoint's), where their tasks go, and the run's
-    progress line (closed on leaving the ``with``)."""
+    """The chunks of one run's grid (a resumed run keeps its checkpoint's), where their tasks go, and the run's
+    progress line (closed on leaving the ``with``).
+
+    Without a checkpoint or ``chunk_points``, a probe task first times a few hundred points spread over the grid
+    (``stabmap.run.tasks.probe``): the chunks hold about BLOCK_SECONDS of work at that pace, and tasks of several
+    chunks about TASK_SECONDS, resized as tasks finish.
+    """
 
     def __init__(self, run: runner.Runner, scene, progress, chunk_points: int | None, checkpoint: Checkpoint | None = None):
+        self.scene, self.runner = scene, run
+        self.progress = ProgressLine(wanted(progress))
+        self.total = math.prod(scene.shape)
+        self.done_before = 0  # points finished by an earlier, interrupted run
+        self.batch = chunk_points is None
+        order = point_order(scene)
         if checkpoint is not None:
             chunks = checkpoint.chunks
-            if chunk_points is not None and chunk_shape(scene.shape, chunk_points) != chunks:
+            if chunk_points is not None and chunk_shape(scene.shape, chunk_points, order) != chunks:
                 raise StabmapError(
                     f"chunk_points {chunk_points} gives other chunks than the interrupted run's {list(chunks)}; "
                     "leave chunk_points (--chunk-points) out to resume"
                 )
+        elif chunk_points is not None:
+            chunks = chunk_shape(scene.shape, chunk_points, order)
+        elif self.total // (8 * run.slots()) <= MIN_CHUNK_POINTS:  # a small grid: balance decides, not time
+            chunks = chunk_shape(scene.shape, chunk_points_for(scene, 0.0, run.slots()), order)
         else:
-            chunks = chunk_shape(scene.shape, chunk_points or default_chunk_points(scene, run.threads))
-        self.scene, self.runner, self.chunks = scene, run, chunks
+            try:
+                chunks = chunk_shape(scene.shape, chunk_points_for(scene, self._probe(), run.slots()), order)
+            except BaseException:
+                self.progress.close()
+                raise
+        self.chunks = chunks
         self.locations = chunk_locations(scene.shape, chunks)
-        self.progress = ProgressLine(wanted(progress))
-        self.done_before = 0
 
     def __enter__(self) -> _Layout:
         return self
@@ -199,23 +273,40 @@ class _Layout:
     def __exit__(self, *exc) -> None:
         self.progress.close()
 
+    def _show(self, rate: Rate | None = None) -> None:
+        where = f" | {self.runner.workers} workers, {self.runner.threads} threads" if self.runner.client is not None else ""
+        if rate is None or rate.done == self.done_before:
+            text = f"{rate.text() if rate else f'0/{self.total:,} points'} | {self.progress.elapsed:.0f} s, starting (loading kernels)"
+        else:
+            text = f"{rate.text()} | {self.progress.elapsed:.0f} s"
+        self.progress.show(f"[atlas] {text}{where}")
+
+    def _probe(self) -> float:
+        """Seconds per point, timed on the probe's points (on the runner: a worker, or a thread here)."""
+        measured = []
+        values = probe_points(self.scene, point_order(self.scene))
+        self.runner.run(probe, self.scene, _Once(values), lambda _, r: measured.append(r), self._show)
+        points, seconds = measured[0]
+        cost = seconds / max(1, points)
+        self.runner.pace = runner.Pace(cost)
+        return cost
+
     def run(self, todo: list[int], on_result) -> None:
-        total, per = len(self.locations), max(1, math.prod(self.chunks))
-        finished = [0]
+        """Decide the chunks ``todo`` (indices into ``locations``), in a shuffled order so that the rate measured
+        on the first chunks holds for the whole grid; ``on_result(i, block)`` as each chunk arrives."""
+        sizes = [math.prod(b - a for a, b in loc) for loc in self.locations]
+        self.done_before = self.total - sum(sizes[i] for i in todo)
+        rate = Rate(self.total, self.done_before)
+        order = [todo[k] for k in np.random.default_rng(0).permutation(len(todo))]
 
-        def handle(i, block):
-            on_result(i, block)
-            finished[0] += 1
-            done = self.done_before + finished[0]
-            rate = finished[0] / max(self.progress.elapsed, 1e-9)
-            eta = (len(todo) - finished[0]) / rate if rate else float("nan")
-            self.progress.show(
-                f"[atlas] {done:,}/{total:,} chunks of ~{per:,} points | {self.progress.elapsed:.0f} s, "
-                f"about {eta:.0f} s to go"
-            )
+        def handle(chunks, blocks):
+            for i, block in zip(chunks, blocks):
+                on_result(i, block)
+            rate.add(sum(sizes[i] for i in chunks))
+            self._show(rate)
 
-        args = [(self.scene, location) for location in self.locations]
-        self.runner.run(evaluate_block, args, todo, handle)
+        self.runner.run(evaluate_blocks, self.scene, _Chunks(self.locations, order, self.batch), handle,
+                        lambda: self._show(rate))
 
 
 __all__ = ["FileReport", "compute", "compute_to_file", "decide_grid", "decide_points"]

@@ -1,10 +1,13 @@
-"""How a run is cut into tasks: one rule for the size of every task, and the blocks of a grid.
+"""How a run is cut into tasks: chunks of the grid sized from a measured cost, and the blocks of a grid.
 
-The size is chosen so that a task takes a fraction of a second: long enough
-that the scheduler's per-task cost (milliseconds) is small beside it, short
-enough that the points' input arrays stay far below a worker's memory and that
-a lost worker loses little.  Dense atlases cut the grid into blocks of that
-many points; refinement and critical values cut their lists of points.
+Nothing here models what a point costs: a dense atlas first times a probe of a
+few hundred points spread over the grid (``stabmap.run.tasks.probe``), and
+cuts the grid into chunks of about BLOCK_SECONDS of work each, long along the axes the kernels run fastest.  The runner then
+hands out tasks of several chunks (or, for lists of points, of several points),
+sized from the run times of the tasks that finished (``stabmap.run.runner.Pace``),
+so each task lasts about TASK_SECONDS whatever the scene: long enough that the
+scheduler's per-task cost (milliseconds) is small beside it, short enough that
+Ctrl-C, a lost worker or the end of the run waits for little.
 """
 
 from __future__ import annotations
@@ -12,29 +15,48 @@ from __future__ import annotations
 import itertools
 import math
 
+import numpy as np
+
 from .. import systems
 from ..errors import StabmapError
 from ..systems.base import SceneBase
 
 TASK_SECONDS = 0.5  # aimed-for run time of one task on one core
+BLOCK_SECONDS = TASK_SECONDS / 2  # aimed-for run time of one chunk of the grid (a task holds one or several)
 MAX_CHUNK_POINTS = 1 << 18
 MAX_CHUNK_BYTES = 64 << 20  # the points' input arrays of one task
-MIN_CHUNK_POINTS = 1024  # balance never cuts tasks smaller than this
+MIN_CHUNK_POINTS = 16  # the time rule never cuts chunks smaller than this (balance may, on tiny grids)
+PROBE_RUNS, PROBE_RUN = 8, 64  # the probe: 8 runs of 64 neighbouring points along the fastest axis
 
 
-def default_chunk_points(scene: SceneBase, threads: int, npoints: int | None = None) -> int:
-    """Points per task: about TASK_SECONDS of work, at most MAX_CHUNK_BYTES of inputs.
+def chunk_points_for(scene: SceneBase, seconds_per_point: float, threads: int, npoints: int | None = None) -> int:
+    """Points per chunk: about BLOCK_SECONDS of work at the measured ``seconds_per_point``, at most
+    MAX_CHUNK_BYTES of inputs and MAX_CHUNK_POINTS points, and at least eight chunks per thread.
 
-    ``npoints`` points (default: the whole grid) are cut into at least four
-    tasks per thread (for balance) but never into tasks of fewer than
-    MIN_CHUNK_POINTS points.
+    ``npoints`` is the number of points to cut (default: the whole grid).
     """
     total = math.prod(scene.shape) if npoints is None else npoints
-    cost = systems.of(scene).cost(scene)
-    by_time = TASK_SECONDS / cost.seconds
-    by_memory = MAX_CHUNK_BYTES // max(1, cost.bytes)
-    balance = max(MIN_CHUNK_POINTS, total // (4 * max(1, threads)))
+    by_time = max(MIN_CHUNK_POINTS, BLOCK_SECONDS / max(seconds_per_point, 1e-9))
+    by_memory = MAX_CHUNK_BYTES // max(1, systems.of(scene).cost(scene).bytes)
+    balance = max(1, total // (8 * max(1, threads)))
     return int(max(1, min(by_time, by_memory, MAX_CHUNK_POINTS, balance)))
+
+
+def probe_points(scene: SceneBase, order: tuple[int, ...], seed: int = 0) -> dict[str, np.ndarray]:
+    """Grid-axis values of the probe's points: PROBE_RUNS runs of PROBE_RUN neighbouring points along the fastest
+    axis of ``order`` (as the kernels meet them in a chunk), at random places of the grid (seeded: repeatable)."""
+    if not scene.grid:
+        return {}
+    rng = np.random.default_rng(seed)
+    fast = order[-1]
+    run = min(PROBE_RUN, scene.shape[fast])
+    index = [rng.integers(0, n, PROBE_RUNS) for n in scene.shape]
+    index[fast] = rng.integers(0, scene.shape[fast] - run + 1, PROBE_RUNS)
+    values = {}
+    for d, axis in enumerate(scene.grid):
+        i = np.repeat(index[d], run) + (np.tile(np.arange(run), PROBE_RUNS) if d == fast else 0)
+        values[axis.name] = axis.array[i]
+    return values
 
 
 def check_chunk_points(value, option: str = "chunk_points") -> int | None:
@@ -45,15 +67,20 @@ def check_chunk_points(value, option: str = "chunk_points") -> int | None:
     return int(value)
 
 
-def chunk_shape(shape: tuple[int, ...], points: int) -> tuple[int, ...]:
-    """Chunk sizes per axis holding about ``points`` points, trailing axes kept whole first."""
-    chunks = []
+def chunk_shape(shape: tuple[int, ...], points: int, order: tuple[int, ...] | None = None) -> tuple[int, ...]:
+    """Chunk sizes per axis holding about ``points`` points, the axes last in ``order`` kept whole first.
+
+    ``order`` is the order the kernels visit the axes, the fastest last (``stabmap.run.tasks.point_order``;
+    default: the grid's): a chunk then holds long runs along the fastest axes, the runs the kernels are quick
+    on (work shared by neighbouring points, such as a cavity's liquid modes or a chain's matrices).
+    """
+    order = tuple(range(len(shape))) if order is None else tuple(order)
+    chunks = list(shape)
     budget = max(1, points)
-    for size in reversed(shape):
-        c = max(1, min(size, budget))
-        chunks.append(c)
-        budget = max(1, budget // c)
-    return tuple(reversed(chunks))
+    for d in reversed(order):
+        chunks[d] = max(1, min(shape[d], budget))
+        budget = max(1, budget // chunks[d])
+    return tuple(chunks)
 
 
 def chunk_locations(shape: tuple[int, ...], chunks: tuple[int, ...]) -> list[tuple[tuple[int, int], ...]]:

@@ -39,3 +39,47 @@ class ProgressLine:
         if self.shown:
             sys.stderr.write("\n")
             sys.stderr.flush()
+
+
+class Rate:
+    """Points per second of a run and the time it has left, from the points finished over the last WINDOW seconds.
+
+    The clock starts at the first finished task, so the time spent loading kernels and timing the probe does not
+    count as slow work; the window follows a cluster that gains or loses workers.
+    """
+
+    WINDOW = 30.0  # seconds of history the rate is measured over
+
+    def __init__(self, total: int, done: int = 0):
+        self.total, self.done = total, done
+        self._history: list[tuple[float, int]] = []
+
+    def add(self, points: int) -> None:
+        self.done += points
+        now = time.perf_counter()
+        self._history.append((now, self.done))
+        while len(self._history) > 2 and now - self._history[1][0] > self.WINDOW:
+            self._history.pop(0)
+
+    def per_second(self) -> float | None:
+        """Points per second, once two tasks have finished."""
+        if len(self._history) < 2:
+            return None
+        (t0, d0), now = self._history[0], time.perf_counter()
+        return (self.done - d0) / max(now - t0, 1e-9)
+
+    def text(self, unit: str = "points") -> str:
+        """'12,345/1,000,000 points (1.2 %)' and, once measured, the rate and the time to go."""
+        line = f"{self.done:,}/{self.total:,} {unit} ({100 * self.done / max(1, self.total):.1f} %)"
+        rate = self.per_second()
+        if rate:
+            line += f", {rate:,.0f} {unit}/s, about {_duration((self.total - self.done) / rate)} to go"
+        return line
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 100:
+        return f"{seconds:.0f} s"
+    if seconds < 6000:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"

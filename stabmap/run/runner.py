@@ -1,29 +1,52 @@
 """Where the tasks of a run go: threads in this process, or a dask.distributed cluster.
 
-Dense atlases, adaptive refinement and critical values all hand their tasks to
+Dense atlases, adaptive refinement and critical values all hand their work to
 ``Runner.run``, so each runs here or on a cluster alike and gives the same
-cells.  Only a bounded window of tasks is in flight at a time: the scheduler
+cells.  The runner sizes every task from the measured run times of the tasks
+before it (``Pace``), keeps a bounded window of tasks in flight (the scheduler
 never holds millions of tasks, and finished results reach the calling process
-(and leave it) one by one.
+and leave it one by one), and follows the cluster as workers leave and join.
+
+Faults, on a cluster: a worker that dies or restarts costs only its running
+tasks, which the scheduler reruns elsewhere (every task is a pure function of
+its arguments); a task that raised is retried RETRIES times; a lost scheduler
+ends the run with ``SchedulerLost``.  The runner makes no call that goes to
+every worker (no ``Client.run``): the stabmap version is checked by each task
+(``stabmap.run.tasks.run_task``), so a worker that dies or joins at any moment
+of the run, start-up included, is never asked anything.
 """
 
 from __future__ import annotations
 
 import contextlib
+import itertools
 import logging
 import os
 import sys
+import time
 import uuid
 from collections.abc import Callable, Iterator
-from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
-from dataclasses import dataclass
+from concurrent.futures import FIRST_COMPLETED, CancelledError, ThreadPoolExecutor, wait
+from typing import Protocol
 
 from ..errors import StabmapError
 from ..version import __version__
+from .chunks import TASK_SECONDS
+from .tasks import run_task
 
 CONNECT_TIMEOUT = 20.0  # seconds to reach a scheduler
 WORKER_TIMEOUT = 120.0  # seconds to wait for a scheduler's first worker
 RETRIES = 2  # re-runs of a task that raised (a worker that dies is handled by the scheduler)
+GRACE_SECONDS = 1.0  # after Ctrl-C, running tasks that finish within this are still kept
+TICK_SECONDS = 0.5  # the progress callback's period while no task finishes
+SLOTS_SECONDS = 2.0  # how often the runner looks at the cluster's workers
+FIRST_TASK_POINTS = 16  # the size of tasks before any task has been timed
+
+
+class SchedulerLost(StabmapError):
+    """The dask scheduler went away mid-run; the CLI exits with status 3 (``--resume`` finishes a file run)."""
+
+    exit_status = 3
 
 
 def check_threads(threads, option: str = "threads") -> int:
@@ -52,51 +75,159 @@ def check_where(client=None, workers: int | None = None, threads: int | None = N
         check_threads(threads, "threads")
 
 
-@dataclass
+class Pace:
+    """The seconds a point costs, measured on finished tasks (recent tasks weigh more), and the next task's size.
+
+    Tasks are sized to last about TASK_SECONDS; before the first task is timed they hold FIRST_TASK_POINTS
+    points (or what ``seconds_per_point``, a probe's measurement, gives).  Each finished task moves the estimate
+    by a fifth of the way to its own cost per point, whatever its size, so the pace follows a scene whose points
+    grow dearer within a few tasks.  Towards the end of a batch the tasks shrink, down to an eighth of full size,
+    so that every thread finishes at about the same time.
+    """
+
+    WEIGHT = 0.2  # weight of the last finished task in the estimate
+
+    def __init__(self, seconds_per_point: float | None = None):
+        self.seconds_per_point = seconds_per_point or None
+
+    def record(self, points: int, seconds: float) -> None:
+        if points <= 0 or seconds <= 0:
+            return
+        cost = seconds / points
+        old = self.seconds_per_point
+        self.seconds_per_point = cost if old is None else old + self.WEIGHT * (cost - old)
+
+    def task_points(self, remaining: int, slots: int) -> int:
+        """Points of the next task, of ``remaining`` points still to hand out to ``slots`` threads."""
+        cost = self.seconds_per_point
+        if cost is None:
+            return FIRST_TASK_POINTS
+        full = TASK_SECONDS / cost
+        return max(1, int(min(full, max(full / 8, remaining / (2 * max(1, slots))))))
+
+
+class Work(Protocol):
+    """What ``Runner.run`` hands out: ``remaining`` points, taken a task at a time."""
+
+    remaining: int
+
+    def take(self, points: int) -> tuple[tuple, object, int]:
+        """A task of about ``points`` points (at least one unit): (its arguments after the scene, a handle given back
+        with its result, its points)."""
+
+
 class Runner:
     """Where one run's tasks go: ``client`` None (``threads`` threads here) or a dask.distributed Client."""
 
-    client: object | None
-    threads: int
+    def __init__(self, client, threads: int):
+        self.client, self.threads = client, threads
+        self.pace = Pace()
+        self.workers = 0 if client is not None else 1
+        self._looked = -float("inf")
+        self._counter = itertools.count()
+        self._token = uuid.uuid4().hex[:8]
+        if client is not None:
+            self.slots()
 
-    def run(self, task: Callable, args: list[tuple], todo: list[int], on_result: Callable[[int, object], None]) -> None:
-        """Run ``task(*args[i])`` for every i in ``todo``, handing each result to ``on_result(i, result)`` as it finishes.
+    @property
+    def address(self) -> str:
+        return getattr(getattr(self.client, "scheduler", None), "address", "?")
 
-        At most ``2 * threads + 2`` tasks are in flight.  On any error or Ctrl-C the tasks not yet finished are
-        cancelled and the exception propagates; results already handed over stay handed over.
-        """
-        window = 2 * self.threads + 2
+    def slots(self) -> int:
+        """Threads to keep busy: this process's, or those of the cluster's workers now (looked up every few seconds,
+        so workers that join or leave during the run count)."""
         if self.client is None:
-            executor, options = ThreadPoolExecutor(self.threads), lambda i: {}
+            return self.threads
+        now = time.monotonic()
+        if now - self._looked >= SLOTS_SECONDS:
+            self._looked = now
+            try:
+                nthreads = self.client.nthreads()
+            except Exception as exc:  # noqa: BLE001 - a lost scheduler shows in the client's status
+                self._check_scheduler(exc)
+                nthreads = None
+            if nthreads is not None:
+                self.workers, self.threads = len(nthreads), sum(nthreads.values())
+        return max(1, self.threads)
+
+    def run(self, task: Callable, scene, work: Work, on_result: Callable[[object, object], None],
+            on_tick: Callable[[], None] | None = None) -> None:
+        """Run ``task(scene, *args)`` over all of ``work``, handing each result to ``on_result(handle, result)``.
+
+        At most ``2 * slots + 2`` tasks are in flight.  ``on_tick()`` is called at least every TICK_SECONDS.  On
+        Ctrl-C, tasks that finish within GRACE_SECONDS are still handed over and the rest are cancelled; on any
+        other error the tasks not yet finished are cancelled; either way the exception propagates and results
+        already handed over stay handed over.
+        """
+        pending: dict = {}
+        if self.client is None:
+            executor = ThreadPoolExecutor(self.threads)
+
+            def submit(args):
+                return executor.submit(run_task, __version__, task, scene, *args)
         else:
-            token = uuid.uuid4().hex[:8]
             executor = self.client.get_executor(retries=RETRIES, pure=False)
             name = getattr(task, "__name__", "task").replace("_", "-")
 
-            def options(i):
-                return {"key": f"stabmap-{name}-{i}-{token}"}
+            def submit(args):
+                key = f"stabmap-{name}-{next(self._counter)}-{self._token}"
+                return executor.submit(run_task, __version__, task, scene, *args, key=key)
 
-        pending: dict = {}
-        queue = iter(todo)
+        def hand_over(futures) -> None:
+            for f in futures:
+                handle, points = pending.pop(f)
+                result, seconds = self._result(f)
+                self.pace.record(points, seconds)
+                on_result(handle, result)
+
         try:
             while True:
-                for i in queue:
-                    pending[executor.submit(task, *args[i], **options(i))] = i
-                    if len(pending) >= window:
-                        break
+                while work.remaining and len(pending) < 2 * self.slots() + 2:
+                    args, handle, points = work.take(self.pace.task_points(work.remaining, self.slots()))
+                    pending[submit(args)] = (handle, points)
                 if not pending:
                     break
-                for f in wait(set(pending), return_when=FIRST_COMPLETED).done:
-                    on_result(pending.pop(f), f.result())
-        except BaseException:
-            for f in pending:
-                f.cancel()
-            if self.client is None:  # a thread cannot be stopped mid-task: running ones finish theirs
-                executor.shutdown(cancel_futures=True)
-            else:  # cluster tasks are cancelled on the scheduler
-                executor.shutdown(wait=False)
+                hand_over(wait(set(pending), timeout=TICK_SECONDS, return_when=FIRST_COMPLETED).done)
+                if on_tick is not None:
+                    on_tick()
+        except BaseException as exc:
+            lost = isinstance(exc, SchedulerLost)
+            if not lost and self.client is None:
+                for f in pending:
+                    f.cancel()  # those not started
+            if isinstance(exc, KeyboardInterrupt) and pending:
+                self._grace(pending, hand_over)
+            if self.client is None:  # a thread cannot be stopped mid-task: a running one finishes in the background
+                executor.shutdown(wait=False, cancel_futures=True)
+            elif not lost:  # cluster tasks are cancelled on the scheduler
+                with contextlib.suppress(Exception):
+                    executor.shutdown(wait=False)
             raise
-        executor.shutdown()
+        executor.shutdown(wait=False)
+
+    def _grace(self, pending: dict, hand_over) -> None:
+        """After Ctrl-C: keep the tasks that finish within GRACE_SECONDS (a second Ctrl-C stops at once)."""
+        done = wait(set(pending), timeout=GRACE_SECONDS).done
+        with contextlib.suppress(Exception):
+            hand_over([f for f in done if not f.cancelled() and f.exception() is None])
+
+    def _result(self, f):
+        try:
+            return f.result()
+        except StabmapError:
+            raise
+        except Exception as exc:
+            self._check_scheduler(exc)
+            raise
+
+    def _check_scheduler(self, exc: BaseException | None = None) -> None:
+        """Raise SchedulerLost if the client has lost its scheduler (its futures are then cancelled)."""
+        if self.client is not None and getattr(self.client, "status", "running") != "running":
+            raise SchedulerLost(f"lost the dask scheduler at {self.address} mid-run") from None
+        if isinstance(exc, CancelledError) and self.client is not None:
+            raise StabmapError(
+                f"the dask scheduler at {self.address} cancelled this run's tasks (was the cluster restarted?)"
+            ) from None
 
 
 @contextlib.contextmanager
@@ -113,14 +244,35 @@ def start(client=None, *, workers: int | None = None, threads: int | None = None
         if client is None:
             yield Runner(None, check_threads(threads))
             return
-        runner = Runner(client, cluster_threads(client))
+        wait_for_workers(client)
+        runner = Runner(client, 1)
         if announce:
             print(
-                f"[stabmap] on the dask cluster at {client.scheduler.address}: {len(client.nthreads())} workers, "
-                f"{runner.threads} threads; dashboard {client.dashboard_link}",
+                f"[stabmap] on the dask cluster at {runner.address}: {runner.workers} workers, {runner.threads} threads "
+                f"now (workers may join or leave during the run); dashboard {client.dashboard_link}",
                 file=sys.stderr,
             )
         yield runner
+
+
+@contextlib.contextmanager
+def quiet_dask_logs(enabled: bool = True) -> Iterator[None]:
+    """Silence the client-side logs of dask.distributed (and tornado) in this process while inside: the command
+    line reports a lost worker or scheduler in its own words.  The scheduler's and workers' own logs are untouched."""
+    if not enabled:
+        yield
+        return
+    import distributed  # noqa: F401 - sets up its loggers' handlers
+
+    handlers = [h for name in ("distributed", "tornado") for h in logging.getLogger(name).handlers]
+    levels = [h.level for h in handlers]
+    for h in handlers:
+        h.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for h, level in zip(handlers, levels):
+            h.setLevel(level)
 
 
 @contextlib.contextmanager
@@ -161,8 +313,8 @@ def local_cluster(workers: int) -> Iterator:
         yield client
 
 
-def cluster_threads(client) -> int:
-    """Threads of the cluster's workers, after waiting for at least one worker to join."""
+def wait_for_workers(client) -> None:
+    """Wait for the cluster's first worker (the scheduler alone is asked: no call goes to the workers)."""
     try:
         client.wait_for_workers(1, timeout=WORKER_TIMEOUT)
     except TimeoutError:
@@ -170,17 +322,5 @@ def cluster_threads(client) -> int:
             f"the dask scheduler at {client.scheduler.address} has no workers after {WORKER_TIMEOUT:.0f} s; "
             f"start some with 'dask worker {client.scheduler.address}'"
         ) from None
-    versions = set(client.run(worker_version).values())
-    if versions != {__version__}:
-        raise StabmapError(
-            f"the cluster's workers run stabmap {', '.join(sorted(map(str, versions)))}, this process {__version__}; "
-            "install the same stabmap on every worker"
-        )
-    return max(1, sum(client.nthreads().values()))
-
-
-def worker_version() -> str:
-    """The stabmap version a worker runs (called on every worker)."""
-    from stabmap.version import __version__ as version
-
-    return version
+    except Exception as exc:  # noqa: BLE001 - the scheduler went away while we waited
+        raise SchedulerLost(f"lost the dask scheduler at {client.scheduler.address} ({type(exc).__name__})") from None

@@ -3,14 +3,52 @@
 A task is a plain function of picklable arguments (a scene and where its points
 are), so the same task runs on a local thread or on a dask.distributed worker,
 and dense atlases, adaptive refinement and critical values all submit it.
+
+Every task goes through ``run_task``, which checks the worker's stabmap version,
+loads the system's kernels once per process (untimed: compiling or loading them
+is not the cost of the points), and returns the task's result with its measured
+run time, from which the runner sizes the next tasks (``stabmap.run.runner``).
 """
 
 from __future__ import annotations
 
+import threading
+import time
+
 import numpy as np
 
 from .. import systems
+from ..errors import StabmapError
 from ..systems.base import SceneBase
+from ..version import __version__
+
+PROBE_SECONDS = 0.2  # a probe stops once it has timed this much work
+
+_warm: set[str] = set()  # the systems whose kernels this process has loaded
+_warm_lock = threading.Lock()
+
+
+def run_task(version: str, function, scene: SceneBase, *args) -> tuple[object, float]:
+    """``function(scene, *args)`` and its run time [s], on a worker of stabmap ``version`` with warm kernels."""
+    if version != __version__:
+        raise StabmapError(
+            f"a worker runs stabmap {__version__}, the calling process {version}; install the same stabmap on every worker"
+        )
+    warm_up(scene)
+    t0 = time.perf_counter()
+    result = function(scene, *args)
+    return result, time.perf_counter() - t0
+
+
+def warm_up(scene: SceneBase) -> None:
+    """Load (or compile) the kernels of ``scene``'s system in this process, by deciding its first grid point once."""
+    name = systems.of(scene).name
+    if name in _warm:
+        return
+    with _warm_lock:
+        if name not in _warm:
+            systems.of(scene).evaluate(scene, {a.name: a.array[:1] for a in scene.grid})
+            _warm.add(name)
 
 
 def point_order(scene: SceneBase) -> tuple[int, ...]:
@@ -38,6 +76,32 @@ def evaluate_block(scene: SceneBase, location: tuple[tuple[int, int], ...]) -> d
     out = systems.of(scene).evaluate(scene, block_values(scene, location, order))
     back = tuple(np.argsort(order))
     return {k: v.transpose(back + tuple(range(len(order), v.ndim))).copy(order="C") for k, v in out.items()}
+
+
+def evaluate_blocks(scene: SceneBase, locations: list) -> list[dict[str, np.ndarray]]:
+    """``evaluate_block`` of each of ``locations``: one task may decide several chunks of the grid."""
+    return [evaluate_block(scene, location) for location in locations]
+
+
+def probe(scene: SceneBase, values: dict[str, np.ndarray]) -> tuple[int, float]:
+    """Time the points ``values`` (1-D arrays of grid-axis values) in growing batches, for up to PROBE_SECONDS.
+
+    The batches run twice and only the second pass is timed: the first loads whatever the kernels load lazily
+    (paths that the first point did not take).  Returns the points timed and their run time [s]: the seconds a
+    point costs, measured, not modelled.
+    """
+    npts = len(next(iter(values.values()))) if values else 1
+    stop = npts
+    for timed in (False, True):
+        done, spent, n = 0, 0.0, 1
+        while done < stop and spent < PROBE_SECONDS:
+            end = min(stop, done + n)
+            t0 = time.perf_counter()
+            evaluate_points(scene, {k: v[done:end] for k, v in values.items()})
+            spent += time.perf_counter() - t0
+            done, n = end, 4 * n
+        stop = max(done, 1)
+    return done, spent
 
 
 def evaluate_points(scene: SceneBase, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
