@@ -37,6 +37,7 @@ _scene_source = [
     click.argument("scene", required=False, type=click.Path(dir_okay=False)),
     click.option("--example", metavar="NAME", help="a bundled example scene (see 'stabmap examples')"),
 ]
+_overwrite = click.option("--overwrite", is_flag=True, help="replace output files that exist (without it, an existing output is an error)")
 _cluster = [
     click.option("--threads", type=int, help="threads of an in-process run (default: all cores)"),
     click.option("--workers", type=int, metavar="N", help="start a local dask cluster of N worker processes for the run"),
@@ -69,8 +70,9 @@ def cli() -> None:
 @click.option("--refine", is_flag=True, help="adaptive: a coarse lattice, refined only where labels change (docs/refine.md)")
 @click.option("--coarse-stride", type=int, metavar="S", help="with --refine: grid steps between coarse nodes, a power of two")
 @click.option("--margin", type=int, metavar="M", help="with --refine: cells split around every disagreeing cell (default 2)")
+@_overwrite
 @click.option("-q", "--quiet", is_flag=True, help="no progress line")
-def atlas(scene, example, output, png, threads, workers, scheduler, chunk_points, resume, refine, coarse_stride, margin, quiet):
+def atlas(scene, example, output, png, threads, workers, scheduler, chunk_points, resume, refine, coarse_stride, margin, overwrite, quiet):
     """Compute an atlas from a scene and write netCDF4 or Zarr, here or on a dask cluster."""
     from . import jobs
     from .run.runner import quiet_dask_logs
@@ -79,13 +81,13 @@ def atlas(scene, example, output, png, threads, workers, scheduler, chunk_points
         with quiet_dask_logs(scheduler is not None or workers is not None):
             _report(jobs.atlas(
                 jobs.scene(scene, example), output, png=png, refine=refine, coarse_stride=coarse_stride, margin=margin,
-                resume=resume, chunk_points=chunk_points, progress=not quiet, **_where(scheduler, workers, threads),
+                resume=resume, overwrite=overwrite, chunk_points=chunk_points, progress=not quiet, **_where(scheduler, workers, threads),
             ))
     except KeyboardInterrupt:
         raise Interrupted(jobs.interrupted(output)) from None
 
 
-@cli.command()
+@cli.command(short_help="What an atlas file holds: scene, axes, stable fraction, who decided.")
 @click.argument("atlas")
 def info(atlas):
     """What an atlas file holds: scene, axes, stable fraction, who decided."""
@@ -95,6 +97,7 @@ def info(atlas):
 
 
 @cli.command(
+    short_help="Ask a saved atlas: a label, a stable fraction, boundaries, the smallest stable value.",
     epilog="""\b
 examples:
   stabmap query a.nc omega=42.5 K_1=3                      label at the nearest grid point
@@ -128,7 +131,7 @@ def query(atlas, items, fraction, boundaries, smallest_stable, over, fmt, limit)
                           over=over, fmt=fmt or "text", limit=limit))
 
 
-@cli.command()
+@cli.command(short_help="Draw an atlas (or critical values) to a PNG or PDF file.")
 @click.argument("atlas")
 @click.argument("items", nargs=-1, metavar="[NAME=VALUE]...")
 @click.option("-o", "--output", required=True, help="PNG or PDF file")
@@ -137,11 +140,12 @@ def query(atlas, items, fraction, boundaries, smallest_stable, over, fmt, limit)
 @click.option("--sel", multiple=True, metavar="NAME=VALUE", help="fix an axis at this value (nearest grid value); also NAME=VALUE after the atlas")
 @click.option("--facet", metavar="NAME", help="axis drawn as one panel per value (default: the third axis; a fourth gives rows)")
 @click.option("--max-panels", type=int, metavar="N", help="at most N panels, evenly spaced values (default 12)")
-def plot(atlas, items, output, x, y, sel, facet, max_panels):
+@_overwrite
+def plot(atlas, items, output, x, y, sel, facet, max_panels, overwrite):
     """Draw an atlas: a map of its classes, small multiples for 3 or 4 axes (docs/plots.md)."""
     from . import jobs
 
-    _report(jobs.plot(atlas, output, x=x, y=y, sel=[*sel, *items], facet=facet, max_panels=max_panels))
+    _report(jobs.plot(atlas, output, x=x, y=y, sel=[*sel, *items], facet=facet, max_panels=max_panels, overwrite=overwrite))
 
 
 @cli.command(short_help="Stable intervals of one parameter (the critical spin rates, say), ends to 1e-10.")
@@ -151,8 +155,9 @@ def plot(atlas, items, output, x, y, sel, facet, max_panels):
 @click.option("--png", metavar="FILE", help="also draw the stable intervals to this PNG/PDF")
 @click.option("--rtol", type=float, default=1e-10, show_default=True, help="relative width of the located ends")
 @_options(_cluster)
+@_overwrite
 @click.option("-q", "--quiet", is_flag=True, help="no interval listing")
-def critical(scene, example, along, output, png, rtol, threads, workers, scheduler, chunk_points, quiet):
+def critical(scene, example, along, output, png, rtol, threads, workers, scheduler, chunk_points, overwrite, quiet):
     """Stable intervals of one parameter (e.g. the critical spin rates), ends to 1e-10."""
     from . import jobs
     from .run.runner import quiet_dask_logs
@@ -161,18 +166,24 @@ def critical(scene, example, along, output, png, rtol, threads, workers, schedul
         with quiet_dask_logs(scheduler is not None or workers is not None):
             _report(jobs.critical(
                 jobs.scene(scene, example), output, along=along, rtol=rtol, png=png, chunk_points=chunk_points,
-                listing=not quiet, progress=not quiet, **_where(scheduler, workers, threads),
+                listing=not quiet, progress=not quiet, overwrite=overwrite, **_where(scheduler, workers, threads),
             ))
     except KeyboardInterrupt:
         raise Interrupted("no output file was written") from None
 
 
-@cli.command()
-def examples():
-    """List the bundled example scenes."""
+@cli.command(short_help="List the bundled example scenes, or print one's TOML (--show NAME).")
+@click.option("--show", metavar="NAME", help="print the scene file of this example (a start for your own scene)")
+def examples(show):
+    """List the bundled example scenes; with --show NAME, print that example's scene (TOML).
+
+    \b
+    stabmap examples --show paper-n1-fixed > my-scene.toml    a scene file of your own to edit
+    stabmap atlas my-scene.toml -o my-atlas.nc                 its atlas
+    """
     from . import jobs
 
-    for line in jobs.examples():
+    for line in jobs.examples(show):
         click.echo(line)
 
 

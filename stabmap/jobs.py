@@ -33,6 +33,20 @@ def scene(path: str | Path | None = None, example: str | None = None):
     return load_scene(path) if path is not None else bundled(example)
 
 
+def check_grid(scene, source: str = "the scene") -> None:
+    """An atlas scans at least one parameter: a scene without ``[grid]`` is an error, not a one-point atlas.
+
+    A scene with no grid axes is almost always a forgotten or misspelt ``[grid]`` table; a single point is asked
+    for explicitly with a one-value axis, ``omega = {values = [42.0]}``.
+    """
+    if not scene.grid:
+        raise StabmapError(
+            f"{source} has no [grid]: an atlas scans at least one parameter of the scene, e.g. "
+            "[grid] omega = { start = 0.0, stop = 50.0, num = 201 }; for the label at one point, give that point as "
+            "one-value axes, e.g. omega = { values = [42.0] }"
+        )
+
+
 def atlas(
     scene,
     output: str | Path,
@@ -42,24 +56,31 @@ def atlas(
     coarse_stride: int | None = None,
     margin: int | None = None,
     resume: bool = False,
+    overwrite: bool = False,
     client=None,
     workers: int | None = None,
     threads: int | None = None,
     chunk_points: int | None = None,
     progress: bool | None = None,
 ) -> Done:
-    """``stabmap atlas``: compute the atlas of ``scene`` into ``output`` (and draw it to ``png``)."""
+    """``stabmap atlas``: compute the atlas of ``scene`` into ``output`` (and draw it to ``png``).
+
+    An existing ``output`` or ``png`` is an error unless ``overwrite``; ``resume`` finishes an interrupted run
+    (its checkpoint ``OUTPUT.partial/``), which left no ``output`` behind.
+    """
     from . import systems
     from .read.plot import check_figure_path, plot_atlas
     from .read.summary import summary
     from .run import refine as refining
     from .run.atlas import compute_to_file
     from .run.chunks import check_chunk_points
-    from .store.files import check_writable, open_atlas, write_atlas
+    from .store.files import check_atlas_output, check_new_output, open_atlas, write_atlas
 
-    check_writable(output)
+    check_atlas_output(output, overwrite)
     if png is not None:
         check_figure_path(png)
+        check_new_output(png, overwrite, "--png")
+    check_grid(scene)
     check_chunk_points(chunk_points, "--chunk-points")
     if not refine:
         given = [opt for opt, v in (("--coarse-stride", coarse_stride), ("--margin", margin)) if v is not None]
@@ -132,16 +153,21 @@ def critical(
     chunk_points: int | None = None,
     progress: bool | None = None,
     listing: bool = True,
+    overwrite: bool = False,
 ) -> Done:
-    """``stabmap critical``: the stable intervals of ``along`` into ``output`` (and drawn to ``png``)."""
+    """``stabmap critical``: the stable intervals of ``along`` into ``output`` (and drawn to ``png``).
+
+    An existing ``output`` or ``png`` is an error unless ``overwrite``.
+    """
     from .read.info import intervals
     from .read.plot import check_figure_path, plot_critical
     from .run import critical as located
-    from .store.files import check_writable, write_atlas
+    from .store.files import check_atlas_output, check_new_output, write_atlas
 
-    check_writable(output)
+    check_atlas_output(output, overwrite)
     if png is not None:
         check_figure_path(png)
+        check_new_output(png, overwrite, "--png")
         others = [a.name for a in scene.grid if a.name != along]
         if len(others) > 1 and along in {a.name for a in scene.grid}:
             # A picture shows one other axis; fail before the work rather than after it.
@@ -234,12 +260,15 @@ def plot(
     sel: list[str] = (),
     facet: str | None = None,
     max_panels: int | None = None,
+    overwrite: bool = False,
 ) -> Done:
-    """``stabmap plot``: draw an atlas (or critical values) to a PNG or PDF file."""
+    """``stabmap plot``: draw an atlas (or critical values) to a PNG or PDF file (an existing one only if ``overwrite``)."""
     from .read import plot as figures
     from .read.query import parse_selection
-    from .store.files import open_atlas
+    from .store.files import check_new_output, open_atlas
 
+    figures.check_figure_path(output)
+    check_new_output(output, overwrite)
     ds = open_atlas(path, lazy=True)  # read chunk by chunk: bounded memory at any size
     chosen = parse_selection(list(sel), ranges=False, option="--sel")
     if ds.attrs.get("stabmap_kind") == "critical values":
@@ -253,11 +282,18 @@ def plot(
     return Done([f"note: {note}" for note in figures.plan_figure(ds, **options).notes] + [f"wrote {output}"])
 
 
-def examples() -> list[str]:
-    """``stabmap examples``: the bundled scenes and their titles."""
+def examples(show: str | None = None) -> list[str]:
+    """``stabmap examples``: the bundled scenes and their titles, or with ``show`` the TOML text of that one."""
+    from importlib import resources
+
     from .examples import example, example_names
 
     names = example_names()
+    if show is not None:
+        if show not in names:
+            raise StabmapError(f"unknown example {show!r}; choose one of: {', '.join(names)}")
+        text = resources.files("stabmap.examples").joinpath(show + ".toml").read_text(encoding="utf-8")
+        return text.rstrip("\n").split("\n")
     width = max(map(len, names))
     return [f"{name:<{width}}  {example(name).title}" for name in names]
 

@@ -173,11 +173,12 @@ def test_refinement_is_declined_with_one_line_and_no_file(tmp_path, capsys):
 
 def test_a_family_without_equilibrium_is_data_not_an_error(tmp_path):
     scene = tmp_path / "none.toml"
-    scene.write_text('system = "closed"\nfamily = "figure-eight-4"\nratio = 1.5\n')
+    # one point: a one-value axis (a scene without [grid] is an error, not a one-point atlas)
+    scene.write_text('system = "closed"\nfamily = "figure-eight-4"\n[grid]\nratio = { values = [1.5] }\n')
     out = tmp_path / "none.nc"
     assert main(["atlas", str(scene), "-o", str(out), "-q"]) == 0
     with xr.open_dataset(out) as ds:
-        assert int(ds["exists"]) == 0 and int(ds["stability"]) == -2 and np.isnan(ds["theta"].values).all()
+        assert ds["exists"].item() == 0 and ds["stability"].item() == -2 and np.isnan(ds["theta"].values).all()
 
 
 def test_python_scene_gets_the_same_checks_as_toml():

@@ -10,13 +10,21 @@ from ..errors import StabmapError
 
 def read(path: str | Path) -> tuple[dict, Path]:
     """The TOML table of a scene file and its directory (relative file names in it are taken from there)."""
+    from ..store.files import kind_of
+
     path = Path(path)
+    if kind_of(path) in ("netCDF", "Zarr"):  # an atlas where a scene was expected
+        raise StabmapError(
+            f"{str(path)!r} is an atlas ({kind_of(path)}), not a scene; a scene is a TOML text file "
+            f"(see 'stabmap examples --show NAME'); to look into this atlas: 'stabmap info {path}'"
+        )
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise StabmapError(f"scene file {str(path)!r} does not exist") from None
     except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
-        raise StabmapError(f"cannot read scene file {str(path)!r}: {exc}") from None
+        what = "a directory" if isinstance(exc, IsADirectoryError) else "binary" if isinstance(exc, UnicodeDecodeError) else "no read permission"
+        raise StabmapError(f"cannot read scene file {str(path)!r} ({what}): a scene is a TOML text file") from None
     return parse(text, str(path)), path.parent
 
 

@@ -15,11 +15,52 @@ import xarray as xr
 from ..errors import StabmapError
 
 ZARR_SUFFIX = ".zarr"
+ATLAS_SUFFIXES = (".nc", ZARR_SUFFIX)  # what an atlas (or critical values) may be written to
 NETCDF_CHUNK_CACHE = 4 << 20  # bytes, while streaming
+_NETCDF_MAGIC = (b"\x89HDF\r\n\x1a\n", b"CDF\x01", b"CDF\x02", b"CDF\x05")  # netCDF4 (HDF5), netCDF3
 
 
 def is_zarr(path: str | Path) -> bool:
     return Path(path).suffix.lower() == ZARR_SUFFIX
+
+
+def kind_of(path: str | Path) -> str | None:
+    """What an existing file holds, from its first bytes: "netCDF", "Zarr", "TOML" (a scene) or None (unknown)."""
+    path = Path(path)
+    if path.is_dir():
+        return "Zarr" if _is_zarr_store(path) else None
+    try:
+        with open(path, "rb") as f:
+            head = f.read(8)
+    except OSError:
+        return None
+    if head.startswith(_NETCDF_MAGIC):
+        return "netCDF"
+    if path.suffix.lower() == ".toml":
+        return "TOML"
+    return None
+
+
+def check_new_output(path: str | Path, overwrite: bool = False, option: str = "-o") -> Path:
+    """An output file that may be written: it does not exist yet, or ``overwrite`` says to replace it.
+
+    ``option`` names the command's option that gave ``path`` (for the message only).
+    """
+    path = check_writable(path)
+    if not overwrite and (path.exists() or path.is_symlink()):
+        raise StabmapError(f"{str(path)!r} ({option}) already exists; add --overwrite to replace it")
+    return path
+
+
+def check_atlas_output(path: str | Path, overwrite: bool = False) -> Path:
+    """An atlas output (``-o``): a ``.nc`` or ``.zarr`` name, writable, new unless ``overwrite``."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in ATLAS_SUFFIXES:
+        raise StabmapError(
+            f"cannot write {str(path)!r}: an atlas is written as netCDF4 (.nc) or Zarr (.zarr), "
+            f"got {repr(suffix) if suffix else 'no suffix'}; name it e.g. atlas.nc"
+        )
+    return check_new_output(path, overwrite)
 
 
 def check_writable(path: str | Path) -> Path:
@@ -109,6 +150,17 @@ def open_atlas(path: str | Path, *, lazy: bool = False) -> xr.Dataset:
     zarr = is_zarr(path) and path.is_dir()
     if not (path.is_file() or zarr):
         raise StabmapError(f"atlas file {str(path)!r} does not exist")
+    kind = "Zarr" if zarr else kind_of(path)
+    if kind == "TOML":
+        raise StabmapError(
+            f"{str(path)!r} is a scene (TOML), not an atlas; an atlas is a .nc or .zarr file that "
+            f"'stabmap atlas {path} -o atlas.nc' writes"
+        )
+    if kind is None:
+        raise StabmapError(
+            f"{str(path)!r} is not an atlas: expected a netCDF4 (.nc) or Zarr (.zarr) file written by 'stabmap atlas' "
+            "or 'stabmap critical'"
+        )
 
     def opened(chunks):
         if zarr:
