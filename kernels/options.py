@@ -154,14 +154,15 @@ def _print_notice(text: str) -> None:
 _notice = [_print_notice]
 
 
-def set_compile_notice(callback) -> None:
+def set_compile_notice(callback):
     """Call ``callback(text)`` instead of printing (to stderr, if a terminal) when kernels start compiling.
 
-    ``None`` silences it.  It is called at most once per process, from the thread
+    ``None`` silences it; returns the callback it replaces (to put back).  It is called at most once per process, from the thread
     that compiles (a dask worker thread, say), when the first kernel of this
     package misses the cache; compilation then holds numba's global lock.
     """
-    _notice[0] = callback
+    previous, _notice[0] = _notice[0], callback
+    return previous
 
 
 class _CompileNotice(event.Listener):

@@ -243,6 +243,8 @@ class _Layout:
     def __init__(self, run: runner.Runner, scene, progress, chunk_points: int | None, checkpoint: Checkpoint | None = None):
         self.scene, self.runner = scene, run
         self.progress = ProgressLine(wanted(progress))
+        self.progress.redraw = lambda: self._show(self._rate)
+        self._rate: Rate | None = None
         self.total = math.prod(scene.shape)
         self.done_before = 0  # points finished by an earlier, interrupted run
         self.batch = chunk_points is None
@@ -276,7 +278,8 @@ class _Layout:
     def _show(self, rate: Rate | None = None) -> None:
         where = f" | {self.runner.workers} workers, {self.runner.threads} threads" if self.runner.client is not None else ""
         if rate is None or rate.done == self.done_before:
-            text = f"{rate.text() if rate else f'0/{self.total:,} points'} | {self.progress.elapsed:.0f} s, starting (loading kernels)"
+            doing = self.progress.note or "starting (loading kernels)"
+            text = f"{rate.text() if rate else f'0/{self.total:,} points'} | {self.progress.elapsed:.0f} s, {doing}"
         else:
             text = f"{rate.text()} | {self.progress.elapsed:.0f} s"
         self.progress.show(f"[atlas] {text}{where}")
@@ -296,7 +299,7 @@ class _Layout:
         on the first chunks holds for the whole grid; ``on_result(i, block)`` as each chunk arrives."""
         sizes = [math.prod(b - a for a, b in loc) for loc in self.locations]
         self.done_before = self.total - sum(sizes[i] for i in todo)
-        rate = Rate(self.total, self.done_before)
+        rate = self._rate = Rate(self.total, self.done_before)
         order = [todo[k] for k in np.random.default_rng(0).permutation(len(todo))]
 
         def handle(chunks, blocks):
