@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 import xarray as xr
 
@@ -10,27 +12,72 @@ from ..errors import StabmapError
 from .summary import summary
 
 
+WIDTH = 100  # characters a line of ``stabmap info`` may take
+
+
+def plural(n: int, word: str, many: str | None = None) -> str:
+    """``1 point``, ``2 points`` (``many``: an irregular plural, ``body`` -> ``bodies``)."""
+    return f"{n} {word if n == 1 else (many or word + 's')}"
+
+
+def wrapped(head: str, items: list[str], indent: str = "  ", width: int = WIDTH) -> list[str]:
+    """``head`` then ``items`` joined by ", ", wrapped at ``width`` with the continuation lines under the first item."""
+    first = f"{indent}{head}"
+    return textwrap.wrap(", ".join(items), width=width, initial_indent=first, subsequent_indent=" " * len(first),
+                         break_long_words=False, break_on_hyphens=False) or [first.rstrip()]
+
+
+def fixed_parameters(ds: xr.Dataset, system) -> list[tuple[str, list[str]]]:
+    """The atlas's fixed parameters (scalar coordinates) grouped as the system groups them, as text with units.
+
+    Returns (heading, ["m = 1 kg", ...]): inside a heading such as ``body 2`` a name loses its index (``m_2`` -> ``m``).
+    """
+    names = [str(k) for k in ds.coords if ds[k].ndim == 0 and np.issubdtype(ds[k].dtype, np.number)]
+    out = []
+    for head, group in system.fixed_groups(names):
+        suffix = "_" + head.rpartition(" ")[2] if head.rpartition(" ")[2].isdigit() else None
+        items = []
+        for k in group:
+            units = ds[k].attrs.get("units", "")
+            shown = k[: -len(suffix)] if suffix and k.endswith(suffix) else k
+            items.append(f"{shown} = {float(ds[k]):.6g}" + (f" {units}" if units and units != "1" else ""))
+        out.append((head, items))
+    return out
+
+
 def describe(ds: xr.Dataset, name: str = "") -> str:
-    """The scene, axes, fixed parameters, counts and provenance of an atlas (or the intervals of critical values)."""
+    """The scene, axes, fixed parameters, counts and provenance of an atlas (or the intervals of critical values).
+
+    Every line fits in :data:`WIDTH` characters but for a single word longer than that (a path); fixed parameters
+    come in the system's groups (per body for gyroscopes), each group's scene notes (liquid modes) beside it.
+    """
     if ds.attrs.get("stabmap_kind") == "critical values":
         head = f"{name}: {ds.attrs.get('title', '')}: critical values along {ds.attrs['critical_along']}"
         return "\n".join([head, f"  {ds.attrs['comment']}", *intervals(ds)])
     system = systems.of_atlas(ds.attrs)
     s = summary(ds)
     a = ds.attrs
-    lines = [f"{name}: {a.get('title', '')}"]
-    lines += [f"  {line}" for line in system.describe(a)]
-    lines += [f"  {line}" for line in scene_notes(a)]
+    lines = textwrap.wrap(f"{name}: {a.get('title', '')}", width=WIDTH, subsequent_indent="    ")
+    for line in system.describe(a):
+        lines += textwrap.wrap(line, width=WIDTH, initial_indent="  ", subsequent_indent="    ")
+    notes = scene_notes(a)
     lines.append("  axes:")
     for d in ds[system.label].dims:
         c = ds[d]
         lines.append(
-            f"    {d:<10} {c.size:>7} points  {float(c.min()):.6g} .. {float(c.max()):.6g} {c.attrs.get('units', '')}  "
+            f"    {d:<10} {plural(c.size, 'point'):>11}  {float(c.min()):.6g} .. {float(c.max()):.6g} {c.attrs.get('units', '')}  "
             f"({c.attrs.get('scale', '')})  {c.attrs.get('long_name', '')}"
         )
-    fixed = [k for k in ds.coords if ds[k].ndim == 0]
-    if fixed:
-        lines.append("  fixed: " + ", ".join(f"{k} = {float(ds[k]):.6g}" for k in fixed))
+    groups = fixed_parameters(ds, system)
+    if groups:
+        lines.append("  fixed:")
+    for head, items in groups:
+        lines += wrapped(f"{head}: " if head else "", items, indent="    ")
+        for text in notes.pop(head, []):  # e.g. the liquid of this body, under its parameters
+            lines += wrapped(" " * (len(head) + 2) if head else "", [text], indent="    ")
+    for head, texts in notes.items():  # notes of a group with no fixed parameter (every one scanned)
+        for text in texts:
+            lines += wrapped(f"{head}: " if head else "", [text], indent="  ")
     if system.stable_label is not None:
         degenerate = f", degenerate: {s['degenerate']}" if s["degenerate"] else ""
         absent = f", absent: {s['absent']}" if s["absent"] else ""
@@ -39,28 +86,44 @@ def describe(ds: xr.Dataset, name: str = "") -> str:
     else:
         lines.append(f"  points: {s['points']}")
     flags = system.variable(system.label).flags
-    name = (lambda k: system.variable(system.label).meaning(k)) if flags else str  # a flag label: its meanings
-    lines.append(f"  {system.label} ({system.label_symbol}): " + ", ".join(f"{name(k)}: {v}" for k, v in s[system.label].items()))
+    meaning = (lambda k: system.variable(system.label).meaning(k)) if flags else str  # a flag label: its meanings
+    lines += wrapped(f"{system.label} ({system.label_symbol}): ", [f"{meaning(k)}: {v}" for k, v in s[system.label].items()])
     if system.provenance in s:
-        lines.append("  decided by: " + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in s[system.provenance].items()))
-    lines.append(f"  made by {a.get('source', '?')}; {a.get('history', '')}")
+        lines += wrapped("decided by: ", [f"{k.replace('_', ' ')} {v}" for k, v in s[system.provenance].items() if v])
+    lines += provenance(a)
     return "\n".join(lines)
 
 
-def scene_notes(attrs: dict) -> list[str]:
-    """What the stored scene chose for itself (its ``notes()``, if it has them), such as the liquid modes kept.
+def provenance(attrs: dict) -> list[str]:
+    """Who made the atlas and what was done to it, each step once: ``history`` lines, and ``source`` only when no
+    history line names it already."""
+    source = str(attrs.get("source", "?"))
+    history = [h.strip() for h in str(attrs.get("history", "")).splitlines() if h.strip()]
+    lines = [] if any(source in h for h in history) else [f"  made by {source}"]
+    for k, h in enumerate(history):
+        lines += textwrap.wrap(h, width=WIDTH, initial_indent="  history: " if k == 0 else " " * 11, subsequent_indent=" " * 13)
+    return lines
+
+
+def scene_notes(attrs: dict) -> dict[str, list[str]]:
+    """What the stored scene says of itself beyond its parameters (its ``notes()``: the liquid modes kept), by the
+    group of :meth:`System.fixed_groups` they belong to (``""``: the whole scene).
 
     The scene is read back from the atlas, so the lines say what that scene chooses;
     a scene this version no longer reads is reported, not fatal: the atlas is still described.
     """
     if "scene" not in attrs:
-        return []
+        return {}
     try:
         scene = systems.loads_scene(str(attrs["scene"]), "the atlas's scene")
     except StabmapError as exc:
-        return [f"(the stored scene does not load in this version: {exc})"]
+        return {"": [f"(the stored scene does not load in this version: {exc})"]}
     notes = getattr(scene, "notes", None)
-    return list(notes()) if notes is not None else []
+    out: dict[str, list[str]] = {}
+    for note in notes() if notes is not None else []:
+        head, text = note if isinstance(note, tuple) else ("", note)
+        out.setdefault(head, []).append(text)
+    return out
 
 
 def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:

@@ -521,7 +521,13 @@ def atlas_figure(
         size = (width, 5.2) if plan.y else (width, max(1.4 + 0.17 * lines, 0.22 * (len(present) + 4)) + 0.6)
     else:
         size = (width, 2.3 * nrows + 0.8 + 0.17 * lines)
+    caption = fixed_caption(ds, plan, int(15.5 * size[0]))
+    caption_height = 0.13 * (caption.count("\n") + 1) + 0.1 if caption else 0.0
+    size = (size[0], size[1] + caption_height)
     fig = Figure(figsize=size, layout="constrained")
+    if caption:  # below everything else: the layout keeps the bottom strip free for it
+        fig.get_layout_engine().set(rect=(0, caption_height / size[1], 1, 1 - caption_height / size[1]))
+        fig.text(0.01, 0.02 / size[1], caption, fontsize=7, va="bottom", ha="left", color="#333333", gid="fixed-caption")
     if plan.facet is None:
         maps = side = fig
     else:  # panels with their titles on the left, the legend on the right: the two never overlap
@@ -544,8 +550,10 @@ def atlas_figure(
             if mask.any():
                 _paint(ax, mask, xe, ye, col, gid)
         stab, other = cell_edge_boundaries(codes, xe, ye, stable, state=state)
-        for segs, width, col, gid in ((other, 0.6, _CLASS_EDGE, "class-boundary"), (stab, 1.5, _BOUNDARY, "stability-boundary")):
-            lines = LineCollection(segs, colors=col, linewidths=width, capstyle="projecting", joinstyle="miter", zorder=3 + (gid == "stability-boundary"))
+        span = panel_points(width, nrows, ncols, facets=plan.facet is not None, strip=plan.y is None)
+        for segs, width_, col, gid in ((other, 0.6, _CLASS_EDGE, "class-boundary"), (stab, 1.5, _BOUNDARY, "stability-boundary")):
+            widths = boundary_widths(segs, xe, ye, span, width_, log=(_log_axis(ds, plan.x), bool(plan.y) and _log_axis(ds, plan.y)))
+            lines = LineCollection(segs, colors=col, linewidths=widths, capstyle="projecting", joinstyle="miter", zorder=3 + (gid == "stability-boundary"))
             lines.set_gid(gid)
             ax.add_collection(lines, autolim=False)
         drawn["stability"] |= len(stab) > 0
@@ -571,6 +579,9 @@ def atlas_figure(
     else:
         first.set_ylim(0, 1)
         first.set_yticks([])
+    for dim, axis in ((plan.x, first.xaxis), (plan.y, first.yaxis)):
+        if dim and axis.get_scale() == "log":
+            log_ticks(axis, *sorted(np.asarray(ds[dim], dtype=float)[[0, -1]]))
     for dim, setter, log in ((plan.x, first.set_xticks, first.get_xscale() == "log"), (plan.y, first.set_yticks, first.get_yscale() == "log")):
         if dim and ds[dim].attrs.get("scale") == "values" and 1 < ds.sizes[dim] <= 8:  # ticks at listed values ...
             v = np.sort(np.asarray(ds[dim], dtype=float))
@@ -639,6 +650,81 @@ def _title(
     if factors != (1, 1):
         title.append(textwrap.fill(reduction_note(ds, plan, factors, shape), chars))
     return "\n".join(title)
+
+
+def fixed_caption(ds: xr.Dataset, plan: FigurePlan, chars: int) -> str:
+    """The atlas's fixed parameters (its scalar coordinates), grouped as ``stabmap info`` groups them (per body for
+    gyroscopes), one group after another in lines of at most ``chars`` characters; ``""`` if there are none.
+
+    Axes fixed by ``sel`` are in the title, not here.
+    """
+    from .info import fixed_parameters
+
+    groups = fixed_parameters(ds, systems.of_atlas(ds.attrs))
+    text = "; ".join((f"{head}: " if head else "") + ", ".join(i.replace(" ", "\u00a0") for i in items) for head, items in groups)
+    return textwrap.fill("fixed: " + text, chars, break_long_words=False, break_on_hyphens=False) if groups else ""
+
+
+def log_ticks(axis, lo: float, hi: float) -> None:
+    """Label a log axis between its decades too: at 2 and 5 times a power of ten over up to three decades, at 3
+    over up to one (unlabelled minor ticks at every integer multiple); numbers as ``0.2``, ``50``, or ``2×10⁻⁵``
+    far from 1."""
+    from matplotlib.ticker import FuncFormatter, LogLocator
+
+    decades = math.log10(hi / lo) if lo > 0 and hi > lo else 0.0
+    labelled = (2, 3, 5) if decades <= 1.2 else (2, 5) if decades <= 3.5 else ()
+
+    def text(v: float, _pos=None) -> str:
+        e = math.floor(math.log10(v) + 1e-9)
+        mantissa = round(v / 10.0**e, 6)
+        if 1e-3 <= v < 1e4:
+            return f"{v:g}"
+        return f"$10^{{{e}}}$" if mantissa == 1 else f"${mantissa:g}\\times10^{{{e}}}$"
+
+    def minor(v: float, pos=None) -> str:
+        e = math.floor(math.log10(v) + 1e-9)
+        return text(v) if round(v / 10.0**e, 6) in labelled else ""
+
+    axis.set_major_locator(LogLocator(base=10))
+    axis.set_minor_locator(LogLocator(base=10, subs=tuple(range(2, 10))))
+    axis.set_major_formatter(FuncFormatter(text))
+    axis.set_minor_formatter(FuncFormatter(minor))
+    axis.set_tick_params(which="minor", labelsize=8)
+
+
+def panel_points(width: float, nrows: int, ncols: int, *, facets: bool, strip: bool) -> tuple[float, float]:
+    """A lower bound of one map's size in points along (y, x) (:func:`panel_pixels` at 72 dots an inch)."""
+    return panel_pixels(width, nrows, ncols, facets=facets, strip=strip, dpi=72)
+
+
+def boundary_widths(segs: np.ndarray, xe: np.ndarray, ye: np.ndarray, span: tuple[float, float], widest: float,
+                    log: tuple[bool, bool] = (False, False)) -> np.ndarray:
+    """Line widths [pt] of boundary segments: ``widest``, but at most a third of the narrower of the two cells a
+    segment separates (at least 0.35 pt), so that a band one cell wide keeps its class colour between its two
+    boundary lines instead of turning into a black bar.
+
+    ``span`` is the map's size in points along (y, x); ``log`` says which of (x, y) is drawn on a log scale.
+    """
+    segs = np.asarray(segs, dtype=float).reshape(-1, 2, 2)
+    if not len(segs):
+        return np.full(0, widest)
+
+    def sizes(edges: np.ndarray, is_log: bool, points: float) -> tuple[np.ndarray, np.ndarray]:
+        e = np.log(edges) if is_log else np.asarray(edges, dtype=float)
+        cells = np.abs(np.diff(e)) / max(abs(e[-1] - e[0]), 1e-300) * points
+        # the narrower cell on either side of each edge (the outer edges have one)
+        near = np.minimum(np.r_[cells[0], cells], np.r_[cells, cells[-1]])
+        return edges, near
+
+    xedges, xnear = sizes(xe, log[0], span[1])
+    yedges, ynear = sizes(ye, log[1], span[0])
+    vertical = segs[:, 0, 0] == segs[:, 1, 0]
+    out = np.empty(len(segs))
+    if vertical.any():
+        out[vertical] = xnear[np.abs(xedges[None, :] - segs[vertical, 0, 0][:, None]).argmin(axis=1)]
+    if (~vertical).any():
+        out[~vertical] = ynear[np.abs(yedges[None, :] - segs[~vertical, 0, 1][:, None]).argmin(axis=1)]
+    return np.clip(out / 3.0, 0.35, widest)
 
 
 def reduction_note(ds: xr.Dataset, plan: FigurePlan, factors: tuple[int, int], shape: tuple[int, int]) -> str:
@@ -730,13 +816,16 @@ def save_figure(fig, path: Path) -> Path:
 
 
 def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | None = None) -> Path:
-    """Draw a critical-values Dataset: stable intervals of the scanned parameter (shaded) and their ends (curves)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    """Draw a critical-values Dataset to a file (:func:`critical_figure`): PNG or PDF, written atomically."""
     path = check_figure_path(path)
+    return save_figure(critical_figure(ds, sel=sel), path)
+
+
+def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
+    """Draw a critical-values Dataset into a new Figure: stable intervals of the scanned parameter (shaded, along x
+    as on the atlas maps) and their located ends (dots), against the one other axis (y) left free by ``sel``."""
+    from matplotlib.figure import Figure
+
     along = ds.attrs["critical_along"]
     lower, upper = ds[f"{along}_stable_lower"], ds[f"{along}_stable_upper"]
     dims = [d for d in lower.dims if d != "interval"]
@@ -752,37 +841,40 @@ def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | N
     upper_b = upper.where(ds[f"{along}_stable_upper_outer"].notnull())
     if chosen:
         lower, upper, lower_b, upper_b = (v.sel(chosen, method="nearest") for v in (lower, upper, lower_b, upper_b))
-    fig, ax = plt.subplots(figsize=(7.5, 5.5), constrained_layout=True)
+    # The scanned parameter runs along x, as on the atlas maps (omega on x); the other axis, if any, along y.
+    fig = Figure(figsize=(7.5, 5.5), layout="constrained")
+    ax = fig.subplots()
     lo, hi = np.atleast_2d(np.asarray(lower)), np.atleast_2d(np.asarray(upper))
     lo_b, hi_b = np.atleast_2d(np.asarray(lower_b)), np.atleast_2d(np.asarray(upper_b))
     scan = ds.attrs["critical_scan_range"]
     if free:
         from matplotlib.collections import PolyCollection
 
-        x = np.asarray(ds[free[0]])
-        edges = _edges(x, ds[free[0]].attrs.get("scale"))
+        y = np.asarray(ds[free[0]])
+        edges = _edges(y, ds[free[0]].attrs.get("scale"))
         # One box per point and interval, and the ends as dots: joining neighbouring points would draw boundaries
         # (and shade regions) that were never computed wherever the number of intervals changes between points.
         i, k = np.nonzero(np.isfinite(lo))
-        boxes = [[(edges[a], lo[a, b]), (edges[a + 1], lo[a, b]), (edges[a + 1], hi[a, b]), (edges[a], hi[a, b])] for a, b in zip(i, k)]
+        boxes = [[(lo[a, b], edges[a]), (lo[a, b], edges[a + 1]), (hi[a, b], edges[a + 1]), (hi[a, b], edges[a])] for a, b in zip(i, k)]
         ax.add_collection(PolyCollection(boxes, facecolors=_STABLE, edgecolors="none", alpha=0.6, label="stable"))
-        xs = np.broadcast_to(x[:, None], lo.shape).ravel()
-        ax.plot(np.concatenate([xs, xs]), np.concatenate([lo_b.ravel(), hi_b.ravel()]), "k.", ms=2.5, label="boundary")
-        ax.set_xlim(edges[0], edges[-1])
-        ax.set_xlabel(axis_label(ds, free[0]))
+        ys = np.broadcast_to(y[:, None], lo.shape).ravel()
+        ax.plot(np.concatenate([lo_b.ravel(), hi_b.ravel()]), np.concatenate([ys, ys]), "k.", ms=2.5, label="boundary")
+        ax.set_ylim(edges[0], edges[-1])
+        ax.set_ylabel(axis_label(ds, free[0], width=45))
         if ds[free[0]].attrs.get("scale") == "log":
-            ax.set_xscale("log")
+            ax.set_yscale("log")
+            log_ticks(ax.yaxis, float(np.min(y)), float(np.max(y)))
     else:
         for k in range(lo.shape[1]):
             if np.isfinite(lo[0, k]):
-                ax.axhspan(lo[0, k], hi[0, k], color=_STABLE, alpha=0.6, label="stable" if k == 0 else None)
-        ax.set_xticks([])
-    ax.set_ylim(float(scan[0]), float(scan[-1]))
-    units = lower.attrs.get("units", "")
-    ax.set_ylabel(f"{_symbol(ds, along)} [{_units(units)}]" if _units(units) else _symbol(ds, along))
+                ax.axvspan(lo[0, k], hi[0, k], color=_STABLE, alpha=0.6, label="stable" if k == 0 else None)
+        ax.set_yticks([])
+    ax.set_xlim(float(scan[0]), float(scan[-1]))
+    units = _units(lower.attrs.get("units", ""))
+    ax.set_xlabel(f"{_symbol(ds, along)} [{units}]" if units else _symbol(ds, along))
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    title = textwrap.fill(ds.attrs.get("title", "stabmap critical values"), 70) + f"\nstable {along} (white: unstable); ends to rtol {ds.attrs['critical_rtol']:g}"
+    title = textwrap.fill(ds.attrs.get("title", "stabmap critical values"), 70) + f"\nstable {_symbol(ds, along)} (white: unstable); ends to rtol {ds.attrs['critical_rtol']:g}"
     if chosen:
-        title += "; " + ", ".join(f"{k} = {v:.4g}" for k, v in chosen.items())
+        title += "; " + ", ".join(_value_text(ds, k, float(ds[k].sel({k: v}, method="nearest"))) if k in ds.coords else f"{k} = {v:.4g}" for k, v in chosen.items())
     ax.set_title(title, fontsize=10)
-    return save_figure(fig, path)
+    return fig

@@ -124,6 +124,11 @@ class StableFraction:
         """The grid coordinates used: one value for a fixed axis, (smallest, largest) grid value otherwise."""
         return {k: a.values[0] if a.fixed else a.bounds for k, a in self.axes.items()}
 
+    def __repr__(self) -> str:
+        # Short: the axes hold every grid value used (thousands of numbers); ``.axes`` still has them.
+        where = ", ".join(a.describe() for a in self.axes.values())
+        return f"StableFraction({self.fraction:.6g}: {self.stable} of {self.points} points stable; {where})"
+
     @property
     def computed_fraction(self) -> float:
         """The stable fraction among the computed (not inferred) points only; NaN if none was computed."""

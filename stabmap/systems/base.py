@@ -132,6 +132,14 @@ class System:
         """Lines that ``stabmap info`` prints about an atlas of this system, from its global attributes."""
         return []
 
+    def fixed_groups(self, names: list[str]) -> list[tuple[str, list[str]]]:
+        """The fixed parameters ``names`` in groups for ``stabmap info`` and figure captions: (heading, names).
+
+        A heading such as ``"body 2"`` lets a name be printed without its index (``m`` for ``m_2``); the
+        heading ``""`` holds the parameters of the whole scene.  Default: one group of every name.
+        """
+        return [("", list(names))] if names else []
+
     # ------------------------------------------------------------------ points
     def dims(self, scene: SceneBase) -> dict[str, int]:
         """Sizes of the dimensions of ``variables`` beyond the grid's."""

@@ -65,13 +65,30 @@ class Gyroscopes(System):
         return attrs
 
     def describe(self, attrs: dict) -> list[str]:
+        n = attrs.get("n_bodies")
         lines = [
-            f"support {attrs.get('support')}, {attrs.get('n_bodies')} bodies, characteristic polynomial of degree "
+            f"support {attrs.get('support')}, {n} bod{'y' if n == 1 else 'ies'}, characteristic polynomial of degree "
             f"<= {attrs.get('polynomial_degree_bound')}"
         ]
         if "topology_parent" in attrs:
             lines.append(f"a tree: parent = {[int(p) for p in np.atleast_1d(attrs['topology_parent'])]} (0: the base; docs/trees.md)")
         return lines
+
+    def fixed_groups(self, names: list[str]) -> list[tuple[str, list[str]]]:
+        # The whole scene (g, omega), the joints K_0.. (K_0 the support's, K_k between bodies k and k+1),
+        # then one group a body: m_k, A_k, C_k, c_k, s_k, omega_k, at_k and its cavity's parameters.
+        scene, joints, bodies = [], [], {}
+        for name in names:
+            head, _, index = name.rpartition("_")
+            if not index.isdigit() or not head:
+                scene.append(name)
+            elif head == "K":
+                joints.append(name)
+            else:
+                bodies.setdefault(int(index), []).append(name)
+        groups = [("", scene)] if scene else []
+        groups += [("joints", joints)] if joints else []
+        return groups + [(f"body {k}", bodies[k]) for k in sorted(bodies)]
 
     def fastest_axes(self, scene: Scene) -> tuple[int, ...]:
         # The kernels rebuild the inertia and stiffness matrices only when a point's masses, lengths or

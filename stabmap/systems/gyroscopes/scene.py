@@ -99,9 +99,18 @@ class Scene(SceneBase):
         """The parameter a grid axis called ``name`` scans, or a StabmapError saying why it cannot be scanned."""
         return _axis_name(name, self.n, self.support, self.topology is not None).parameter
 
-    def notes(self) -> list[str]:
-        """What the scene chose for itself that its file does not state: the liquid modes each cavity keeps."""
-        return [f"body {k}: {liquid.describe(b.cavity)}" for k, b in enumerate(self.bodies, start=1) if b.cavity is not None]
+    def notes(self) -> list[tuple[str, str]]:
+        """The liquid of each body for ``stabmap info``, as (``"body k"``, text): the modes given (E [kg m^2],
+        kappa [1]) and what a cavity chose for itself that the file does not state (the modes it keeps)."""
+        out = []
+        for k, b in enumerate(self.bodies, start=1):
+            if b.E:
+                n = len(b.E)
+                out.append((f"body {k}", f"liquid, {n} mode{'s' if n > 1 else ''} given: E = {', '.join(f'{e:g}' for e in b.E)} "
+                                         f"kg m2, \u03ba = {', '.join(f'{v:g}' for v in b.kappa)}"))
+            if b.cavity is not None:
+                out.append((f"body {k}", liquid.describe(b.cavity)))
+        return out
 
     def to_dict(self) -> dict:
         out = {"title": self.title, "support": self.support}
