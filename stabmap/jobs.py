@@ -311,4 +311,5 @@ def interrupted(output: str | Path | None) -> str:
         chunks = len(Checkpoint.open(saved).done())
     except StabmapError:
         return f"{output} was not written"
-    return f"{output} was not written; {chunks} finished chunks are saved in {saved}: run the same command with --resume to finish"
+    done = "1 finished chunk is" if chunks == 1 else f"{chunks} finished chunks are"
+    return f"{output} was not written; {done} saved in {saved}: run the same command with --resume to finish"
