@@ -92,6 +92,20 @@ def slow_scene_file(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
+def big_scene_file(tmp_path_factory):
+    """The slow scene on 4 x the points: chunks sized by measured cost are few and short, and an interrupt must
+    land while work is left whatever the machine's speed (kernels loaded from an install-time cache are fast)."""
+    path = tmp_path_factory.mktemp("scene") / "big.toml"
+    path.write_text(SLOW.replace("num = 160", "num = 640"))
+    return path
+
+
+@pytest.fixture(scope="module")
+def big_local(big_scene_file):
+    return compute(stabmap.load_scene(big_scene_file), threads=2, progress=False)
+
+
+@pytest.fixture(scope="module")
 def slow_local(slow_scene_file):
     """The in-process atlas; computing it also fills the kernel cache that worker processes then load."""
     return compute(stabmap.load_scene(slow_scene_file), threads=2, progress=False)
@@ -435,11 +449,14 @@ def _wait_for_chunks(saved, proc, n):
     ],
 )
 def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(
-    how, where, sizing, request, tmp_path, slow_scene_file, slow_local, monkeypatch, capsys
+    how, where, sizing, request, tmp_path, monkeypatch, capsys
 ):
+    size = "slow" if sizing == "fixed" else "big"
+    scene_file, local = request.getfixturevalue(f"{size}_scene_file"), request.getfixturevalue(f"{size}_local")
+    shape = (240, 160) if sizing == "fixed" else (240, 640)
     out = tmp_path / "a.nc"
     saved = partial_dir(out)
-    args = ["atlas", str(slow_scene_file), "-o", str(out), "-q"]
+    args = ["atlas", str(scene_file), "-o", str(out), "-q"]
     if sizing == "fixed":
         args += ["--chunk-points", str(SLOW_CHUNK)]
     here = ["--threads", "1"]
@@ -457,7 +474,7 @@ def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(
     assert [p.name for p in tmp_path.iterdir()] == [saved.name]  # no temporary file left beside it
     done = _finished(saved)
     chunks = Checkpoint.open(saved).chunks
-    total = len(chunk_locations((240, 160), chunks))
+    total = len(chunk_locations(shape, chunks))
     assert before <= len(done) < total
     if sizing == "fixed":
         assert chunks == chunk_shape((240, 160), SLOW_CHUNK, (1, 0))  # omega, the fastest axis, whole
@@ -474,7 +491,7 @@ def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(
     assert len(calls) == total - len(done)
     assert f"resumed: {len(done)} of {total} chunks were already done" in err
     assert not saved.exists()
-    _same_atlas(open_atlas(out), slow_local)
+    _same_atlas(open_atlas(out), local)
 
 
 @pytest.mark.slow
