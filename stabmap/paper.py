@@ -25,12 +25,12 @@ def check(systems=None, *, out: str | Path | None = None, quick: bool = False, c
     ``quick``, ``cases`` and ``rows`` apply to the gyroscopes (coarse grids and 3 checked rows; some cases; rows
     per case). Returns ``{"problems": [...], "text": str}``; ``problems`` is empty when everything agrees.
     """
-    systems = list(systems or SYSTEMS)
+    systems = list(systems or (["gyroscopes"] if cases else SYSTEMS))
     unknown = [s for s in systems if s not in SYSTEMS]
     if unknown:
         raise StabmapError(f"no paper check for system {unknown[0]!r}; choose from: {', '.join(SYSTEMS)}")
-    if cases and systems != ["gyroscopes"]:
-        systems = ["gyroscopes"]
+    if cases and "gyroscopes" not in systems:
+        raise StabmapError("--case names a gyroscope paper case; add 'gyroscopes' to the systems, or drop --case")
     if rows is not None and rows < 1:
         raise StabmapError(f"--rows must be >= 1, got {rows}")
     out = None if out is None else Path(out)

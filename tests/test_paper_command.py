@@ -59,6 +59,7 @@ def test_a_wrong_reaction_exits_1(monkeypatch, capsys):
     (["paper", "tops"], "no paper check for system 'tops'"),
     (["paper", "gyroscopes", "--case", "paper-n9"], "unknown paper case 'paper-n9'"),
     (["paper", "--rows", "0"], "--rows must be >= 1"),
+    (["paper", "closed", "--case", "paper-n1-free"], "--case names a gyroscope paper case"),
 ])
 def test_bad_arguments_are_one_line_and_exit_2(argv, message, capsys):
     assert main(argv) == 2
