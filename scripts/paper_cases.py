@@ -23,210 +23,19 @@ Each case is a bundled scene (``stabmap atlas --example NAME``) with two grid ax
    of every atlas point on the checked rows, and of both ends of every located boundary.
 
 ``--check`` exits 1 if anything disagrees, and prints which case, row and value.
+
+The checks themselves live in ``stabmap.systems.gyroscopes.paper_cases`` and run as ``stabmap paper gyroscopes``
+from an installed stabmap; this script keeps the old options and ``--golden``.
 """
 
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import sys
-import time
 from pathlib import Path
 
-import numpy as np
-
-from stabmap import example
-from stabmap.run import atlas
-from stabmap.run.critical import critical
-from stabmap.systems.gyroscopes import paper
-from stabmap.store.files import write_atlas
-from stabmap.systems.gyroscopes.points import point_arrays
-from stabmap.scene.grid import Axis, resample
-
-RTOL = 1e-8  # engine ends are located to 1e-10 and discriminant roots to ~1e-15; this leaves room for both
-
-
-@dataclasses.dataclass(frozen=True)
-class Case:
-    name: str  # bundled example scene
-    equation: str
-    closed_form: str | None  # stabmap.systems.gyroscopes.paper.factors case, or None where the paper has no closed form
-    along: str  # the axis along which boundaries are located
-
-
-CASES = (
-    Case("paper-n1-fixed-dry", "(23) without liquid: Maievskii's condition", "top", "omega"),
-    Case("paper-n1-fixed-1mode", "(23), one liquid mode: cubic, discriminant >= 0", "top", "omega"),
-    Case("paper-n1-fixed", "(23), two liquid modes (quartic: no closed form)", None, "omega"),
-    Case("paper-n1-free", "(24), two liquid modes: lambda x cubic, discriminant >= 0", "free-body", "C_1"),
-    Case("paper-n2-fixed", "(31), elastic joint", None, "omega"),
-    Case("paper-n2-free", "(32), elastic joint", None, "omega"),
-    Case("paper-n2-free-resonance", "(32), elastic joint, liquid near resonance", None, "omega"),
-    Case("paper-n3-fixed", "(29), elastic joints", None, "omega"),
-    Case("paper-n3-free", "(30), elastic joints", None, "omega"),
-    Case("paper-n3-free-resonance", "(30), elastic joints, liquid near resonance", None, "omega"),
-    Case("paper-n2-free-identical", "(34): identical free bodies, (F~ - 1/2)(F~ + 1/2)", "identical-free", "C"),
-    Case("paper-n3-free-identical", "(33): identical free bodies, (F~ - 2/3)(F~ - 1/3)(F~ + 7/3)", "identical-free", "C"),
-    Case("paper-n3-fixed-split", "a_2 = a_3 = 0: F_1 F_2 F_3, (23) x (24) x (24)", "split", "omega"),
-)
-
-
-def _other(scene, along: str) -> str:
-    return next(a.name for a in scene.grid if a.name != along)
-
-
-def _chains(scene, values: dict[str, np.ndarray]):
-    """Exact paper.Chain of every point given by broadcast axis values, in C order."""
-    pa = point_arrays(scene, values)
-    return [paper.chain_from_arrays(pa.body[i], pa.joint[i], pa.g[i], pa.E[i], pa.kappa[i], pa.nmodes, pa.free) for i in range(len(pa.g))]
-
-
-def closed_form_along(scene, case: Case, row: float) -> list[tuple[float, int, int]]:
-    """Closed-form boundaries (value, N_c below, N_c above) along ``case.along`` at ``other = row``."""
-    other = _other(scene, case.along)
-    scan = next(a.array for a in scene.grid if a.name == case.along)
-    chain = _chains(scene, {other: np.array([row]), case.along: np.array([scan[0]])})[0]
-    _set_symbolic(chain, case.along)
-    lo, hi = sorted((float(scan[0]), float(scan[-1])))
-    return paper.closed_form_boundaries(paper.factors(chain, case.closed_form), lo, hi)
-
-
-def _set_symbolic(chain: paper.Chain, name: str) -> None:
-    """Make the parameter ``name`` of ``chain`` the variable T of the closed form."""
-    symbol, _, index = name.partition("_")
-    columns = getattr(chain, symbol)
-    for k in range(chain.n) if not index else (int(index) - 1,):
-        columns[k] = paper.T
-
-
-def closed_form_pairs_at(scene, case: Case, values: dict[str, np.ndarray]) -> np.ndarray:
-    """N_c from the closed form at every point (C order of the broadcast values)."""
-    return np.array([paper.closed_form_pairs(paper.factors(ch, case.closed_form)) for ch in _chains(scene, values)])
-
-
-def grid_values(ds) -> dict[str, np.ndarray]:
-    """The atlas' axis values, shaped to broadcast over its grid (C order of ``n_complex_pairs``)."""
-    dims = list(ds["n_complex_pairs"].dims)
-    return {d: ds[d].values.reshape([-1 if i == j else 1 for j in range(len(dims))]) for i, d in enumerate(dims)}
-
-
-def paper_pairs_at(scene, values: dict[str, np.ndarray]) -> np.ndarray:
-    """N_c of the paper's printed determinant, exactly, at every point (C order)."""
-    return np.array([paper.complex_pairs(paper.paper_polynomial(ch)) for ch in _chains(scene, values)])
-
-
-def engine_boundaries(crit, other: str, row: float) -> list[tuple[float, float, int, int]]:
-    """(lower, upper, N_c below, N_c above) of every located change at ``other = row``."""
-    r = crit.sel({other: row})
-    lo, hi = np.asarray(r["boundary_lower"]), np.asarray(r["boundary_upper"])
-    below, above = np.asarray(r["n_complex_pairs_below"]), np.asarray(r["n_complex_pairs_above"])
-    return [(float(lo[i]), float(hi[i]), int(below[i]), int(above[i])) for i in range(lo.size) if np.isfinite(lo[i])]
-
-
-def check_case(case: Case, *, quick: bool, rows: int, out: Path | None) -> dict:
-    """Atlas, located boundaries, closed form and exact paper determinant for one case; the disagreements found."""
-    scene = example(case.name)
-    other = _other(scene, case.along)
-    if quick:
-        scene = resample(scene, **{case.along: 60, other: 40})
-    t0 = time.perf_counter()
-    ds = atlas.compute(scene, progress=False)
-    t_atlas = time.perf_counter() - t0
-    grid_rows = next(a.array for a in scene.grid if a.name == other)
-    picks = grid_rows[np.linspace(0, grid_rows.size - 1, rows + 2).round().astype(int)[1:-1]]
-    row_scene = dataclasses.replace(scene, grid=tuple(a if a.name != other else Axis(other, tuple(float(v) for v in picks), "values") for a in scene.grid))
-    crit = critical(row_scene, case.along, progress=False)
-    problems, matched, worst = [], 0, 0.0
-    if case.closed_form is not None:
-        # The whole map against the closed form, point by point, in exact arithmetic.
-        expected = closed_form_pairs_at(scene, case, grid_values(ds)).reshape(ds["n_complex_pairs"].shape)
-        wrong = np.argwhere(expected != ds["n_complex_pairs"].values)
-        dims = ds["n_complex_pairs"].dims
-        for idx in wrong[:5]:
-            at = ", ".join(f"{d} = {ds[d].values[i]:.10g}" for d, i in zip(dims, idx))
-            problems.append(f"{case.name}: {at}: engine N_c = {ds['n_complex_pairs'].values[tuple(idx)]}, closed form {expected[tuple(idx)]}")
-        if len(wrong) > 5:
-            problems.append(f"{case.name}: {len(wrong)} points of the map disagree with the closed form in all")
-    scan = next(a.array for a in scene.grid if a.name == case.along)
-    for row in picks:
-        found = engine_boundaries(crit, other, row)
-        where = f"{case.name}: {other} = {row:.6g}"
-        # The paper's determinant, exactly: every atlas point on the row and both ends of every bracket.
-        line = ds["n_complex_pairs"].sel({other: row}).values
-        exact = paper_pairs_at(scene, {case.along: scan, other: np.array([row])})
-        for v, e, x in zip(scan, line, exact):
-            if e != x:
-                problems.append(f"{where}, {case.along} = {v:.10g}: engine N_c = {e}, paper's determinant {x}")
-        ends = np.array([[lo, hi] for lo, hi, _, _ in found]).ravel()
-        if ends.size:
-            exact_ends = paper_pairs_at(scene, {case.along: ends, other: np.array([row])}).reshape(-1, 2)
-            for (lo, hi, below, above), (xb, xa) in zip(found, exact_ends):
-                if (xb, xa) != (below, above):
-                    problems.append(f"{where}: bracket [{lo:.12g}, {hi:.12g}] has N_c {below} -> {above}, paper's determinant {xb} -> {xa}")
-        if case.closed_form is None:
-            continue
-        closed = closed_form_along(scene, case, row)
-        if len(closed) != len(found):
-            problems.append(f"{where}: engine found {len(found)} boundaries {[round((a + b) / 2, 8) for a, b, _, _ in found]}, closed form {len(closed)} {[round(t, 8) for t, _, _ in closed]}")
-            continue
-        for (lo, hi, below, above), (t, cb, ca) in zip(found, closed):
-            mid = (lo + hi) / 2
-            err = abs(mid - t) / max(abs(t), 1e-300)
-            worst = max(worst, err)
-            matched += 1
-            if err > RTOL or (below, above) != (cb, ca):
-                problems.append(f"{where}: engine boundary {mid:.12g} (N_c {below} -> {above}), closed form {t:.12g} ({cb} -> {ca}), rel. diff {err:.1e}")
-    if out is not None:
-        _figure(case, scene, ds, crit, picks, out / f"{case.name}.png")
-    return {
-        "case": case, "points": int(ds["n_complex_pairs"].size), "atlas_s": t_atlas, "rows": len(picks),
-        "boundaries": sum(len(engine_boundaries(crit, other, r)) for r in picks), "matched": matched,
-        "worst_rel": worst, "problems": problems,
-        "map_agree": None if case.closed_form is None else int(ds["n_complex_pairs"].size - len(wrong)),
-    }
-
-
-def _figure(case: Case, scene, ds, crit, picks, path: Path) -> None:
-    """The engine's map, the closed-form boundary (dense) and the located boundaries on the checked rows."""
-    from stabmap.read.plot import atlas_figure, save_figure
-
-    fig = atlas_figure(ds)
-    ax = fig.axes[0]
-    other = _other(scene, case.along)
-    x_is_along = list(ds["n_complex_pairs"].dims)[0] == case.along
-
-    def draw(alongs, others, **kw):
-        xs, ys = (alongs, others) if x_is_along else (others, alongs)
-        ax.plot(xs, ys, linestyle="none", **kw)
-
-    if case.closed_form is not None:
-        lo, hi = float(ds[other].min()), float(ds[other].max())
-        dense = np.geomspace(lo, hi, 200) if ds[other].attrs.get("scale") == "log" else np.linspace(lo, hi, 200)
-        pts = [(t, r) for r in dense for t, _, _ in closed_form_along(scene, case, r)]
-        if pts:
-            t, r = np.array(pts).T
-            draw(t, r, marker=".", ms=2.0, color="black", label="closed form (paper)")
-    located = [((lo + hi) / 2, r) for r in picks for lo, hi, _, _ in engine_boundaries(crit, other, r)]
-    if located:
-        t, r = np.array(located).T
-        draw(t, r, marker="o", ms=6, mfc="none", mec="white", mew=1.6, label="engine, located to 1e-10")
-    handles, labels = ax.get_legend_handles_labels()
-    if handles:
-        ax.legend(handles, labels, loc="best", fontsize=8, framealpha=0.85)
-    save_figure(fig, path)
-
-
-def write_golden(directory: Path) -> list[Path]:
-    """Small atlases of every case (41 x 21 points) for tests/test_paper_cases.py to pin."""
-    directory.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for case in CASES:
-        scene = example(case.name)
-        scene = resample(scene, **{case.along: 41, _other(scene, case.along): 21})
-        ds = atlas.compute(scene, progress=False)
-        ds.attrs["history"] = f"golden atlas of the paper case {case.name}: python scripts/paper_cases.py --golden {directory}"
-        paths.append(write_atlas(ds, directory / f"{case.name}.nc"))
-    return paths
+from stabmap.systems.gyroscopes.paper_cases import *  # noqa: F401,F403  (tests/test_paper_cases.py reads these names)
+from stabmap.systems.gyroscopes.paper_cases import CASES, RTOL, check_case, run, write_golden  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> dict:
@@ -243,35 +52,17 @@ def main(argv: list[str] | None = None) -> dict:
         for path in write_golden(args.golden):
             print(f"wrote {path}")
         return {}
-    out = None if args.no_figures else args.out
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-    rows = args.rows or (3 if args.quick else 15)
-    if rows < 1:
+    if args.rows is not None and args.rows < 1:
         p.error("--rows must be >= 1")
-    cases = [c for c in CASES if not args.case or c.name in args.case]
-    t0 = time.perf_counter()
-    results = [check_case(c, quick=args.quick, rows=rows, out=out) for c in cases]
+    out = None if args.no_figures else args.out
+    done = run(args.case, quick=args.quick, rows=args.rows, out=out)
     print(f"# command: python scripts/paper_cases.py {' '.join(argv if argv is not None else sys.argv[1:])}")
-    print(f"# boundaries located to 1e-10 relative by stabmap.critical; closed form must agree to {RTOL:g}; every label on")
-    print("# the checked rows and both ends of every boundary are compared with the paper's determinant in exact arithmetic")
-    print()
-    print("| case | paper | points | map points = closed form | rows | boundaries located | closed form: matched, worst rel. diff | disagreements |")
-    print("|---|---|---|---|---|---|---|---|")
-    for r in results:
-        c = r["case"]
-        cf = f"{r['matched']}, {r['worst_rel']:.1e}" if c.closed_form else "none exists"
-        agree = "-" if r["map_agree"] is None else f"{r['map_agree']}"
-        print(f"| {c.name} | {c.equation} | {r['points']} | {agree} | {r['rows']} | {r['boundaries']} | {cf} | {len(r['problems'])} |")
-    problems = [msg for r in results for msg in r["problems"]]
-    for msg in problems:
-        print(f"DISAGREES: {msg}")
+    print(done["text"])
     if out is not None:
         print(f"\nfigures in {out}/")
-    print(f"# total {time.perf_counter() - t0:.0f} s")
-    if args.check and problems:
+    if args.check and done["problems"]:
         sys.exit(1)
-    return {"results": results, "problems": problems}
+    return done
 
 
 if __name__ == "__main__":

@@ -187,6 +187,26 @@ def examples(show):
         click.echo(line)
 
 
+@cli.command(short_help="Recompute the source papers' results and check them: determinants, closed forms, figures.")
+@click.argument("systems", nargs=-1, metavar="[gyroscopes|closed|reactions]...")
+@click.option("--out", metavar="DIR", help="write the figures to DIR/<system>/ (default: no figures)")
+@click.option("--quick", is_flag=True, help="gyroscopes: coarse grids (60 x 40) and 3 checked rows per case")
+@click.option("--case", "cases", multiple=True, metavar="NAME", help="gyroscopes: only this paper case (repeatable; e.g. paper-n1-fixed-dry)")
+@click.option("--rows", type=int, metavar="N", help="gyroscopes: rows checked per case (default 15, --quick 3)")
+def paper(systems, out, quick, cases, rows):
+    """Recompute the papers' cases and check them; exit status 1 on any disagreement (docs/paper-cases.md).
+
+    gyroscopes: the cases n = 1, 2, 3 against the printed determinants (exact arithmetic) and closed forms;
+    closed: the families' boundaries along h2/h1 against CLOSED.md; reactions: the square plate's G/4.
+    """
+    from . import paper as papers
+
+    done = papers.check(systems, out=out, quick=quick, cases=cases, rows=rows)
+    click.echo(done["text"])
+    if done["problems"]:
+        raise click.ClickException(f"{len(done['problems'])} disagreements with the papers (DISAGREES lines above)")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (2: bad input, 130: interrupted)."""
     # 'kill' (SIGTERM) stops a run as Ctrl-C does: temporary files removed, finished chunks kept for --resume.

@@ -1,0 +1,75 @@
+"""``stabmap paper``: the papers' checks as a command of the installed tool (stabmap/paper.py)."""
+
+from __future__ import annotations
+
+import pytest
+
+from stabmap import paper as papers
+from stabmap.cli import main
+from stabmap.systems.gyroscopes import paper
+from stabmap.systems.gyroscopes import paper_cases
+
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def test_closed_and_reactions_agree_with_their_papers_and_draw(tmp_path, capsys):
+    assert main(["paper", "closed", "reactions", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "| closed-hinge | 3 | 3 |" in out and "| closed-figure-eight-6 | 2 | 2 |" in out
+    assert "24.525 = G/4, 4" in out and "all agree with the papers" in out
+    for name in ("closed/closed-hinge", "closed/closed-figure-eight-6", "reactions/reactions-square-plate"):
+        assert (tmp_path / f"{name}.png").read_bytes()[:8] == PNG
+
+
+def test_gyroscope_cases_quick_with_figures(tmp_path, capsys):
+    cases = ["paper-n1-fixed-dry", "paper-n1-free", "paper-n3-fixed-split"]
+    argv = ["paper", "gyroscopes", "--quick", "--out", str(tmp_path)]  # 3 rows: with --rows 2 the split case has a narrow window the scan misses
+    assert main([*argv, *[a for c in cases for a in ("--case", c)]]) == 0
+    out = capsys.readouterr().out
+    for c in cases:
+        assert f"| {c} |" in out
+        assert (tmp_path / "gyroscopes" / f"{c}.png").read_bytes()[:8] == PNG
+    assert "| 0 |\n" in out and "DISAGREES" not in out
+
+
+@pytest.mark.slow
+def test_every_paper_check_quick(tmp_path):
+    done = papers.check(out=tmp_path, quick=True)
+    assert done["problems"] == []
+    assert len(list((tmp_path / "gyroscopes").glob("*.png"))) == len(paper_cases.CASES)
+
+
+def test_a_wrong_closed_form_exits_1(monkeypatch, capsys):
+    original = paper.F_polynomial
+    monkeypatch.setattr(paper, "F_polynomial", lambda A_prime, *args: original(A_prime * paper.q(1.01), *args))
+    assert main(["paper", "gyroscopes", "--quick", "--rows", "2", "--case", "paper-n1-fixed-1mode"]) == 1
+    captured = capsys.readouterr()
+    assert "DISAGREES: paper-n1-fixed-1mode" in captured.out and "disagreements with the papers" in captured.err
+
+
+def test_a_wrong_reaction_exits_1(monkeypatch, capsys):
+    from stabmap.systems.reactions import paper_cases as plate
+
+    monkeypatch.setattr(plate, "RTOL", -1.0)  # nothing can agree to a negative tolerance: the check must say so
+    assert main(["paper", "reactions"]) == 1
+    assert "DISAGREES: reactions-square-plate" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["paper", "tops"], "no paper check for system 'tops'"),
+    (["paper", "gyroscopes", "--case", "paper-n9"], "unknown paper case 'paper-n9'"),
+    (["paper", "--rows", "0"], "--rows must be >= 1"),
+    (["paper", "closed", "--case", "paper-n1-free"], "--case names a gyroscope paper case"),
+])
+def test_bad_arguments_are_one_line_and_exit_2(argv, message, capsys):
+    assert main(argv) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_the_command_is_listed():
+    from click.testing import CliRunner
+
+    from stabmap.cli import cli
+
+    result = CliRunner().invoke(cli, ["--help"])
+    assert "paper" in result.output and "Recompute the source papers" in result.output
