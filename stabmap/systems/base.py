@@ -112,17 +112,23 @@ class System:
     symbols: dict[str, str] = {}
 
     # ------------------------------------------------------------------ scenes
+    # The module of the system's scene, if it has ``from_dict(table, base_dir)`` and ``fixed_values(scene)``:
+    # the three members below then need no code in the subclass.
+    scene_module = None
+
     def scene_from_dict(self, table: dict, base_dir: Path | None = None) -> SceneBase:
         """The scene of a TOML table (without its ``system`` key); errors name the key and the fix."""
-        raise NotImplementedError
+        if self.scene_module is None:
+            raise NotImplementedError
+        return self.scene_module.from_dict(table, base_dir)
 
     def parameter(self, scene: SceneBase, name: str) -> Parameter:
         """Units, long name and limits of the scannable ``name``; a StabmapError for a name this scene cannot scan."""
-        raise NotImplementedError
+        return scene.parameter(name)
 
     def fixed_values(self, scene: SceneBase) -> dict[str, float]:
         """The scene's scalar parameters that are not grid axes, by their scannable names (scalar coordinates)."""
-        return {}
+        return {} if self.scene_module is None else self.scene_module.fixed_values(scene)
 
     def attrs(self, scene: SceneBase) -> dict:
         """Global attributes that describe the scene beyond its TOML (netCDF-safe values)."""

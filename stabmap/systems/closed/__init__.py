@@ -45,15 +45,7 @@ class Closed(System):
     proves_labels = True  # every class is proved or flagged undecided (proofs.py, docs/closed.md)
     provenance = "decided_by"
     symbols = {"ratio": "h_2/h_1", "n": "n", "j": "j", "h": "h"}
-
-    def scene_from_dict(self, table, base_dir=None) -> Scene:
-        return _scene.from_dict(table, base_dir)
-
-    def parameter(self, scene: Scene, name: str):
-        return scene.parameter(name)
-
-    def fixed_values(self, scene: Scene) -> dict[str, float]:
-        return _scene.fixed_values(scene)
+    scene_module = _scene
 
     def attrs(self, scene: Scene) -> dict:
         fam = scene.fam

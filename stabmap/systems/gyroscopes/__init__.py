@@ -48,15 +48,7 @@ class Gyroscopes(System):
     stable_label = 0
     provenance = "decided_by"
     symbols = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho", "radius": "a"}
-
-    def scene_from_dict(self, table, base_dir=None) -> Scene:
-        return _scene.from_dict(table, base_dir)
-
-    def parameter(self, scene: Scene, name: str):
-        return scene.parameter(name)
-
-    def fixed_values(self, scene: Scene) -> dict[str, float]:
-        return _scene.fixed_values(scene)
+    scene_module = _scene
 
     def attrs(self, scene: Scene) -> dict:
         attrs = {"support": scene.support, "n_bodies": scene.n, "polynomial_degree_bound": scene.degree}

@@ -49,15 +49,7 @@ class Reactions(System):
     stable_label = None
     provenance = DECIDED_BY.name
     symbols = {"F": "F", "M": "M", "c": "c", "g": "g", "a": "a", "omega": r"\omega", "alpha": r"\alpha", "x": "x", "y": "y", "z": "z"}
-
-    def scene_from_dict(self, table, base_dir=None) -> Scene:
-        return _scene.from_dict(table, base_dir)
-
-    def parameter(self, scene: Scene, name: str):
-        return scene.parameter(name)
-
-    def fixed_values(self, scene: Scene) -> dict[str, float]:
-        return _scene.fixed_values(scene)
+    scene_module = _scene
 
     def attrs(self, scene: Scene) -> dict:
         attrs = {"n_nodes": scene.n, "load_given_as": scene.kind}
