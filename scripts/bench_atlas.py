@@ -31,7 +31,7 @@ def cold_start(cache_dir: str | None, workdir: str) -> float:
     env = dict(os.environ)
     if cache_dir is not None:
         env["STABMAP_CACHE_DIR"] = cache_dir
-    cmd = [sys.executable, "-m", "stabmap", "atlas", "--example", "paper-n1-fixed", "-o", os.path.join(workdir, "a.nc"), "-q"]
+    cmd = [sys.executable, "-m", "stabmap", "atlas", "--example", "paper-n1-fixed", "-o", os.path.join(workdir, "a.nc"), "-q", "--overwrite"]
     t0 = time.perf_counter()
     subprocess.run(cmd, check=True, env=env, capture_output=True)
     return time.perf_counter() - t0

@@ -179,10 +179,13 @@ def test_round_trip_and_atlas_reproduce_the_choice(tmp_path):
     assert rebuilt.nmodes.tolist() == s.nmodes.tolist()
     assert np.array_equal(atlas.compute(rebuilt, progress=False).n_complex_pairs.values, ds.n_complex_pairs.values)
     text = describe(ds, "a.nc")
-    line = next(x for x in text.splitlines() if "body 1:" in x)
+    lines = text.splitlines()
+    start = next(i for i, x in enumerate(lines) if "body 1:" in x)
+    # body 1's group: its line and the wrapped lines under it, up to the next group
+    group = " ".join([lines[start]] + [x for x in lines[start + 1 :] if x.startswith(" " * 12)][:4])
     c = s.bodies[0].cavity
-    assert f"{c.kept} liquid modes kept" in line and "mode_tolerance = 0.0003" in line
-    assert f"{c.tail_over_A:.2g} of A" in line
+    assert f"{c.kept} liquid modes kept" in group and "mode_tolerance = 0.0003" in group
+    assert f"{c.tail_over_A:.2g} of A" in group
 
 
 def test_default_scene_writes_its_count_and_auto_without_a_tolerance():
