@@ -21,6 +21,7 @@ A block is changed by an HTML comment on the line just before its fence, which t
 from __future__ import annotations
 
 import doctest
+import dataclasses
 import os
 import re
 import subprocess
@@ -59,6 +60,9 @@ def blocks(path: Path) -> list[Block]:
         line = text.count("\n", 0, m.start("body"))
         assert not mark or MARKS.match(mark), f"{path.name}:{line}: unknown doc-test mark {mark!r}"
         found.append(Block(path.relative_to(ROOT).as_posix(), line, m.group("lang"), m.group("body"), mark))
+    if path.name == "README.md" and found and not found[0].mark:
+        # The README must open with its two commands, no comment before them: its first block is run as no-install.
+        found[0] = dataclasses.replace(found[0], mark="no-install")
     return found
 
 
