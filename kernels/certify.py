@@ -68,10 +68,10 @@ def allocate(n, nmodes, parent):
     feat = np.empty(nfeat)
     R = np.empty(degree)
     group = np.empty(degree, np.int64)
-    # state: [0] the previous point was decided, [1] its degree d, [2] its N_c, [3] points left to do
-    # cold, [4] unused, [5] zold holds the roots of the point before the previous one,
-    # [6] the workspace holds the structure (M T, K T) of the last point given
-    state = np.zeros(7, np.int64)
+    # state: [0] the previous point was decided, [1] its degree d, [2] points left to do cold,
+    # [3] zold holds the roots of the point before the previous one,
+    # [4] the workspace holds the structure (M T, K T) of the last point given
+    state = np.zeros(5, np.int64)
     # running means: cost of a warm start (n x n solves), its hit rate (hoped 1 until tried), cost of a cold start
     costs = np.array([0.0, 1.0, 0.0])
     zold = np.empty(degree, np.complex128)
@@ -261,13 +261,13 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     n = body.shape[0]
     degree = C.shape[0]
     # M T and K T in the workspace are the previous point's only if it got as far as prepare
-    reuse = reuse and state[6] == 1
-    state[6] = 0
+    reuse = reuse and state[4] == 1
+    state[4] = 0
     if not _moderate(body, joint, at, g, E, kappa, nmodes):
         state[0] = 0
         return -1, UNDECIDED
     m = pencil.prepare(body, joint, at, g, E, kappa, nmodes, parent, free, pws, reuse)
-    state[6] = 1
+    state[4] = 1
     d = degree - m
     ok, lead_m, lead_e = disks.lead_bound(pws, n, Sm, Sr)
     if not ok:  # deg p unproved: nothing below counts
@@ -277,10 +277,10 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     # 1. a grid neighbour's roots, extrapolated, usually separate this point's: no eigenvalue problem
     neighbour = state[0] == 1 and state[1] == d
     if neighbour:
-        approximations.predict(z, zold, d, state[5] == 1, nmodes, pws[5], bold)
-    state[5] = 1 if neighbour else 0
+        approximations.predict(z, zold, d, state[3] == 1, nmodes, pws[5], bold)
+    state[3] = 1 if neighbour else 0
     bold[:] = pws[5][0]
-    if neighbour and state[3] <= 0:
+    if neighbour and state[2] <= 0:
         real, nc, status, warm = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, WARM_STEPS)
         suspects = done[:d].sum()
         if status == UNDECIDED and 0 < suspects <= d // 4:
@@ -303,12 +303,12 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
         costs[0] = (1 - SMOOTH) * costs[0] + SMOOTH * warm if costs[0] > 0 else warm
         costs[1] = (1 - SMOOTH) * costs[1] + SMOOTH * (status != UNDECIDED)
         if costs[2] > 0 and costs[0] > costs[1] * costs[2]:
-            state[3] = PAUSE
-    elif state[3] > 0:
-        state[3] -= 1
+            state[2] = PAUSE
+    elif state[2] > 0:
+        state[2] -= 1
     # 2. approximations from the linearisation, 3. polished by Aberth sweeps, 4. every disk
     if status == UNDECIDED:
-        state[5] = 0  # the eigenvalues come in their own order: no history to extrapolate from
+        state[3] = 0  # the eigenvalues come in their own order: no history to extrapolate from
         if pencil.linearisation(body, E, nmodes, parent, pws, C, Mo) and approximations.eigenvalues(C, wr, wi, vdummy, z, degree, m):
             cold = _eigenvalue_price(n, degree)
             real, nc, status, more = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, 0)
@@ -325,5 +325,4 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
                     nc, status = nonreal // 2, DECIDED_DISKS
     state[0] = 1 if status != UNDECIDED else 0
     state[1] = d
-    state[2] = nc
     return nc, status
