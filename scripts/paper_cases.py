@@ -5,22 +5,7 @@
     python scripts/paper_cases.py --golden tests/data        # rewrite the golden atlases the tests pin
     python scripts/paper_cases.py --case paper-n1-fixed-dry --out figs
 
-Each case is a bundled scene (``stabmap atlas --example NAME``) with two grid axes. For each one:
-
-1. The atlas is computed by the engine and drawn (``stabmap.read.plot.atlas_figure``).
-2. On a few rows of the second axis the engine locates every change of N_c along the case's
-   ``along`` axis to 1e-10 relative (``stabmap.critical``).
-3. Where the paper gives a closed form (``stabmap.systems.gyroscopes.paper.factors``: (23) without liquid is
-   Maievskii's condition; (23) and (24) with one liquid mode, (33), (34) and the split
-   (23) x (24) x (24) factor into polynomials of degree <= 3 whose discriminant decides), its
-   boundaries are the real roots of the discriminant, as a polynomial in the ``along`` parameter,
-   at which the closed-form count changes. They are drawn over the map (dense dotted curve), and
-   ``--check`` requires the engine's boundaries and the closed form's to pair up one to one with
-   the same N_c on either side and to agree to RTOL relative, and every point of the map to have
-   the closed form's N_c (exact rational arithmetic).
-4. Every case, closed form or not, is checked against the paper's printed determinant
-   ((22), (29)-(32), (28); ``stabmap.systems.gyroscopes.paper.paper_polynomial``) in exact rational arithmetic: the N_c
-   of every atlas point on the checked rows, and of both ends of every located boundary.
+What each case computes and checks: the docstring of ``stabmap.systems.gyroscopes.paper_cases``.
 
 ``--check`` exits 1 if anything disagrees, and prints which case, row and value.
 
