@@ -4,6 +4,8 @@ colour and put the scanned parameter on x in critical plots as on atlas maps."""
 
 from __future__ import annotations
 
+import re
+
 import io
 
 import numpy as np
@@ -74,8 +76,11 @@ def test_caption_holds_the_fixed_values_per_body():
     fig = atlas_figure(hand_atlas(4, np.zeros((4, 5), dtype=np.int16)))
     (caption,) = [t for t in fig.texts if t.get_gid() == "fixed-caption"]
     text = caption.get_text().replace("\u00a0", " ")
-    assert "body 4: m = 1.03 kg" in text and "g = 9.81" in text and "K_3 = 12" in text
-    assert max(len(line) for line in text.splitlines()) <= 15.5 * fig.get_figwidth() + 1
+    assert "body 4: $m$ = 1.03 kg" in text and "$g$ = 9.81" in text and "$K_{3}$ = 12" in text
+    assert "E = 0.002, 0.0001 kg m$^{2}$, \u03ba = 2.7, 3.1" in text  # each body's liquid modes, one list unbroken
+    assert "$s$" in text.split("body 3:")[1].split("body 4:")[0] and "$s$" not in text.split("body 4:")[1]  # no joint above the top
+    shown = [re.sub(r"[${}^_]", "", re.sub(r"\\[A-Za-z]+", "x", line)) for line in text.splitlines()]
+    assert max(map(len, shown)) <= 15.5 * fig.get_figwidth() + 1
 
 
 def test_log_axis_labels_more_than_decades():

@@ -27,11 +27,13 @@ def wrapped(head: str, items: list[str], indent: str = "  ", width: int = WIDTH)
                          break_long_words=False, break_on_hyphens=False) or [first.rstrip()]
 
 
-def fixed_parameters(ds: xr.Dataset, system) -> list[tuple[str, list[str]]]:
+def fixed_parameters(ds: xr.Dataset, system, item=None) -> list[tuple[str, list[str]]]:
     """The atlas's fixed parameters (scalar coordinates) grouped as the system groups them, as text with units.
 
     Returns (heading, ["m = 1 kg", ...]): inside a heading such as ``body 2`` a name loses its index (``m_2`` -> ``m``).
+    ``item(name, value, units)`` writes one entry (a figure's caption writes symbols and units in mathtext).
     """
+    item = item or (lambda name, value, units: f"{name} = {value:.6g}" + (f" {units}" if units and units != "1" else ""))
     names = [str(k) for k in ds.coords if ds[k].ndim == 0 and np.issubdtype(ds[k].dtype, np.number)]
     out = []
     for head, group in system.fixed_groups(names):
@@ -40,7 +42,7 @@ def fixed_parameters(ds: xr.Dataset, system) -> list[tuple[str, list[str]]]:
         for k in group:
             units = ds[k].attrs.get("units", "")
             shown = k[: -len(suffix)] if suffix and k.endswith(suffix) else k
-            items.append(f"{shown} = {float(ds[k]):.6g}" + (f" {units}" if units and units != "1" else ""))
+            items.append(item(shown, float(ds[k]), units))
         out.append((head, items))
     return out
 

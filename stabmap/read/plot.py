@@ -654,15 +654,43 @@ def _title(
 
 def fixed_caption(ds: xr.Dataset, plan: FigurePlan, chars: int) -> str:
     """The atlas's fixed parameters (its scalar coordinates), grouped as ``stabmap info`` groups them (per body for
-    gyroscopes), one group after another in lines of at most ``chars`` characters; ``""`` if there are none.
+    gyroscopes) with each group's liquid modes, symbols and units as in the titles, in lines of at most ``chars``
+    characters (mathtext markup not counted); ``""`` if there are none.
 
     Axes fixed by ``sel`` are in the title, not here.
     """
-    from .info import fixed_parameters
+    from .info import fixed_parameters, scene_notes
 
-    groups = fixed_parameters(ds, systems.of_atlas(ds.attrs))
-    text = "; ".join((f"{head}: " if head else "") + ", ".join(i.replace(" ", "\u00a0") for i in items) for head, items in groups)
-    return textwrap.fill("fixed: " + text, chars, break_long_words=False, break_on_hyphens=False) if groups else ""
+    def item(name: str, value: float, units: str) -> str:
+        return f"{_symbol(ds, name)} = {value:.6g}" + (f" {_units(units)}" if _units(units) else "")
+
+    groups = fixed_parameters(ds, systems.of_atlas(ds.attrs), item)
+    if not groups:
+        return ""
+    notes = scene_notes(ds.attrs)
+    parts = []
+    for head, items in groups:
+        liquid = [re.sub(r"(?<= )(kg|m|s|rad)(-?\d+)\b", r"\1$^{\2}$", t) for t in notes.get(head, [])]
+        parts.append((f"{head}: " if head else "") + ", ".join(items + liquid))
+    return _fill_mathtext("fixed: " + "; ".join(parts), chars)
+
+
+def _fill_mathtext(text: str, chars: int) -> str:
+    """Wrap ``text`` at spaces into lines of at most ``chars`` shown characters: ``$...$`` markup counts as the
+    characters it shows, and spaces inside an entry (``m = 1 kg``) do not break."""
+    def shown(word: str) -> int:  # '$\\kappa_{2}$' shows as two characters
+        return len(re.sub(r"[${}^_]", "", re.sub(r"\\[A-Za-z]+", "x", word)))
+
+    lines, line, width = [], [], 0
+    for word in re.split(r"(?<=[,;:]) (?![\d-])", text):  # a list of values (E = 1e-4, 2e-5) stays on one line
+        word = word.replace(" ", "\u00a0")
+        w = shown(word)
+        if line and width + 1 + w > chars:
+            lines.append(" ".join(line))
+            line, width = [], 0
+        line.append(word)
+        width += w + (1 if width else 0)
+    return "\n".join(lines + [" ".join(line)])
 
 
 def log_ticks(axis, lo: float, hi: float) -> None:

@@ -330,7 +330,8 @@ def fixed_values(scene: Scene) -> dict[str, float]:
         out["g"] = scene.g
     for k, b in enumerate(scene.bodies, start=1):
         for key in EVERY_BODY:
-            if key not in names and not (key == "s" and scene.topology is not None):
+            # s places the joint above: a tree places its joints by topology.at, and a chain's top body has none
+            if key not in names and not (key == "s" and (scene.topology is not None or k == len(scene.bodies))):
                 out[f"{key}_{k}"] = getattr(b, key)
         if scene.topology is not None and k > 1:
             out[f"at_{k}"] = scene.topology.at[k - 1]
