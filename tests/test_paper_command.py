@@ -23,7 +23,7 @@ def test_closed_and_reactions_agree_with_their_papers_and_draw(tmp_path, capsys)
 
 def test_gyroscope_cases_quick_with_figures(tmp_path, capsys):
     cases = ["paper-n1-fixed-dry", "paper-n1-free", "paper-n3-fixed-split"]
-    argv = ["paper", "gyroscopes", "--quick", "--out", str(tmp_path)]  # 3 rows: with --rows 2 the split case has a narrow window the scan misses
+    argv = ["paper", "gyroscopes", "--quick", "--out", str(tmp_path)]
     assert main([*argv, *[a for c in cases for a in ("--case", c)]]) == 0
     out = capsys.readouterr().out
     for c in cases:
@@ -37,6 +37,28 @@ def test_every_paper_check_quick(tmp_path):
     done = papers.check(out=tmp_path, quick=True)
     assert done["problems"] == []
     assert len(list((tmp_path / "gyroscopes").glob("*.png"))) == len(paper_cases.CASES)
+
+
+def test_a_window_narrower_than_the_scan_step_is_found_by_rescanning_that_step(capsys):
+    # With 2 rows the split case checks c_1 = 0.1133, whose stable window (48.905, 49.337) lies inside one
+    # scan step of the 60-value quick scan: the scan cannot see it; a fine scan of that step must find both ends.
+    assert main(["paper", "gyroscopes", "--quick", "--rows", "2", "--case", "paper-n3-fixed-split"]) == 0
+    out = capsys.readouterr().out
+    assert "DISAGREES" not in out and "| 2 | 2 | 4, " in out  # 2 boundaries seen by the scan, 4 matched in all
+    assert "NOTE: paper-n3-fixed-split: c_1 = 0.113333: a window narrower than the scan step" in out
+    assert "48.90473524" in out and "49.33733592" in out
+
+
+def test_a_closed_form_window_the_engine_does_not_find_is_a_disagreement(monkeypatch, capsys):
+    real = paper_cases.closed_form_along
+
+    def with_a_false_window(scene, case, row):  # a stable window the true polynomial does not have
+        return sorted([*real(scene, case, row), (150.2, 1, 0), (150.3, 0, 1)])
+
+    monkeypatch.setattr(paper_cases, "closed_form_along", with_a_false_window)
+    assert main(["paper", "gyroscopes", "--quick", "--rows", "1", "--case", "paper-n1-fixed-dry"]) == 1
+    out = capsys.readouterr().out
+    assert "DISAGREES: paper-n1-fixed-dry" in out and "inside the scan step" in out and "a 65-value scan of it finds []" in out
 
 
 def test_a_wrong_closed_form_exits_1(monkeypatch, capsys):
