@@ -112,6 +112,22 @@ def test_one_cell_band_keeps_its_class_colour():
     assert (hits >= 1).mean() > 0.95  # the class colour shows along (nearly) all the band: no black bar
 
 
+def test_boundary_between_wide_regions_stays_thick():
+    # 300 cells along omega are thinner than the thick line: only the lines around the one-cell band may thin
+    # down, or the stability boundary would look like a change of N_c (thin) everywhere on fine grids
+    nc = np.zeros((40, 300), dtype=np.int16)
+    nc[:, 200:] = 1
+    nc[:, 100] = 2
+    fig = atlas_figure(hand_atlas(1, nc))
+    (stab,) = [c for c in fig.axes[0].collections if c.get_gid() == "stability-boundary"]
+    widths = np.broadcast_to(stab.get_linewidth(), (len(stab.get_segments()),))
+    y = np.array([seg[0][1] for seg in stab.get_segments()])
+    omega = np.linspace(1.0, 100.0, 300)
+    wide, band = np.abs(y - (omega[199] + omega[200]) / 2) < 1e-9, np.abs(y - omega[100]) < omega[1] - omega[0]
+    assert wide.any() and band.sum() >= 2
+    assert widths[wide].min() == 1.5 and widths[band].max() < 0.6
+
+
 def test_critical_plot_puts_the_scanned_parameter_on_x():
     scene = from_dict({"support": "fixed", "g": 9.81, "bodies": [{"m": 1.0, "A": 0.02, "C": 0.03, "c": 0.1}],
                        "grid": {"omega": {"start": 1.0, "stop": 60.0, "num": 21}, "c_1": {"values": [0.05, 0.1, 0.2]}}})

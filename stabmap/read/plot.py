@@ -552,7 +552,7 @@ def atlas_figure(
         stab, other = cell_edge_boundaries(codes, xe, ye, stable, state=state)
         span = panel_points(width, nrows, ncols, facets=plan.facet is not None, strip=plan.y is None)
         for segs, width_, col, gid in ((other, 0.6, _CLASS_EDGE, "class-boundary"), (stab, 1.5, _BOUNDARY, "stability-boundary")):
-            widths = boundary_widths(segs, xe, ye, span, width_, log=(_log_axis(ds, plan.x), bool(plan.y) and _log_axis(ds, plan.y)))
+            widths = boundary_widths(segs, xe, ye, span, width_, log=(_log_axis(ds, plan.x), bool(plan.y) and _log_axis(ds, plan.y)), codes=codes)
             lines = LineCollection(segs, colors=col, linewidths=widths, capstyle="projecting", joinstyle="miter", zorder=3 + (gid == "stability-boundary"))
             lines.set_gid(gid)
             ax.add_collection(lines, autolim=False)
@@ -726,32 +726,55 @@ def panel_points(width: float, nrows: int, ncols: int, *, facets: bool, strip: b
 
 
 def boundary_widths(segs: np.ndarray, xe: np.ndarray, ye: np.ndarray, span: tuple[float, float], widest: float,
-                    log: tuple[bool, bool] = (False, False)) -> np.ndarray:
-    """Line widths [pt] of boundary segments: ``widest``, but at most a third of the narrower of the two cells a
+                    log: tuple[bool, bool] = (False, False), codes: np.ndarray | None = None) -> np.ndarray:
+    """Line widths [pt] of boundary segments: ``widest``, but at most a third of the narrower of the two bands a
     segment separates (at least 0.35 pt), so that a band one cell wide keeps its class colour between its two
-    boundary lines instead of turning into a black bar.
+    boundary lines instead of turning into a black bar, while a boundary between wide regions stays thick.
 
+    A band is the run of cells of one class in ``codes`` (shape (ny, nx)) across the segment, measured along the
+    whole segment (its narrowest place counts); without ``codes`` every cell is a band of its own.
     ``span`` is the map's size in points along (y, x); ``log`` says which of (x, y) is drawn on a log scale.
     """
     segs = np.asarray(segs, dtype=float).reshape(-1, 2, 2)
     if not len(segs):
         return np.full(0, widest)
+    if codes is None:
+        codes = np.arange((len(ye) - 1) * (len(xe) - 1)).reshape(len(ye) - 1, len(xe) - 1)
 
-    def sizes(edges: np.ndarray, is_log: bool, points: float) -> tuple[np.ndarray, np.ndarray]:
+    def cells(edges: np.ndarray, is_log: bool, points: float) -> np.ndarray:
         e = np.log(edges) if is_log else np.asarray(edges, dtype=float)
-        cells = np.abs(np.diff(e)) / max(abs(e[-1] - e[0]), 1e-300) * points
-        # the narrower cell on either side of each edge (the outer edges have one)
-        near = np.minimum(np.r_[cells[0], cells], np.r_[cells, cells[-1]])
-        return edges, near
+        return np.abs(np.diff(e)) / max(abs(e[-1] - e[0]), 1e-300) * points
 
-    xedges, xnear = sizes(xe, log[0], span[1])
-    yedges, ynear = sizes(ye, log[1], span[0])
+    def bands(c: np.ndarray, size: np.ndarray) -> np.ndarray:
+        """Per cell, the width [pt] of its run of equal codes along the last axis."""
+        start = np.ones(c.shape, dtype=bool)
+        start[:, 1:] = c[:, 1:] != c[:, :-1]  # a run never crosses into the next line
+        run = np.cumsum(start.ravel()) - 1
+        width = np.bincount(run, weights=np.broadcast_to(size, c.shape).ravel())
+        return width[run].reshape(c.shape)
+
+    def narrowest(table: np.ndarray, line: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """min of table[line, a:b] for every segment, in one pass."""
+        flat = np.append(table.ravel(), np.inf)
+        starts = np.stack([line * table.shape[1] + a, line * table.shape[1] + b], 1).ravel()
+        return np.minimum.reduceat(flat, starts)[::2]
+
+    def index(edges: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return np.abs(edges[None, :] - v[:, None]).argmin(axis=1)
+
+    codes = np.asarray(codes)
+    along_x = bands(codes, cells(xe, log[0], span[1]))
+    along_y = bands(codes.T, cells(ye, log[1], span[0])).T
     vertical = segs[:, 0, 0] == segs[:, 1, 0]
     out = np.empty(len(segs))
-    if vertical.any():
-        out[vertical] = xnear[np.abs(xedges[None, :] - segs[vertical, 0, 0][:, None]).argmin(axis=1)]
-    if (~vertical).any():
-        out[~vertical] = ynear[np.abs(yedges[None, :] - segs[~vertical, 0, 1][:, None]).argmin(axis=1)]
+    for mask, table, edges, ends, at, pos in (
+        (vertical, np.minimum(along_x[:, :-1], along_x[:, 1:]).T, xe, ye, 0, 1),
+        (~vertical, np.minimum(along_y[:-1, :], along_y[1:, :]), ye, xe, 1, 0),
+    ):
+        if mask.any():
+            s = segs[mask]
+            i0, i1 = index(ends, s[:, 0, pos]), index(ends, s[:, 1, pos])
+            out[mask] = narrowest(table, index(edges, s[:, 0, at]) - 1, np.minimum(i0, i1), np.maximum(i0, i1))
     return np.clip(out / 3.0, 0.35, widest)
 
 
