@@ -136,5 +136,7 @@ def test_critical_plot_puts_the_scanned_parameter_on_x():
     ax = fig.axes[0]
     assert "\\omega" in ax.get_xlabel() and "c" in ax.get_ylabel()
     assert ax.get_xlim() == (1.0, 60.0)
+    (caption,) = [t for t in fig.texts if t.get_gid() == "fixed-caption"]  # the fixed values, as under a map
+    assert "$m$ = 1 kg" in caption.get_text().replace("\u00a0", " ") and "$c$" not in caption.get_text()  # c_1 is an axis
     buf = io.BytesIO()
     fig.savefig(buf, format="png")

@@ -382,6 +382,8 @@ def _units(units: str) -> str:
 def _symbol(ds: xr.Dataset, name: str) -> str:
     """'omega' -> '$\\omega$', 'm_2' -> '$m_{2}$' (the system's ``symbols``); other names are returned as they are."""
     symbols = systems.of_atlas(ds.attrs).symbols
+    if name in symbols and not re.fullmatch(r"[A-Za-z]+", name):  # a whole name with its own symbol: c1sq -> c_1^2
+        return f"${symbols[name]}$"
     m = re.fullmatch(r"([A-Za-z]+)(?:_(\d+|[a-z]))?", name)  # m_2, and components such as c_x
     if not m or m.group(1) not in symbols:
         return name
@@ -458,7 +460,6 @@ def atlas_figure(
     """
     from matplotlib.collections import LineCollection
     from matplotlib.colors import BoundaryNorm, ListedColormap
-    from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -521,13 +522,7 @@ def atlas_figure(
         size = (width, 5.2) if plan.y else (width, max(1.4 + 0.17 * lines, 0.22 * (len(present) + 4)) + 0.6)
     else:
         size = (width, 2.3 * nrows + 0.8 + 0.17 * lines)
-    caption = fixed_caption(ds, plan, int(15.5 * size[0]))
-    caption_height = 0.13 * (caption.count("\n") + 1) + 0.1 if caption else 0.0
-    size = (size[0], size[1] + caption_height)
-    fig = Figure(figsize=size, layout="constrained")
-    if caption:  # below everything else: the layout keeps the bottom strip free for it
-        fig.get_layout_engine().set(rect=(0, caption_height / size[1], 1, 1 - caption_height / size[1]))
-        fig.text(0.01, 0.02 / size[1], caption, fontsize=7, va="bottom", ha="left", color="#333333", gid="fixed-caption")
+    fig = captioned_figure(ds, size)
     if plan.facet is None:
         maps = side = fig
     else:  # panels with their titles on the left, the legend on the right: the two never overlap
@@ -652,7 +647,22 @@ def _title(
     return "\n".join(title)
 
 
-def fixed_caption(ds: xr.Dataset, plan: FigurePlan, chars: int) -> str:
+def captioned_figure(ds: xr.Dataset, size: tuple[float, float]):
+    """A constrained-layout Figure of ``size`` [in] for the plot, taller by the caption of the fixed parameters,
+    which sits below everything else: the layout keeps the bottom strip free for it."""
+    from matplotlib.figure import Figure
+
+    caption = fixed_caption(ds, int(15.5 * size[0]))
+    caption_height = 0.13 * (caption.count("\n") + 1) + 0.1 if caption else 0.0
+    size = (size[0], size[1] + caption_height)
+    fig = Figure(figsize=size, layout="constrained")
+    if caption:
+        fig.get_layout_engine().set(rect=(0, caption_height / size[1], 1, 1 - caption_height / size[1]))
+        fig.text(0.01, 0.02 / size[1], caption, fontsize=7, va="bottom", ha="left", color="#333333", gid="fixed-caption")
+    return fig
+
+
+def fixed_caption(ds: xr.Dataset, chars: int) -> str:
     """The atlas's fixed parameters (its scalar coordinates), grouped as ``stabmap info`` groups them (per body for
     gyroscopes) with each group's liquid modes, symbols and units as in the titles, in lines of at most ``chars``
     characters (mathtext markup not counted); ``""`` if there are none.
@@ -875,7 +885,6 @@ def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | N
 def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
     """Draw a critical-values Dataset into a new Figure: stable intervals of the scanned parameter (shaded, along x
     as on the atlas maps) and their located ends (dots), against the one other axis (y) left free by ``sel``."""
-    from matplotlib.figure import Figure
 
     along = ds.attrs["critical_along"]
     lower, upper = ds[f"{along}_stable_lower"], ds[f"{along}_stable_upper"]
@@ -893,7 +902,7 @@ def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
     if chosen:
         lower, upper, lower_b, upper_b = (v.sel(chosen, method="nearest") for v in (lower, upper, lower_b, upper_b))
     # The scanned parameter runs along x, as on the atlas maps (omega on x); the other axis, if any, along y.
-    fig = Figure(figsize=(7.5, 5.5), layout="constrained")
+    fig = captioned_figure(ds, (7.5, 5.5))
     ax = fig.subplots()
     lo, hi = np.atleast_2d(np.asarray(lower)), np.atleast_2d(np.asarray(upper))
     lo_b, hi_b = np.atleast_2d(np.asarray(lower_b)), np.atleast_2d(np.asarray(upper_b))

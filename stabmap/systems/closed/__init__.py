@@ -44,7 +44,7 @@ class Closed(System):
     undecided_label = UNDECIDED
     proves_labels = True  # every class is proved or flagged undecided (proofs.py, docs/closed.md)
     provenance = "decided_by"
-    symbols = {"ratio": "h_2/h_1", "n": "n", "j": "j", "h": "h"}
+    symbols = {"ratio": "h_2/h_1", "n": "n", "j": "j", "h": "h", "h1": "h_1", "c1sq": "c_1^2"}
     scene_module = _scene
 
     def attrs(self, scene: Scene) -> dict:
