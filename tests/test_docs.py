@@ -15,17 +15,36 @@ A block is changed by an HTML comment on the line just before its fence, which t
 - ``<!-- doc-test: no-install -->`` (bash): drop ``pip install ... &&`` prefixes (the tests run in the installed
   environment, which a test must not replace) and lines running the test suite itself;
 - ``<!-- doc-test: slow -->``: run only in the slow variant of the document's test;
-- ``<!-- doc-test: skip: REASON -->``: not run, for the reason given (e.g. it needs a running dask cluster).
+- ``<!-- doc-test: cluster -->`` (bash, python): needs a dask cluster at ``tcp://HOST:8786``; run, in the slow
+  variant only, against a real one on loopback (below);
+- ``<!-- doc-test: skip: REASON -->``: not run, for the reason given (e.g. it needs data the tests do not have).
+
+A document's first cluster block starts its cluster: a scheduler on 127.0.0.1 at a free port and its workers, each
+``dask ...`` command in its own process group (``dask`` on PATH is this interpreter's ``python -m dask``). The
+scheduler's readiness (a client connects) and its workers' arrival are waited for, and the cluster serves the
+document's later cluster blocks until the document ends, when every process group is stopped, pass or fail.
+In a cluster block, ``HOST:8786`` (also inside ``tcp://HOST:8786``) becomes the real address before it runs.
+The lines of a bash cluster block that start a cluster, ``dask scheduler ...`` and ``dask worker ...`` (they come
+first), are the commands that start it: each runs in the background as written, plus the options a test on
+loopback needs and the line does not set (scheduler: ``--host 127.0.0.1 --port N --no-dashboard``; worker:
+``--nthreads 1 --no-dashboard``); the rest of the block then runs as any bash block. A block that needs a cluster
+when none runs and starts none (a Python example, or commands given ``--scheduler tcp://HOST:8786``) gets one from
+the harness: ``dask scheduler`` and two ``dask worker tcp://HOST:8786``, started in the same way.
 """
 
 from __future__ import annotations
 
+import contextlib
 import doctest
 import dataclasses
+import json
 import os
 import re
+import signal
+import socket
 import subprocess
 import sys
+import time
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,7 +56,9 @@ DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 FENCE = re.compile(r"^(?:<!-- doc-test: (?P<mark>.*?) -->\n)?```(?P<lang>bash|toml|python)\n(?P<body>.*?)^```", re.M | re.S)
 # Pages another change edits at the same time; each is skipped, saying why, until its blocks are marked.
 PENDING: dict[str, str] = {}  # page name -> why it cannot run yet
-MARKS = re.compile(r"^(file \S+|fragment|no-install|slow|skip: .+)$")
+MARKS = re.compile(r"^(file \S+|fragment|no-install|slow|cluster|skip: .+)$")
+PLACEHOLDER = "HOST:8786"  # the docs' address of a running scheduler, as in tcp://HOST:8786
+STARTS_CLUSTER = re.compile(r"^\s*dask (scheduler|worker)\b")
 
 
 @dataclass(frozen=True)
@@ -59,7 +80,9 @@ def blocks(path: Path) -> list[Block]:
         mark = m.group("mark") or ""
         line = text.count("\n", 0, m.start("body"))
         assert not mark or MARKS.match(mark), f"{path.name}:{line}: unknown doc-test mark {mark!r}"
-        found.append(Block(path.relative_to(ROOT).as_posix(), line, m.group("lang"), m.group("body"), mark))
+        assert mark != "cluster" or m.group("lang") != "toml", f"{path.name}:{line}: a scene needs no cluster"
+        name = path.relative_to(ROOT).as_posix() if path.is_relative_to(ROOT) else path.name
+        found.append(Block(name, line, m.group("lang"), m.group("body"), mark))
     if path.name == "README.md" and found and not found[0].mark:
         # The README must open with its two commands, no comment before them: its first block is run as no-install.
         found[0] = dataclasses.replace(found[0], mark="no-install")
@@ -73,6 +96,9 @@ def _shim(directory: Path) -> dict:
     stabmap = bin_dir / "stabmap"
     stabmap.write_text(f'#!/bin/sh\nexec "{sys.executable}" -m stabmap "$@"\n')
     stabmap.chmod(0o755)
+    dask = bin_dir / "dask"
+    dask.write_text(f'#!/bin/sh\nexec "{sys.executable}" -m dask "$@"\n')
+    dask.chmod(0o755)
     python = bin_dir / "python"
     python.symlink_to(sys.executable)
     env = dict(os.environ)
@@ -82,8 +108,8 @@ def _shim(directory: Path) -> dict:
     return env
 
 
-def _bash(block: Block, cwd: Path, env: dict) -> None:
-    body = block.body
+def _bash(block: Block, cwd: Path, env: dict, body: str | None = None) -> None:
+    body = block.body if body is None else body
     if block.mark == "no-install":
         lines = [re.sub(r"^pip install \S+ && ", "", line) for line in body.splitlines()]
         body = "\n".join(line for line in lines if not re.match(r"\s*python -m pytest\b", line))
@@ -102,39 +128,188 @@ def _toml(block: Block, cwd: Path) -> None:
         (cwd / block.mark.split()[1]).write_text(block.body, encoding="utf-8")
 
 
-def _python(block: Block, namespace: dict) -> None:
-    if block.body.lstrip().startswith(">>>"):
+def _python(block: Block, namespace: dict, body: str | None = None) -> None:
+    body = block.body if body is None else body
+    if body.lstrip().startswith(">>>"):
         import pandas
 
         # Tables print whole, as in a wide terminal, rather than cut to the width pandas guesses here.
-        test = doctest.DocTestParser().get_doctest(block.body, namespace, block.where(), block.doc, block.line)
+        test = doctest.DocTestParser().get_doctest(body, namespace, block.where(), block.doc, block.line)
         runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
         with pandas.option_context("display.width", 250, "display.max_columns", None):
             runner.run(test, clear_globs=False)
         assert runner.failures == 0, f"{block.where()}: {runner.failures} doctest failures (see the captured output)"
     else:
-        exec(compile(block.body, block.where(), "exec"), namespace)
+        exec(compile(body, block.where(), "exec"), namespace)
 
 
-def run_doc(path: Path, tmp_path: Path, monkeypatch, slow: bool) -> None:
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Cluster:
+    """One document's dask cluster on loopback: the ``dask scheduler`` and ``dask worker`` lines that started it,
+    each a background process group, stopped together by ``stop``."""
+
+    def __init__(self, cwd: Path, env: dict):
+        self.cwd, self.env = cwd, env
+        self.port = _free_port()
+        self.address = f"tcp://127.0.0.1:{self.port}"
+        self.procs: list[tuple[str, subprocess.Popen, Path]] = []  # (command as run, process, its log)
+
+    def substitute(self, text: str) -> str:
+        return text.replace(PLACEHOLDER, f"127.0.0.1:{self.port}")
+
+    def command(self, line: str) -> tuple[str, str]:
+        """The start line as it runs here, and which it starts ("scheduler" or "worker")."""
+        kind = STARTS_CLUSTER.match(line).group(1)
+        code = re.sub(r"\s+#.*$", "", self.substitute(line)).strip()
+        assert kind == "worker" or not re.search(r"\s--(host|port)\b", code), f"the harness sets the scheduler's address: {line!r}"
+        # What a cluster on loopback in a test needs, added where the line does not set it: the docs' own lines
+        # would listen on every interface at the fixed port 8786, with dashboards, and a worker would take every core.
+        if kind == "scheduler":
+            options = {"--host": "127.0.0.1", "--port": str(self.port), "--no-dashboard": ""}
+        else:
+            options = {"--nthreads": "1", "--no-dashboard": ""}
+        extra = [f"{flag} {value}".strip() for flag, value in options.items() if not re.search(rf"\s{flag}\b", code)]
+        return " ".join([code, *extra]), kind
+
+    @property
+    def workers(self) -> int:
+        return sum(1 for command, _, _ in self.procs if STARTS_CLUSTER.match(command).group(1) == "worker")
+
+    def start(self, line: str) -> None:
+        command, kind = self.command(line)
+        assert (kind == "scheduler") == (not self.procs), f"a cluster starts with one scheduler, then workers: {line!r}"
+        log = self.cwd / f".cluster-{len(self.procs)}-{kind}.log"
+        with log.open("w") as out:
+            # Its own session and process group, so that stop() reaches the processes it starts in turn (a
+            # worker's nanny starts the worker process) and nothing outlives the document.
+            proc = subprocess.Popen(["bash", "-c", command], cwd=self.cwd, env=self.env, stdout=out,
+                                    stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True)
+        self.procs.append((command, proc, log))
+        if kind == "scheduler":
+            self._wait(lambda client: True, "the scheduler to accept clients")
+
+    def wait_for_workers(self) -> None:
+        n = self.workers
+        self._wait(lambda client: len(client.nthreads()) >= n, f"{n} worker(s) to join")
+
+    def _wait(self, ready, what: str, timeout: float = 120) -> None:
+        from distributed import Client
+
+        deadline = time.monotonic() + timeout
+        while True:
+            self._check_alive(what)
+            try:
+                with Client(self.address, timeout=3, set_as_default=False) as client:
+                    while not ready(client):
+                        self._check_alive(what)
+                        assert time.monotonic() < deadline, f"timed out waiting for {what}\n{self.logs()}"
+                        time.sleep(0.2)
+                    return
+            except OSError:  # not listening yet (distributed's connection timeouts are OSErrors)
+                assert time.monotonic() < deadline, f"timed out waiting for {what}\n{self.logs()}"
+                time.sleep(0.2)
+
+    def _check_alive(self, what: str) -> None:
+        dead = [(c, p.returncode) for c, p, _ in self.procs if p.poll() is not None]
+        assert not dead, f"while waiting for {what}, {dead} exited\n{self.logs()}"
+
+    def logs(self) -> str:
+        return "\n".join(f"--- {command}\n{log.read_text()[-3000:]}" for command, _, log in self.procs)
+
+    def stop(self) -> None:
+        """SIGTERM to every process group (workers first), SIGKILL to what is left after 15 s."""
+        for _, proc, _ in reversed(self.procs):
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(proc.pid, signal.SIGTERM)
+        deadline = time.monotonic() + 15
+        for _, proc, _ in reversed(self.procs):
+            try:
+                proc.wait(max(0.1, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+        for _, proc, _ in self.procs:
+            # A group outlives its leader while a member lives (a worker process its nanny left behind), and Linux
+            # gives no new process the pid of a group still in use, so this reaches only what is left of ours.
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(proc.pid, signal.SIGKILL)
+
+
+def split_cluster_lines(body: str) -> tuple[list[str], str]:
+    """A bash block's lines that start a cluster, and the rest of the block."""
+    lines = body.splitlines()
+    starts = [i for i, line in enumerate(lines) if STARTS_CLUSTER.match(line)]
+    commands = [i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")]
+    assert starts == commands[: len(starts)], f"the lines that start a cluster come first in their block:\n{body}"
+    return [lines[i] for i in starts], "\n".join(line for i, line in enumerate(lines) if i not in starts) + "\n"
+
+
+def _cluster_for(block: Block, cluster: Cluster | None, cwd: Path, env: dict) -> tuple[Cluster, str]:
+    """The document's running cluster, started by the block's own start lines or else by the harness, and the
+    block's code that runs on it (the start lines taken out, the address put in)."""
+    starts, body = split_cluster_lines(block.body) if block.lang == "bash" else ([], block.body)
+    schedulers = [line for line in starts if STARTS_CLUSTER.match(line).group(1) == "scheduler"]
+    assert len(schedulers) <= 1 and not (schedulers and cluster), f"{block.where()}: one scheduler per document"
+    new = cluster is None
+    if new:
+        cluster = Cluster(cwd, env)
+    try:
+        if new:
+            cluster.start(schedulers[0] if schedulers else "dask scheduler")
+        for line in starts:
+            if line not in schedulers:
+                cluster.start(line)
+        if not cluster.workers:
+            for _ in range(2):
+                cluster.start(f"dask worker tcp://{PLACEHOLDER}")
+        cluster.wait_for_workers()
+    except BaseException:
+        if new:  # the caller never got it, so cannot stop it
+            cluster.stop()
+        raise
+    return cluster, cluster.substitute(body)
+
+
+def run_doc(path: Path, tmp_path: Path, monkeypatch, slow: bool) -> Cluster | None:
+    """Run the document's blocks; return the cluster they ran on (stopped by then), if any."""
     env = _shim(tmp_path)
     (tmp_path / "scripts").symlink_to(ROOT / "scripts")
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("MPLBACKEND", "Agg")
     namespace: dict = {"__name__": "__doc_test__"}
-    for block in blocks(path):
-        if block.mark.startswith("skip: ") or (block.mark == "slow" and not slow):
-            continue
-        if block.lang == "bash":
-            _bash(block, tmp_path, env)
-        elif block.lang == "toml":
-            _toml(block, tmp_path)
-        else:
-            _python(block, namespace)
+    cluster: Cluster | None = None
+    try:
+        for block in blocks(path):
+            if block.mark.startswith("skip: ") or (block.mark in ("slow", "cluster") and not slow):
+                continue
+            body = None
+            if block.mark == "cluster":
+                cluster, body = _cluster_for(block, cluster, tmp_path, env)
+            try:
+                if block.lang == "bash":
+                    _bash(block, tmp_path, env, body)
+                elif block.lang == "toml":
+                    _toml(block, tmp_path)
+                else:
+                    _python(block, namespace, body)
+            except AssertionError as exc:
+                if cluster is None:
+                    raise
+                raise AssertionError(f"{exc}\n--- the cluster's logs\n{cluster.logs()}") from None
+    finally:
+        if cluster is not None:
+            cluster.stop()
+    return cluster
 
 
 def _slow_docs() -> list[Path]:
-    return [p for p in DOCS if any(b.mark == "slow" for b in blocks(p))]
+    return [p for p in DOCS if any(b.mark in ("slow", "cluster") for b in blocks(p))]
 
 
 @pytest.mark.parametrize("path", DOCS, ids=lambda p: p.name)
@@ -161,3 +336,110 @@ def test_every_skip_says_why_and_the_readme_keeps_its_first_two_commands():
         "pip install '.[test]' && python -m pytest -q\n"
     )
     assert first.mark == "no-install"
+
+
+CLUSTER_BASH = """<!-- doc-test: cluster -->
+```bash
+dask scheduler                      # prints tcp://HOST:8786
+dask worker tcp://HOST:8786         # the worker line as a reader would type it
+echo "tcp://HOST:8786" > address.txt
+```
+"""
+CLUSTER_PYTHON = """<!-- doc-test: cluster -->
+```python
+import json, os
+from distributed import Client
+
+with Client("tcp://HOST:8786") as client:
+    pids = {"scheduler": client.run_on_scheduler(os.getpid), "workers": sorted(client.run(os.getpid).values()),
+            "nannies": sorted(client.run(os.getppid).values())}
+with open("pids.json", "w") as f:
+    json.dump(pids, f)
+```
+"""
+
+
+def _doc(tmp_path: Path, text: str) -> Path:
+    (tmp_path / "run").mkdir()
+    doc = tmp_path / "doc.md"
+    doc.write_text(text)
+    return doc
+
+
+def _gone(pid: int, wait: float = 5) -> bool:
+    import psutil
+
+    deadline = time.monotonic() + wait
+    while True:
+        try:
+            if psutil.Process(pid).status() == psutil.STATUS_ZOMBIE:  # dead, its parent not told yet
+                return True
+        except psutil.NoSuchProcess:
+            return True
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.1)
+
+
+def test_a_cluster_block_is_recognised_and_the_address_substituted(tmp_path):
+    first, second = blocks(_doc(tmp_path, CLUSTER_BASH + CLUSTER_PYTHON))
+    assert (first.lang, first.mark, second.lang, second.mark) == ("bash", "cluster", "python", "cluster")
+    starts, rest = split_cluster_lines(first.body)
+    assert [s.split("#")[0].strip() for s in starts] == ["dask scheduler", "dask worker tcp://HOST:8786"]
+    assert rest.strip() == 'echo "tcp://HOST:8786" > address.txt'
+    cluster = Cluster(tmp_path, {})  # not started: its commands only
+    port = cluster.port
+    assert cluster.substitute(rest + second.body).count(f"tcp://127.0.0.1:{port}") == 2
+    assert cluster.substitute("HOST:8786 tcp://HOST:8786") == f"127.0.0.1:{port} tcp://127.0.0.1:{port}"
+    assert cluster.command(starts[0]) == (f"dask scheduler --host 127.0.0.1 --port {port} --no-dashboard", "scheduler")
+    assert cluster.command(starts[1]) == (f"dask worker tcp://127.0.0.1:{port} --nthreads 1 --no-dashboard", "worker")
+    assert cluster.command("dask worker tcp://HOST:8786 --nthreads 4")[0] == (
+        f"dask worker tcp://127.0.0.1:{port} --nthreads 4 --no-dashboard")
+    with pytest.raises(AssertionError, match="come first"):
+        split_cluster_lines("stabmap examples\ndask scheduler\n")
+    with pytest.raises(AssertionError, match="sets the scheduler's address"):
+        cluster.command("dask scheduler --port 8786")
+
+
+def test_every_block_that_names_the_placeholder_address_runs_on_a_cluster():
+    for path in DOCS:
+        for b in blocks(path):
+            if PLACEHOLDER in b.body or any(STARTS_CLUSTER.match(line) for line in b.body.splitlines()):
+                assert b.mark == "cluster" or b.mark.startswith("skip: "), f"{b.where()}: mark it <!-- doc-test: cluster -->"
+
+
+def test_a_cluster_document_runs_on_its_own_cluster_and_leaves_no_process(tmp_path, monkeypatch):
+    doc = _doc(tmp_path, CLUSTER_BASH + CLUSTER_PYTHON)
+    (tmp_path / "fast").mkdir()
+    assert run_doc(doc, tmp_path / "fast", monkeypatch, slow=False) is None  # the fast variant starts nothing
+    assert not (tmp_path / "fast" / "address.txt").exists()
+    run = tmp_path / "run"
+    cluster = run_doc(doc, run, monkeypatch, slow=True)
+    assert (run / "address.txt").read_text().strip() == cluster.address != "tcp://HOST:8786"
+    pids = json.loads((run / "pids.json").read_text())
+    # The block's own worker line, run once as written: one worker, under its nanny (the line's process).
+    assert len(pids["workers"]) == 1 and pids["nannies"] == [cluster.procs[1][1].pid]
+    left = [pid for pid in [pids["scheduler"], *pids["workers"], *pids["nannies"]] if not _gone(pid)]
+    assert not left, f"processes left running after the document: {left}"
+
+
+def test_a_failing_cluster_block_still_stops_the_cluster_the_harness_gave_it(tmp_path, monkeypatch):
+    fails = CLUSTER_PYTHON[: CLUSTER_PYTHON.rindex("```")] + "raise RuntimeError('the block fails')\n```\n"
+    doc = _doc(tmp_path, fails)
+    with pytest.raises(RuntimeError, match="the block fails"):
+        run_doc(doc, tmp_path / "run", monkeypatch, slow=True)
+    pids = json.loads((tmp_path / "run" / "pids.json").read_text())
+    assert len(pids["workers"]) == 2  # no block started one: the harness's two
+    left = [pid for pid in [pids["scheduler"], *pids["workers"], *pids["nannies"]] if not _gone(pid)]
+    assert not left, f"processes left running after the failed document: {left}"
+
+
+def test_a_failing_bash_block_shows_the_cluster_logs_and_stops_the_lines_it_started(tmp_path, monkeypatch):
+    import psutil
+
+    doc = _doc(tmp_path, CLUSTER_BASH.replace("address.txt\n", "address.txt\nexit 3\n"))
+    with pytest.raises(AssertionError, match=r"(?s)failed \(exit 3\).*the cluster's logs.*--- dask scheduler --host"):
+        run_doc(doc, tmp_path / "run", monkeypatch, slow=True)
+    port = (tmp_path / "run" / "address.txt").read_text().strip().rsplit(":", 1)[1]
+    left = [p.pid for p in psutil.process_iter(["cmdline"]) if port in " ".join(p.info["cmdline"] or []) and not _gone(p.pid, 0)]
+    assert not left, f"the block's scheduler or worker is still running: {left}"
