@@ -5,11 +5,11 @@
     python scripts/paper_cases.py --golden tests/data        # rewrite the golden atlases the tests pin
     python scripts/paper_cases.py --case paper-n1-fixed-dry --out figs
 
-What each case computes and checks: the docstring of ``stabmap.systems.gyroscopes.paper_cases``.
+What each case computes and checks: the docstring of ``stabmap.paper.gyroscopes``.
 
 ``--check`` exits 1 if anything disagrees, and prints which case, row and value.
 
-The checks themselves live in ``stabmap.systems.gyroscopes.paper_cases`` and run as ``stabmap paper gyroscopes``
+The checks themselves live in ``stabmap.paper.gyroscopes`` and run as ``stabmap paper gyroscopes``
 from an installed stabmap; this script keeps the old options and ``--golden``.
 """
 
@@ -19,8 +19,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from stabmap.systems.gyroscopes.paper_cases import *  # noqa: F401,F403  (tests/test_paper_cases.py reads these names)
-from stabmap.systems.gyroscopes.paper_cases import CASES, RTOL, check_case, run, write_golden  # noqa: F401
+from stabmap.paper.gyroscopes import *  # noqa: F401,F403  (tests/test_paper_cases.py reads these names)
+from stabmap.paper.gyroscopes import CASES, RTOL, check_case, run, write_golden  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> dict:

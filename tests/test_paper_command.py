@@ -7,7 +7,7 @@ import pytest
 from stabmap import paper as papers
 from stabmap.cli import main
 from stabmap.systems.gyroscopes import paper
-from stabmap.systems.gyroscopes import paper_cases
+from stabmap.paper import gyroscopes as paper_cases
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -70,7 +70,7 @@ def test_a_wrong_closed_form_exits_1(monkeypatch, capsys):
 
 
 def test_a_wrong_reaction_exits_1(monkeypatch, capsys):
-    from stabmap.systems.reactions import paper_cases as plate
+    from stabmap.paper import reactions as plate
 
     monkeypatch.setattr(plate, "RTOL", -1.0)  # nothing can agree to a negative tolerance: the check must say so
     assert main(["paper", "reactions"]) == 1

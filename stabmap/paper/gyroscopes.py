@@ -17,7 +17,7 @@ Each case is a bundled scene (``stabmap atlas --example NAME``) with two grid ax
    ((22), (29)-(32), (28); ``stabmap.systems.gyroscopes.paper.paper_polynomial``) in exact rational arithmetic: the N_c
    of every atlas point on the checked rows, and of both ends of every located boundary.
 
-Moved here from ``scripts/paper_cases.py`` (which a pip install does not ship); that script is now a thin wrapper.
+``scripts/paper_cases.py`` is a thin wrapper of this module for a source checkout (``--golden``).
 """
 
 from __future__ import annotations

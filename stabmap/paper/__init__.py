@@ -1,6 +1,6 @@
 """``stabmap paper``: the source papers' results recomputed by the installed engine and checked.
 
-One entry per system, each a module of that system (``paper_cases.py``) with a ``run`` that computes, compares
+One module per system (``stabmap/paper/<system>.py``), each with a ``run`` that computes, compares
 with the paper's printed determinants or closed forms, and draws its figures:
 
 - ``gyroscopes``: the cases n = 1, 2, 3 (seed 003; docs/paper-cases.md), against the printed determinants
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .errors import StabmapError
+from ..errors import StabmapError
 
 SYSTEMS = ("gyroscopes", "closed", "reactions")
 
@@ -38,7 +38,7 @@ def check(systems=None, *, out: str | Path | None = None, quick: bool = False, c
     for name in systems:
         where = None if out is None else out / name
         if name == "gyroscopes":
-            from .systems.gyroscopes import paper_cases
+            from . import gyroscopes as paper_cases
 
             known = [c.name for c in paper_cases.CASES]
             bad = [c for c in cases or () if c not in known]
@@ -46,11 +46,11 @@ def check(systems=None, *, out: str | Path | None = None, quick: bool = False, c
                 raise StabmapError(f"unknown paper case {bad[0]!r}; choose one of: {', '.join(known)}")
             done = paper_cases.run(cases, quick=quick, rows=rows, out=where)
         elif name == "closed":
-            from .systems.closed import paper_cases
+            from . import closed as paper_cases
 
             done = paper_cases.run(out=where)
         else:
-            from .systems.reactions import paper_cases
+            from . import reactions as paper_cases
 
             done = paper_cases.run(out=where)
         texts.append(f"## {name}\n{done['text']}" + ("" if where is None else f"\nfigures in {where}/"))

@@ -21,9 +21,9 @@ RTOL = 1e-12  # relative to G; the solver's proved error bound is far below this
 
 def run(*, out: Path | None = None) -> dict:
     """Compute the plate's atlas and compare it with the closed forms; its figure into ``out`` (None: none)."""
-    from ...examples import example
-    from ...run import atlas
-    from .solver import closed_form
+    from ..examples import example
+    from ..run import atlas
+    from ..systems.reactions.solver import closed_form
 
     t0 = time.perf_counter()
     scene = example(NAME)
@@ -53,7 +53,7 @@ def run(*, out: Path | None = None) -> dict:
     if worst_cf > RTOL:
         problems.append(f"{NAME}: the paper's closed form (6)-(9) differs by {worst_cf:.1e} G")
     if out is not None:
-        from ...read.plot import plot_atlas
+        from ..read.plot import plot_atlas
 
         out.mkdir(parents=True, exist_ok=True)
         plot_atlas(ds, out / f"{NAME}.png")

@@ -27,7 +27,7 @@ CASES = (
 
 
 def _meanings(ds) -> dict[int, str]:
-    from .. import of_atlas
+    from ..systems import of_atlas
 
     flags = of_atlas(ds.attrs).variable("stability").flags
     return {int(v): name for v, name in flags}
@@ -35,8 +35,8 @@ def _meanings(ds) -> dict[int, str]:
 
 def check_case(name: str, expected, out: Path | None = None) -> dict:
     """Locate the boundaries of one bundled family along ``ratio`` and compare them with the closed form."""
-    from ...examples import example
-    from ...run.critical import critical
+    from ..examples import example
+    from ..run.critical import critical
 
     scene = example(name)
     ds = critical(scene, "ratio", progress=False)
@@ -55,7 +55,7 @@ def check_case(name: str, expected, out: Path | None = None) -> dict:
         if err > RTOL or (below, above) != (xb, xa):
             problems.append(f"{name}: boundary {t:.12g} ({below} -> {above}), closed form {x:.12g} ({xb} -> {xa}), rel. diff {err:.1e}")
     if out is not None:
-        from ...read.plot import plot_critical
+        from ..read.plot import plot_critical
 
         plot_critical(ds, out / f"{name}.png")
     return {"case": name, "boundaries": len(found), "expected": len(expected), "worst_rel": worst, "problems": problems}
