@@ -382,7 +382,7 @@ def _units(units: str) -> str:
 def _symbol(ds: xr.Dataset, name: str) -> str:
     """'omega' -> '$\\omega$', 'm_2' -> '$m_{2}$' (the system's ``symbols``); other names are returned as they are."""
     symbols = systems.of_atlas(ds.attrs).symbols
-    if name in symbols and not re.fullmatch(r"[A-Za-z]+", name):  # a whole name with its own symbol: c1sq -> c_1^2
+    if name in symbols:  # a whole name with its own symbol: omega, c1sq -> c_1^2
         return f"${symbols[name]}$"
     m = re.fullmatch(r"([A-Za-z]+)(?:_(\d+|[a-z]))?", name)  # m_2, and components such as c_x
     if not m or m.group(1) not in symbols:
@@ -770,7 +770,12 @@ def boundary_widths(segs: np.ndarray, xe: np.ndarray, ye: np.ndarray, span: tupl
         return np.minimum.reduceat(flat, starts)[::2]
 
     def index(edges: np.ndarray, v: np.ndarray) -> np.ndarray:
-        return np.abs(edges[None, :] - v[:, None]).argmin(axis=1)
+        """The edge nearest each of ``v`` (a segment's ends lie on edges), by bisection: no segments x edges table."""
+        order = np.argsort(edges)
+        e = edges[order]
+        i = np.clip(np.searchsorted(e, v), 1, len(e) - 1)
+        i -= (v - e[i - 1]) < (e[i] - v)
+        return order[i]
 
     codes = np.asarray(codes)
     along_x = bands(codes, cells(xe, log[0], span[1]))
