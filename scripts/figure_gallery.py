@@ -185,7 +185,7 @@ KINDS = [
     Kind("thin-bands", "a band one cell wide keeps its class colour between two thinner lines instead of becoming "
          "a black bar", RESONANCE, ATLAS, zoom=(90, 630, 370, 705)),
     Kind("critical", "critical values put the scanned parameter (ω) on x as the atlas maps do, "
-         "with its symbol in the title, a labelled log axis and the caption of fixed parameters", LOG_MASS,
+         "each stretch in its class's colour as on the maps, a labelled log axis and the caption of fixed parameters", LOG_MASS,
          [["critical", "{scene}", "--along", "omega", "-o", "{nc}", "--png", "{png}", "-q"]]),
     Kind("closed", "closed chains: only the caption of fixed parameters (h₁, c₁²) is new", HINGE, ATLAS),
     Kind("reactions", "reactions maps: only the caption of fixed parameters is new", PLATE, ATLAS),

@@ -76,6 +76,22 @@ def test_every_boundary_is_a_real_change_of_the_exact_count():
     assert found >= 2
 
 
+def test_the_label_at_scan_start_and_the_boundaries_give_the_label_of_every_scan_value():
+    # The file states the label everywhere in the scan: the start's, then each boundary's label above it.
+    system = _liquid_pair()
+    system["grid"] = {"omega": {"start": 1.0, "stop": 150.0, "num": 60}, "m_2": {"values": [0.3, 2.0]}}
+    scene = from_dict(system)
+    ds = critical(scene, "omega", rtol=1e-10)
+    atlas = stabmap.compute_atlas(scene, progress=False)["n_complex_pairs"].transpose("m_2", "omega")
+    for j in range(ds.sizes["m_2"]):
+        lo = ds["boundary_lower"][j].values
+        ok = np.isfinite(lo)
+        labels = [int(ds["n_complex_pairs_at_scan_start"][j]), *ds["n_complex_pairs_above"][j].values[ok]]
+        for i, omega in enumerate(atlas["omega"].values):
+            stretch = int(np.searchsorted(lo[ok], omega, side="left"))  # boundaries whose bracket lies below omega
+            assert labels[stretch] == int(atlas[j, i]), (j, omega)
+
+
 def _ref_count(system: dict, omega: float) -> int:
     point = {k: v for k, v in system.items() if k != "grid"}
     point["omega"] = omega
@@ -122,8 +138,11 @@ def test_cli_roundtrip_plot_and_errors(tmp_path, capsys):
     assert main(["info", str(out)]) == 0
     # Bad input: exit 2, a message naming the option, and no file.
     bad = tmp_path / "bad.nc"
-    assert main(["critical", str(scene), "--along", "K_1", "-o", str(bad)]) == 2
-    assert "--along K_1: not a grid axis" in capsys.readouterr().err
+    assert main(["critical", str(scene), "--along", "K_0", "-o", str(bad)]) == 2
+    assert "--along K_0: not a grid axis" in capsys.readouterr().err  # a parameter, not scanned: add it to [grid]
+    assert main(["critical", str(scene), "--along", "K1", "-o", str(bad)]) == 2
+    err = capsys.readouterr().err  # not a parameter at all: no advice to add it to [grid]
+    assert "--along K1: unknown parameter name 'K1'" in err and "under [grid]" not in err
     assert main(["critical", str(scene), "--rtol", "0", "-o", str(bad)]) == 2
     assert "rtol must be between" in capsys.readouterr().err
     assert not bad.exists()

@@ -297,6 +297,9 @@ def test_cli_png_and_pdf_are_valid_and_vector(atlas3_file, tmp_path, capsys):
     assert b"/Subtype /Image" not in data  # colours, lines and text are vector
     assert main(["plot", str(atlas3_file), "-o", str(tmp_path / "f.png"), "--facet", "omega", "--max-panels", "4"]) == 0
     assert sorted(os.listdir(tmp_path)) == ["f.png", "map.pdf", "map.png"]  # no temporary files left
+    capsys.readouterr()
+    assert main(["plot", str(atlas3_file), "-o", str(tmp_path / "far.png"), "--sel", "K_1=1e9"]) == 0  # beyond the grid
+    assert "note: K_1 = 1e+09 lies outside the grid" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(
@@ -304,6 +307,7 @@ def test_cli_png_and_pdf_are_valid_and_vector(atlas3_file, tmp_path, capsys):
     [
         (["--facet", "nope"], "--facet nope: not an axis of this atlas; choose from omega, m_2, K_1"),
         (["--sel", "nope=1"], "--sel nope: not an axis of this atlas"),
+        (["--sel", "g=9"], "--sel g: fixed at 9.81 m s-2 in this atlas, not a grid axis"),
         (["--sel", "K_1"], "--sel 'K_1': write NAME=VALUE"),
         (["--x", "nope"], "--x nope: not an axis of this atlas"),
         (["--x", "omega", "--y", "omega"], "--x and --y both name omega"),

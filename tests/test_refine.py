@@ -153,6 +153,15 @@ def test_bad_arguments(kwargs, message):
         stabmap.compute_refined(stabmap.example("paper-n1-fixed"), **kwargs)
 
 
+def test_refining_a_grid_too_coarse_to_refine_says_so(tmp_path, capsys):
+    scene = tmp_path / "small.toml"
+    scene.write_text('support = "fixed"\n[[bodies]]\nm = 1.0\nA = 0.02\nC = 0.03\nc = 0.1\n'
+                     '[grid]\nomega = { start = 1.0, stop = 100.0, num = 40 }\n')
+    assert main(["atlas", str(scene), "-o", str(tmp_path / "a.nc"), "--refine", "-q"]) == 0
+    err = capsys.readouterr().err
+    assert "nothing to infer, every point computed" in err and "--coarse-stride" in err and "x fewer" not in err
+
+
 def test_cli_refine_file_info_query(tmp_path, capsys):
     out = tmp_path / "a.nc"
     assert main(["atlas", "--example", "paper-n2-fixed", "-o", str(out), "--refine", "--coarse-stride", "8", "-q"]) == 0

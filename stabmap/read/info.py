@@ -55,7 +55,8 @@ def describe(ds: xr.Dataset, name: str = "") -> str:
     """
     if ds.attrs.get("stabmap_kind") == "critical values":
         head = f"{name}: {ds.attrs.get('title', '')}: critical values along {ds.attrs['critical_along']}"
-        return "\n".join([head, f"  {ds.attrs['comment']}", *intervals(ds)])
+        comment = textwrap.wrap(ds.attrs["comment"], width=WIDTH, initial_indent="  ", subsequent_indent="  ")
+        return "\n".join([head, *comment, *intervals(ds)])
     system = systems.of_atlas(ds.attrs)
     s = summary(ds)
     a = ds.attrs
@@ -140,12 +141,13 @@ def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
     for p, label in enumerate(table["point"].values[:limit]):
         where = ", ".join(f"{d} = {v:g}" for d, v in zip(dims, label)) if dims else "the scene"
         parts = [
-            f"{lo[p, k]:.10g} ({'scan end' if np.isnan(olo[p, k]) else 'boundary'}) to "
+            f"{lo[p, k]:.10g} ({'scan start' if np.isnan(olo[p, k]) else 'boundary'}) to "
             f"{hi[p, k]:.10g} ({'scan end' if np.isnan(ohi[p, k]) else 'boundary'})"
             for k in range(lo.shape[1])
             if np.isfinite(lo[p, k])
         ]
-        lines.append(f"{where}: stable {along} [{units}] " + ("; ".join(parts) if parts else "nowhere in the scan"))
+        shown = f" [{units}]" if units not in ("", "1") else ""
+        lines.append(f"{where}: stable {along}{shown} " + ("; ".join(parts) if parts else "nowhere in the scan"))
     if lo.shape[0] > limit:
         lines.append(f"... and {lo.shape[0] - limit} more points in the file")
     return lines

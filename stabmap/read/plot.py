@@ -155,6 +155,9 @@ def plan_figure(
         raise StabmapError("this atlas has no axis to plot (a single point); use 'stabmap info' or 'stabmap query'")
     sel = dict(sel or {})
     for k, v in sel.items():
+        if k in ds.coords and ds[k].ndim == 0 and k not in dims:
+            units = _plain_units(ds[k])
+            raise StabmapError(f"--sel {k}: fixed at {float(ds[k]):g}{units} in this atlas, not a grid axis; its axes are: {', '.join(dims)}")
         if k not in dims:
             raise StabmapError(f"--sel {k}: not an axis of this atlas; its axes are: {', '.join(dims)}")
         if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
@@ -189,7 +192,11 @@ def plan_figure(
 
     fixed, notes = {}, []
     for k, v in sel.items():
-        fixed[k] = (int(np.argmin(np.abs(np.asarray(ds[k], dtype=float) - v))), float(v))
+        values = np.asarray(ds[k], dtype=float)
+        fixed[k] = (int(np.argmin(np.abs(values - v))), float(v))
+        if not values.min() <= v <= values.max():
+            notes.append(f"{k} = {v:g} lies outside the grid ({values.min():g} .. {values.max():g}{_plain_units(ds[k])}): "
+                         f"drawn at its nearest end, {k} = {values[fixed[k][0]]:g}")
     for d in rest:  # a figure shows at most four axes
         fixed[d] = (0, None)
         notes.append(f"{d} fixed at its first value (choose with --sel {d}=VALUE)")
@@ -377,6 +384,12 @@ def _units(units: str) -> str:
         m = re.fullmatch(r"([A-Za-z]+)(-?\d+)", w)
         words.append(f"{m.group(1)}$^{{{m.group(2)}}}$" if m else w)
     return "\u00a0".join(words)
+
+
+def _plain_units(coord: xr.DataArray) -> str:
+    """' kg' for messages on the terminal; '' for none or '1'."""
+    units = str(coord.attrs.get("units", ""))
+    return "" if units in ("", "1") else f" {units}"
 
 
 def _symbol(ds: xr.Dataset, name: str) -> str:
@@ -887,12 +900,29 @@ def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | N
     return save_figure(critical_figure(ds, sel=sel), path)
 
 
-def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
-    """Draw a critical-values Dataset into a new Figure: stable intervals of the scanned parameter (shaded, along x
-    as on the atlas maps) and their located ends (dots), against the one other axis (y) left free by ``sel``."""
+def _scanned(ds: xr.Dataset, system, along: str, lower: xr.DataArray) -> dict:
+    """long_name and units of the scanned parameter, as an atlas's axis has them (from the stored scene)."""
+    try:
+        info = system.parameter(systems.loads_scene(str(ds.attrs["scene"]), "the file's scene"), along)
+        return {"long_name": info.long_name, "units": info.units}
+    except (KeyError, StabmapError):  # no scene, or one this version does not read: the symbol and units only
+        return {"units": lower.attrs.get("units", "")}
 
-    along = ds.attrs["critical_along"]
-    lower, upper = ds[f"{along}_stable_lower"], ds[f"{along}_stable_upper"]
+
+def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
+    """Draw a critical-values Dataset into a new Figure: the scanned parameter along x (as on the atlas maps),
+    each stretch between located boundaries in the colour of its class (as on the maps), the boundaries as dots,
+    against the one other axis (y) left free by ``sel``.
+
+    A file without ``<label>_at_scan_start`` (written before it existed) shows its stable intervals only.
+    """
+    from matplotlib.collections import PolyCollection
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    system = systems.of_atlas(ds.attrs)
+    along, lab = ds.attrs["critical_along"], system.label
+    lower = ds[f"{along}_stable_lower"]
     dims = [d for d in lower.dims if d != "interval"]
     for k in sel or {}:
         if k not in dims:
@@ -901,44 +931,66 @@ def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
     free = [d for d in dims if d not in chosen]
     if len(free) > 1:
         raise StabmapError(f"this file has {len(free)} other axes ({', '.join(free)}); fix all but one with --sel NAME=VALUE")
-    # Curves only where an end is a located boundary, not where the interval meets the end of the scan.
-    lower_b = lower.where(ds[f"{along}_stable_lower_outer"].notnull())
-    upper_b = upper.where(ds[f"{along}_stable_upper_outer"].notnull())
+    names = ["boundary_lower", "boundary_upper", f"{lab}_below", f"{lab}_above", f"{along}_stable_lower", f"{along}_stable_upper"]
+    start = f"{lab}_at_scan_start" if f"{lab}_at_scan_start" in ds else None
+    picked = ds[names + ([start] if start else [])]
     if chosen:
-        lower, upper, lower_b, upper_b = (v.sel(chosen, method="nearest") for v in (lower, upper, lower_b, upper_b))
-    # The scanned parameter runs along x, as on the atlas maps (omega on x); the other axis, if any, along y.
-    fig = captioned_figure(ds, (7.5, 5.5))
-    ax = fig.subplots()
-    lo, hi = np.atleast_2d(np.asarray(lower)), np.atleast_2d(np.asarray(upper))
-    lo_b, hi_b = np.atleast_2d(np.asarray(lower_b)), np.atleast_2d(np.asarray(upper_b))
-    scan = ds.attrs["critical_scan_range"]
-    if free:
-        from matplotlib.collections import PolyCollection
+        picked = picked.sel(chosen, method="nearest")
+    rows = picked.transpose(*free, ...) if free else picked.expand_dims(row=[0])
+    b_lo, b_hi = (np.asarray(rows[n]) for n in names[:2])
+    below, above = (np.asarray(rows[n]) for n in names[2:4])
+    s_lo, s_hi = (np.asarray(rows[n]) for n in names[4:])
+    scan = [float(v) for v in ds.attrs["critical_scan_range"]]
+    stable, absent, undecided = system.stable_label, system.absent_label, system.undecided_label
 
+    # (row, x0, x1, class) of every stretch the file proves; the few-ulp brackets between them are left blank
+    stretches = []
+    for r in range(b_lo.shape[0]):
+        if start is None:  # an old file: its stable intervals only
+            stretches += [(r, lo, hi, stable) for lo, hi in zip(s_lo[r], s_hi[r]) if np.isfinite(lo)]
+            continue
+        ok = np.isfinite(b_lo[r])
+        cuts = [scan[0], *[v for pair in zip(b_lo[r][ok], b_hi[r][ok]) for v in pair], scan[1]]
+        classes = [int(np.asarray(rows[start])[r]), *above[r][ok].astype(int)]
+        stretches += [(r, cuts[2 * i], cuts[2 * i + 1], c) for i, c in enumerate(classes)]
+
+    one_d = not free
+    fig = captioned_figure(ds, (7.5, 2.4 if one_d else 5.5))
+    ax = fig.subplots()
+    if free:
         y = np.asarray(ds[free[0]])
         edges = _edges(y, ds[free[0]].attrs.get("scale"))
-        # One box per point and interval, and the ends as dots: joining neighbouring points would draw boundaries
-        # (and shade regions) that were never computed wherever the number of intervals changes between points.
-        i, k = np.nonzero(np.isfinite(lo))
-        boxes = [[(lo[a, b], edges[a]), (lo[a, b], edges[a + 1]), (hi[a, b], edges[a + 1]), (hi[a, b], edges[a])] for a, b in zip(i, k)]
-        ax.add_collection(PolyCollection(boxes, facecolors=_STABLE, edgecolors="none", alpha=0.6, label="stable"))
-        ys = np.broadcast_to(y[:, None], lo.shape).ravel()
-        ax.plot(np.concatenate([lo_b.ravel(), hi_b.ravel()]), np.concatenate([ys, ys]), "k.", ms=2.5, label="boundary")
-        ax.set_ylim(edges[0], edges[-1])
+    else:
+        edges = np.array([0.0, 1.0])
+    # One box per point and stretch: joining neighbouring points would draw boundaries (and shade regions) that
+    # were never computed wherever the classes change between points.
+    present = sorted({c for *_, c in stretches})
+    for c in present:
+        boxes = [[(x0, edges[r]), (x0, edges[r + 1]), (x1, edges[r + 1]), (x1, edges[r])] for r, x0, x1, cc in stretches if cc == c]
+        hatch = _HATCH_DEGENERATE if c < 0 and c != absent else None
+        ax.add_collection(PolyCollection(boxes, facecolors=colour(c, stable, absent, undecided), edgecolors="none", hatch=hatch))
+    ends = np.concatenate([b_lo.ravel(), b_hi.ravel()])
+    ys = np.broadcast_to(((edges[:-1] + edges[1:]) / 2 if free else np.array([0.5]))[:, None], b_lo.shape).ravel()
+    ax.plot(ends, np.concatenate([ys, ys]), "k.", ms=2.5 if free else 6)
+    ax.set_xlim(scan[0], scan[1])
+    ax.set_ylim(edges[0], edges[-1])
+    if free:
         ax.set_ylabel(axis_label(ds, free[0], width=45))
         if ds[free[0]].attrs.get("scale") == "log":
             ax.set_yscale("log")
             log_ticks(ax.yaxis, float(np.min(y)), float(np.max(y)))
     else:
-        for k in range(lo.shape[1]):
-            if np.isfinite(lo[0, k]):
-                ax.axvspan(lo[0, k], hi[0, k], color=_STABLE, alpha=0.6, label="stable" if k == 0 else None)
         ax.set_yticks([])
-    ax.set_xlim(float(scan[0]), float(scan[-1]))
-    units = _units(lower.attrs.get("units", ""))
-    ax.set_xlabel(f"{_symbol(ds, along)} [{units}]" if units else _symbol(ds, along))
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    title = textwrap.fill(ds.attrs.get("title", "stabmap critical values"), 70) + f"\nstable {_symbol(ds, along)} (white: unstable); ends to rtol {ds.attrs['critical_rtol']:g}"
+    ax.set_xlabel(axis_label(xr.Dataset(coords={along: ((), 0.0, _scanned(ds, system, along, lower))}, attrs=ds.attrs), along, width=60))
+    handles = [Patch(facecolor=colour(c, stable, absent, undecided), edgecolor="#888888" if c == absent else "none", lw=0.5,
+                     hatch=_HATCH_DEGENERATE if c < 0 and c != absent else None, label=class_label(c, system)) for c in present]
+    handles.append(Line2D([], [], color="k", marker=".", ls="none", label=f"a change of {_mathtext(system.label_symbol)},\nlocated"))
+    fig.legend(handles=handles, loc="outside right upper", alignment="left", frameon=False, title=system.label_title,
+               fontsize=9, title_fontsize=9)
+    title = textwrap.fill(ds.attrs.get("title", "stabmap critical values"), 70, break_on_hyphens=False)
+    title += f"\n{_symbol(ds, along)} scanned, every change located to rtol {ds.attrs['critical_rtol']:g}"
+    if start is None:
+        title += " (stable intervals only: an older file)"
     if chosen:
         title += "; " + ", ".join(_value_text(ds, k, float(ds[k].sel({k: v}, method="nearest"))) if k in ds.coords else f"{k} = {v:.4g}" for k, v in chosen.items())
     ax.set_title(title, fontsize=10)

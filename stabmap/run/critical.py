@@ -101,6 +101,10 @@ def check_along(scene: SceneBase, along: str) -> int:
     names = [a.name for a in scene.grid]
     if along not in names:
         have = ", ".join(names) if names else "none (the scene has no [grid])"
+        try:
+            scene.parameter(along)
+        except StabmapError as exc:  # not a name this scene could scan at all: say that, not "add it to [grid]"
+            raise StabmapError(f"--along {along}: {exc}; its grid axes are: {have}") from None
         raise StabmapError(
             f"--along {along}: not a grid axis of this scene; its grid axes are: {have}. "
             f"Add {along} = {{ start = ..., stop = ..., num = ... }} under [grid] to scan it"
@@ -257,6 +261,7 @@ class _Table:
     b_upper: np.ndarray
     nc_below: np.ndarray
     nc_above: np.ndarray
+    start: np.ndarray  # the label at the first scan value: with the boundaries, the label everywhere in the scan
 
 
 def _table(nc: np.ndarray, scan: np.ndarray, b: _Brackets, stable: int, fill: int) -> _Table:
@@ -278,7 +283,7 @@ def _table(nc: np.ndarray, scan: np.ndarray, b: _Brackets, stable: int, fill: in
     counts = np.full((2, npoints, nb), fill, dtype=nc.dtype)
     bounds[0, b.owner, slot], bounds[1, b.owner, slot] = b.lo, b.hi
     counts[0, b.owner, slot], counts[1, b.owner, slot] = b.nc_lo, b.nc_hi
-    return _Table(n_int, *ends, *bounds, *counts)
+    return _Table(n_int, *ends, *bounds, *counts, flat[:, 0].copy())
 
 
 def _stable_intervals(nc_start: int, scan: np.ndarray, b: _Brackets, stable: int) -> list[tuple[float, float, float, float]]:
@@ -337,6 +342,9 @@ def _dataset(system, scene, along, others, scan, nc, brackets, proved: str = "pr
         "boundary_upper": (bd, grid(t.b_upper), along_attrs(f"upper end of the bracket of a change of {lab}", f"{lab}_above holds here, {proved}; a change lies in (lower, upper]; NaN pads")),
         f"{lab}_below": (bd, grid(t.nc_below), count_attrs(f"{lab} at boundary_lower")),
         f"{lab}_above": (bd, grid(t.nc_above), count_attrs(f"{lab} at boundary_upper")),
+        f"{lab}_at_scan_start": (dims, grid(t.start), {"long_name": f"{lab} at the first scan value", "units": label.units or "1",
+                                                       "comment": f"{proved}; it holds up to boundary_lower of the first boundary, "
+                                                                  f"then {lab}_above of each boundary up to the next"}),
     }
     attrs = global_attrs(system, scene, "stabmap critical values")
     return xr.Dataset(data, coords=coordinates(system, scene, skip=(along,)), attrs=attrs)
