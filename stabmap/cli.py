@@ -197,7 +197,7 @@ def paper(systems, out, quick, cases, rows):
     """Recompute the papers' cases and check them; exit status 1 on any disagreement (docs/paper-cases.md).
 
     gyroscopes: the cases n = 1, 2, 3 against the printed determinants (exact arithmetic) and closed forms;
-    closed: the families' boundaries along h2/h1 against CLOSED.md; reactions: the square plate's G/4.
+    closed: the families' boundaries along h2/h1 against docs/closed.md; reactions: the square plate's G/4.
     """
     from . import paper as papers
 

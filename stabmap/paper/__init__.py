@@ -5,7 +5,7 @@ with the paper's printed determinants or closed forms, and draws its figures:
 
 - ``gyroscopes``: the cases n = 1, 2, 3 (seed 003; docs/paper-cases.md), against the printed determinants
   (22), (28)-(32) in exact arithmetic and the closed forms (23), (24), (33), (34) and the split;
-- ``closed``: the hinge and six-body figure-eight families' boundaries along h2/h1, against CLOSED.md
+- ``closed``: the hinge and six-body figure-eight families' boundaries along h2/h1, against docs/closed.md
   (docs/closed.md);
 - ``reactions``: the square plate's atlas against G/4 and the paper's closed form (docs/reactions.md).
 """

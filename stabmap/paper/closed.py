@@ -1,7 +1,7 @@
 """The closed-chain paper's families checked against their closed forms (``stabmap paper closed``).
 
 The bundled scenes ``closed-hinge`` and ``closed-figure-eight-6`` scan the length ratio h2/h1. Along it,
-``stabmap.critical`` locates every change of class to 1e-10 relative; each must be one that CLOSED.md's table
+``stabmap.critical`` locates every change of class to 1e-10 relative; each must be one that docs/closed.md's table
 (docs/closed.md, section 2) gives in closed form, with the same classes on either side:
 
 - hinge: stable below h2/h1 = sqrt 2, unstable (index 1) above, absent beyond h2/h1 = 2 (the hinge is then a

@@ -1,5 +1,5 @@
 """Closed chains of elastic joints (docs/closed.md): the planar equilibria of a closed rod of n bodies, their
-forces and their stability, from Bolgrabskaya, Savchenko and Shchepin (2006), as checked in CLOSED.md.
+forces and their stability, from Bolgrabskaya, Savchenko and Shchepin (2006), as restated and corrected in docs/closed.md.
 
 The pipeline's part of this system is the ``System`` below; the physics is in the modules beside it:
 
@@ -27,7 +27,7 @@ from .scene import Scene
 
 REFERENCES = (
     "I. A. Bolgrabskaya, A. Ya. Savchenko, N. N. Shchepin, Closed systems of coupled rigid bodies (in Russian), "
-    "Mekhanika tverdogo tela 36 (2006): equations (22)-(52); corrected and extended by stabmap's CLOSED.md"
+    "Mekhanika tverdogo tela 36 (2006): equations (22)-(52); corrected and extended in stabmap's docs/closed.md"
 )
 
 

@@ -1,4 +1,4 @@
-"""The named equilibrium families of a closed chain and their closed forms (docs/closed.md, CLOSED.md section 1).
+"""The named equilibrium families of a closed chain and their closed forms (docs/closed.md, sections 1 and 2).
 
 Each family fixes the number of bodies (the ring takes any n >= 3), which loops close, and which bodies share
 which of two lengths: ``pattern`` gives 1 for a body of length h1 and 2 for one of length h2, and scenes scan

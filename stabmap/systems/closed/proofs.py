@@ -131,7 +131,7 @@ def _pattern_lengths(pattern, r):
 def closed_form(family: str, r, sqrt):
     """cos theta_k, sin theta_k, the scaled loop forces rho = R h / c1^2 as (rho_y, rho_z) per loop, and the lengths,
     of a family at ratio r = h2/h1 with h1 = 1 (the labels are scale-free), in the arithmetic of r (balls or exact
-    rationals; ``sqrt`` its square root).  The closed forms of CLOSED.md written with square roots only."""
+    rationals; ``sqrt`` its square root).  The closed forms of docs/closed.md written with square roots only."""
     one, zero = r * 0 + 1, r * 0
     if family == "figure-eight-4":  # theta = (-t, pi/2, pi + t, pi/2), sin t = r, R_y = 2/a_1
         st = r
