@@ -83,7 +83,8 @@ def test_info_query_plot_on_a_closed_atlas(hinge_atlas, tmp_path, capsys):
     assert f"decided by: ball arithmetic {r.size - folded - absent}, exact rational arithmetic {folded + absent}" in text
     assert main(["query", str(hinge_atlas), "ratio=1.2"]) == 0
     text = capsys.readouterr().out
-    assert "stability = stable" in text and "force_y = [" in text and "(decided by ball arithmetic)" in text
+    assert "stability = stable (decided by ball arithmetic)" in text and "force_y = [" in text
+    assert "nearest grid point 1.2\n" in text  # a ratio has no units to print (CF "1")
     assert main(["query", str(hinge_atlas), "--fraction", "--json"]) == 0
     f = json.loads(capsys.readouterr().out)
     assert (f["stable"], f["unstable"], f["degenerate"], f["absent"], f["points"]) == (stable, unstable, folded, absent, r.size)

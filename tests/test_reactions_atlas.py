@@ -164,7 +164,8 @@ def test_cli_atlas_info_query_plot(tmp_path, capsys):
     assert "stable" not in text
     assert main(["query", str(out), "c_x=0.3", "c_y=0.45"]) == 0
     text = capsys.readouterr().out
-    assert "critical_node = 2" in text and "compatible = compatible" in text and "R = [[" in text
+    assert "critical_node = 2 (decided by " in text and "compatible = compatible" in text and "R = [[" in text
+    assert text.count("decided by") == 1  # on the label it qualifies, not on whichever variable is last
     assert main(["query", str(out), "c_x=0.3", "c_y=0.45", "--json"]) == 0
     answer = json.loads(capsys.readouterr().out)
     assert answer["critical_node"] == 2 and len(answer["R"]) == 4 and answer["rank"] == 6

@@ -10,6 +10,7 @@ import math
 import numpy as np
 import xarray as xr
 
+from .. import systems
 from ..errors import StabmapError
 from .query import CRITICAL_HINT, Label, StableFraction
 
@@ -52,12 +53,18 @@ def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
     lines = []
     for k, v in label.requested.items():
         note = " (outside the grid: nearest edge)" if k in label.outside else ""
-        lines.append(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g} {_units(atlas, k)}".rstrip() + note)
+        units = _units(atlas, k)
+        lines.append(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g} {'' if units == '1' else units}".rstrip() + note)
     shown = [(k, v) for k, v in label.values.items() if k != label.provenance]
     lines += [f"{k} = {_value(v)}" for k, v in shown]
     if label.provenance is not None:
         how = label.values[label.provenance]
-        lines[-1] += (
+        # How the point was decided qualifies its verdict (stability, else the label: the critical node), not
+        # whichever variable happens to be last.
+        names = [k for k, _ in shown]
+        main = "stability" if "stability" in names else systems.of_atlas(atlas.attrs).label if atlas is not None else None
+        at = len(lines) - len(shown) + names.index(main) if main in names else -1
+        lines[at] += (
             " (not computed: inferred from the agreeing corners of its grid cell; docs/refine.md)"
             if label.inferred
             else " (not proved: the class is undecided)"
