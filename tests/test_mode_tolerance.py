@@ -185,7 +185,7 @@ def test_round_trip_and_atlas_reproduce_the_choice(tmp_path):
     group = " ".join([lines[start]] + [x for x in lines[start + 1 :] if x.startswith(" " * 12)][:4])
     c = s.bodies[0].cavity
     assert f"{c.kept} liquid modes kept" in group and "mode_tolerance = 0.0003" in group
-    assert f"{c.tail_over_A:.2g} of A" in group
+    assert f"{100 * c.tail_over_A:.2g} % of A" in group
 
 
 def test_default_scene_writes_its_count_and_auto_without_a_tolerance():

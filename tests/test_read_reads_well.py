@@ -95,6 +95,20 @@ def test_log_axis_labels_more_than_decades():
     assert "0.2" in labels and "50" in labels
 
 
+def test_a_log_axis_over_many_decades_writes_every_label_one_way():
+    from matplotlib.figure import Figure
+
+    from stabmap.read.plot import log_ticks
+
+    ax = Figure().subplots()
+    ax.set_xscale("log")
+    ax.set_xlim(10.0, 1e5)
+    log_ticks(ax.xaxis, 10.0, 1e5)
+    ax.figure.canvas.draw()
+    labels = [t.get_text() for t in ax.xaxis.get_majorticklabels() if t.get_text()]
+    assert labels and all(t.startswith("$") for t in labels), labels  # 10¹ .. 10⁵, not "10, 100, 1000, 10⁴"
+
+
 def test_one_cell_band_keeps_its_class_colour():
     nc = np.zeros((40, 300), dtype=np.int16)
     nc[:, 150] = 2  # one column of 2 pairs between stable cells: two stability boundaries one cell apart

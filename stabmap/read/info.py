@@ -20,11 +20,14 @@ def plural(n: int, word: str, many: str | None = None) -> str:
     return f"{n} {word if n == 1 else (many or word + 's')}"
 
 
-def wrapped(head: str, items: list[str], indent: str = "  ", width: int = WIDTH) -> list[str]:
-    """``head`` then ``items`` joined by ", ", wrapped at ``width`` with the continuation lines under the first item."""
+def wrapped(head: str, items: list[str], indent: str = "  ", width: int = WIDTH, whole: bool = False) -> list[str]:
+    """``head`` then ``items`` joined by ", ", wrapped at ``width`` with the continuation lines under the first item;
+    ``whole``: an item (``density = 1000 kg m-3``) is never broken across lines."""
     first = f"{indent}{head}"
-    return textwrap.wrap(", ".join(items), width=width, initial_indent=first, subsequent_indent=" " * len(first),
-                         break_long_words=False, break_on_hyphens=False) or [first.rstrip()]
+    text = ", ".join(i.replace(" ", "\u00a0") if whole else i for i in items)  # textwrap does not break at U+00A0
+    lines = textwrap.wrap(text, width=width, initial_indent=first, subsequent_indent=" " * len(first),
+                          break_long_words=False, break_on_hyphens=False) or [first.rstrip()]
+    return [line.replace("\u00a0", " ") for line in lines]
 
 
 def fixed_parameters(ds: xr.Dataset, system, item=None) -> list[tuple[str, list[str]]]:
@@ -65,17 +68,19 @@ def describe(ds: xr.Dataset, name: str = "") -> str:
         lines += textwrap.wrap(line, width=WIDTH, initial_indent="  ", subsequent_indent="    ")
     notes = scene_notes(a)
     lines.append("  axes:")
-    for d in ds[system.label].dims:
+    dims = ds[system.label].dims
+    name_width = max([10, *map(len, dims)])
+    for d in dims:
         c = ds[d]
         lines.append(
-            f"    {d:<10} {plural(c.size, 'point'):>11}  {float(c.min()):.6g} .. {float(c.max()):.6g} {c.attrs.get('units', '')}  "
+            f"    {d:<{name_width}} {plural(c.size, 'point'):>11}  {float(c.min()):.6g} .. {float(c.max()):.6g} {c.attrs.get('units', '')}  "
             f"({c.attrs.get('scale', '')})  {c.attrs.get('long_name', '')}"
         )
     groups = fixed_parameters(ds, system)
     if groups:
         lines.append("  fixed:")
     for head, items in groups:
-        lines += wrapped(f"{head}: " if head else "", items, indent="    ")
+        lines += wrapped(f"{head}: " if head else "", items, indent="    ", whole=True)
         for text in notes.pop(head, []):  # e.g. the liquid of this body, under its parameters
             lines += wrapped(" " * (len(head) + 2) if head else "", [text], indent="    ")
     for head, texts in notes.items():  # notes of a group with no fixed parameter (every one scanned)

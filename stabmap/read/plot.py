@@ -718,17 +718,19 @@ def _fill_mathtext(text: str, chars: int) -> str:
 
 def log_ticks(axis, lo: float, hi: float) -> None:
     """Label a log axis between its decades too: at 2 and 5 times a power of ten over up to three decades, at 3
-    over up to one (unlabelled minor ticks at every integer multiple); numbers as ``0.2``, ``50``, or ``2×10⁻⁵``
-    far from 1."""
+    over up to one (unlabelled minor ticks at every integer multiple); numbers as ``0.2``, ``50``, or, on an axis
+    that reaches below 10⁻³ or to 10⁴, all as powers of ten (``2×10⁻⁵``)."""
     from matplotlib.ticker import FuncFormatter, LogLocator
 
     decades = math.log10(hi / lo) if lo > 0 and hi > lo else 0.0
     labelled = (2, 3, 5) if decades <= 1.2 else (2, 5) if decades <= 3.5 else ()
 
+    plain = 1e-3 <= lo and hi < 1e4  # one style an axis: "1000" beside "10⁴" would read as two scales
+
     def text(v: float, _pos=None) -> str:
         e = math.floor(math.log10(v) + 1e-9)
         mantissa = round(v / 10.0**e, 6)
-        if 1e-3 <= v < 1e4:
+        if plain:
             return f"{v:g}"
         return f"$10^{{{e}}}$" if mantissa == 1 else f"${mantissa:g}\\times10^{{{e}}}$"
 

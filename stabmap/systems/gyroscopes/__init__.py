@@ -47,7 +47,7 @@ class Gyroscopes(System):
     label_title = "complex root pairs N$_c$"
     stable_label = 0
     provenance = "decided_by"
-    symbols = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho", "radius": "a"}
+    symbols = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho"}
     scene_module = _scene
 
     def attrs(self, scene: Scene) -> dict:

@@ -289,11 +289,11 @@ def describe(c: Cavity) -> str:
         stated = f"mode_tolerance = {tol:g}" if c.mode_tolerance is not None else f'modes = "auto", tail <= {tol:g} of A'
         why = f"the fewest with {stated}" if c.tail_over_A <= tol else f"{stated} not met within the default's {n}; state mode_tolerance to keep more"
     else:
-        why = f"modes = {n}"
-    lumped = "lumped into A" if c.tail else "dropped (tail = false)"
+        why = "as the scene's modes asks"
+    lumped = "lumped into A as rigid inertia" if c.tail else "dropped (tail = false)"
     return (
-        f"{head} ({why}); the rest {lumped}: at the grid's worst point {c.tail_over_A:.2g} of A "
-        f"and {100 * c.tail_share:.3g} % of the liquid's sum(E)"
+        f"{head} ({why}); the modes left out are {lumped}: at most {100 * c.tail_over_A:.2g} % of A "
+        f"and {100 * c.tail_share:.3g} % of the liquid's ΣE over the grid"
     )
 
 
