@@ -84,7 +84,8 @@ BAD = [
     (_replace("K_1 = { values = [0.0, 10.0, 100.0] }", "K_1 = { values = [] }"), "grid.K_1.values must be a non-empty list"),
     (_replace("K_1 = { values = [0.0, 10.0, 100.0] }", "K_1 = { values = [0.0, 10.0, 5.0] }"), "grid.K_1: values must be distinct and sorted"),
     (_replace("start = 0.1, stop = 10.0", "start = -0.1, stop = 10.0"), "grid.m_2.start must be > 0"),
-    (_replace("c = 0.10", "c = 0.10\nfoo = 1"), "bodies[1]: unknown key 'foo'"),
+    (_replace("c = 0.10", "c = 0.10\nfoo = 1"), "bodies[1]: unknown key 'foo'; allowed keys are"),
+    (_replace("c = 0.10", "c = 0.10\nfluids = { E = [1e-4], kappa = [1.31] }"), "bodies[1]: unknown key 'fluids'; did you mean 'fluid'?"),
     (_replace("C = 0.02", ""), "bodies[2].C is missing"),
 ]
 

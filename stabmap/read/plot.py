@@ -638,7 +638,7 @@ def _title(
 ) -> str:
     """The atlas title, the stable fraction of the ``points`` shown (``stable``: how many are stable; None for a
     system without stability), the fixed axes, the panels, the notes and the rule that reduced a large grid."""
-    title = [textwrap.fill(ds.attrs.get("title", "") or "stabmap atlas", chars)]
+    title = [_fill_title(ds.attrs.get("title", "") or "stabmap atlas", chars)]
     part = plan.facet is not None or bool(plan.fixed)
     if stable is not None:
         title.append(f"{100 * stable / points:.1f} % of {'the ' if part else ''}{points:,} grid points{' shown' if part else ''} stable")
@@ -673,6 +673,12 @@ def captioned_figure(ds: xr.Dataset, size: tuple[float, float]):
         fig.get_layout_engine().set(rect=(0, caption_height / size[1], 1, 1 - caption_height / size[1]))
         fig.text(0.01, 0.02 / size[1], caption, fontsize=7, va="bottom", ha="left", color="#333333", gid="fixed-caption")
     return fig
+
+
+def _fill_title(text: str, chars: int) -> str:
+    """The atlas title in lines of ``chars``, never broken between "eq." and its number."""
+    text = re.sub(r"\b(eqs?\.|No\.) (?=\S)", "\\1\u00a0", text)
+    return textwrap.fill(text, chars, break_on_hyphens=False, break_long_words=False)
 
 
 def fixed_caption(ds: xr.Dataset, chars: int) -> str:
@@ -989,7 +995,7 @@ def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
     handles.append(Line2D([], [], color="k", marker=".", ls="none", label=f"a change of {_mathtext(system.label_symbol)},\nlocated"))
     fig.legend(handles=handles, loc="outside right upper", alignment="left", frameon=False, title=system.label_title,
                fontsize=9, title_fontsize=9)
-    title = textwrap.fill(ds.attrs.get("title", "stabmap critical values"), 70, break_on_hyphens=False)
+    title = _fill_title(ds.attrs.get("title", "stabmap critical values"), 70)
     title += f"\n{_symbol(ds, along)} scanned, every change located to rtol {ds.attrs['critical_rtol']:g}"
     if start is None:
         title += " (stable intervals only: an older file)"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import difflib
 import math
 from dataclasses import dataclass
 
@@ -40,4 +41,6 @@ def no_unknown(table, allowed, where: str) -> None:
         raise StabmapError(f"{where} must be a table, got {table!r}")
     unknown = sorted(set(table) - set(allowed))
     if unknown:
-        raise StabmapError(f"{where}: unknown key {unknown[0]!r}; allowed keys are {', '.join(sorted(allowed))}")
+        close = difflib.get_close_matches(unknown[0], list(allowed), n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise StabmapError(f"{where}: unknown key {unknown[0]!r}; {hint}allowed keys are {', '.join(sorted(allowed))}")
