@@ -109,32 +109,8 @@ omega = { start = 1.0, stop = 120.0, num = 80 }
 m_2 = { start = 0.1, stop = 10.0, num = 60, scale = "log" }
 """
 
-# The bundled example paper-n2-free-resonance, written out so that both versions read the same text.
-RESONANCE = """
-title = "two free bodies, elastic joint, liquid near resonance (paper eq. 32)"
-support = "free"
-omega = 30.0
-joints = [20.0]
-
-[[bodies]]
-m = 1.0
-A = 0.02
-C = 0.016
-c = 0.10
-s = 0.25
-fluid = { E = [2.0e-4], kappa = [2.7] }
-
-[[bodies]]
-m = 0.5
-A = 0.01
-C = 0.002
-c = 0.08
-fluid = { E = [1.0e-4], kappa = [2.7] }
-
-[grid]
-omega = { start = 1.0, stop = 150.0, num = 300 }
-K_1 = { start = 0.0, stop = 40.0, num = 200 }
-"""
+# The bundled example paper-n2-free-resonance as this checkout has it: both versions read the same text.
+RESONANCE = (ROOT / "stabmap" / "examples" / "paper-n2-free-resonance.toml").read_text()
 
 HINGE = """
 title = "closed chain: two loops on a shared joint (hinge) against h2/h1"
