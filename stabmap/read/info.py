@@ -20,6 +20,12 @@ def plural(n: int, word: str, many: str | None = None) -> str:
     return f"{n} {word if n == 1 else (many or word + 's')}"
 
 
+def unit_suffix(units) -> str:
+    """``" kg"`` after a number on the terminal; ``""`` for no units or the dimensionless CF ``"1"``."""
+    units = str(units or "")
+    return "" if units in ("", "1") else f" {units}"
+
+
 def wrapped(head: str, items: list[str], indent: str = "  ", width: int = WIDTH, whole: bool = False) -> list[str]:
     """``head`` then ``items`` joined by ", ", wrapped at ``width`` with the continuation lines under the first item;
     ``whole``: an item (``density = 1000 kg m-3``) is never broken across lines."""
@@ -36,7 +42,7 @@ def fixed_parameters(ds: xr.Dataset, system, item=None) -> list[tuple[str, list[
     Returns (heading, ["m = 1 kg", ...]): inside a heading such as ``body 2`` a name loses its index (``m_2`` -> ``m``).
     ``item(name, value, units)`` writes one entry (a figure's caption writes symbols and units in mathtext).
     """
-    item = item or (lambda name, value, units: f"{name} = {value:.6g}" + (f" {units}" if units and units != "1" else ""))
+    item = item or (lambda name, value, units: f"{name} = {value:.6g}{unit_suffix(units)}")
     names = [str(k) for k in ds.coords if ds[k].ndim == 0 and np.issubdtype(ds[k].dtype, np.number)]
     out = []
     for head, group in system.fixed_groups(names):
@@ -151,7 +157,7 @@ def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
             for k in range(lo.shape[1])
             if np.isfinite(lo[p, k])
         ]
-        shown = f" [{units}]" if units not in ("", "1") else ""
+        shown = f" [{unit_suffix(units).strip()}]" if unit_suffix(units) else ""
         lines.append(f"{where}: stable {along}{shown} " + ("; ".join(parts) if parts else "nowhere in the scan"))
     if lo.shape[0] > limit:
         lines.append(f"... and {lo.shape[0] - limit} more points in the file")

@@ -40,6 +40,7 @@ from .. import systems
 from ..store.files import check_writable
 from ..store.variables import INFERRED
 from .blocks import block_factors, reduce_blocks
+from .info import fixed_parameters, scene_notes, unit_suffix
 
 MAX_PANELS = 12  # default limit of small multiples
 _LEGEND_WIDTH = 2.5  # [inch] beside small multiples
@@ -87,6 +88,16 @@ def colour(value: int, stable: int | None = 0, absent: int | None = None, undeci
 def class_label(value: int, system=None) -> str:
     """Legend text of the label ``value`` of ``system`` (default: gyroscopes, where the label is N_c)."""
     return (system or systems.get(systems.DEFAULT)).class_name(value)
+
+
+def class_patch(value: int, system):
+    """The legend entry of one class of ``system``'s label, as every figure draws it."""
+    from matplotlib.patches import Patch
+
+    absent = system.absent_label
+    return Patch(facecolor=colour(value, system.stable_label, absent, system.undecided_label),
+                 edgecolor="#888888" if value == absent else "none",  # a white patch needs an outline to be seen
+                 lw=0.5, hatch=_HATCH_DEGENERATE if value < 0 and value != absent else None, label=class_label(value, system))
 
 
 def _mathtext(symbol: str) -> str:
@@ -156,8 +167,7 @@ def plan_figure(
     sel = dict(sel or {})
     for k, v in sel.items():
         if k in ds.coords and ds[k].ndim == 0 and k not in dims:
-            units = _plain_units(ds[k])
-            raise StabmapError(f"--sel {k}: fixed at {float(ds[k]):g}{units} in this atlas, not a grid axis; its axes are: {', '.join(dims)}")
+            raise StabmapError(f"--sel {k}: fixed at {float(ds[k]):g}{unit_suffix(ds[k].attrs.get('units'))} in this atlas, not a grid axis; its axes are: {', '.join(dims)}")
         if k not in dims:
             raise StabmapError(f"--sel {k}: not an axis of this atlas; its axes are: {', '.join(dims)}")
         if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
@@ -195,7 +205,7 @@ def plan_figure(
         values = np.asarray(ds[k], dtype=float)
         fixed[k] = (int(np.argmin(np.abs(values - v))), float(v))
         if not values.min() <= v <= values.max():
-            notes.append(f"{k} = {v:g} lies outside the grid ({values.min():g} .. {values.max():g}{_plain_units(ds[k])}): "
+            notes.append(f"{k} = {v:g} lies outside the grid ({values.min():g} .. {values.max():g}{unit_suffix(ds[k].attrs.get('units'))}): "
                          f"drawn at its nearest end, {k} = {values[fixed[k][0]]:g}")
     for d in rest:  # a figure shows at most four axes
         fixed[d] = (0, None)
@@ -384,12 +394,6 @@ def _units(units: str) -> str:
         m = re.fullmatch(r"([A-Za-z]+)(-?\d+)", w)
         words.append(f"{m.group(1)}$^{{{m.group(2)}}}$" if m else w)
     return "\u00a0".join(words)
-
-
-def _plain_units(coord: xr.DataArray) -> str:
-    """' kg' for messages on the terminal; '' for none or '1'."""
-    units = str(coord.attrs.get("units", ""))
-    return "" if units in ("", "1") else f" {units}"
 
 
 def _symbol(ds: xr.Dataset, name: str) -> str:
@@ -607,11 +611,7 @@ def atlas_figure(
         maps.supxlabel(axis_label(ds, plan.x, width=int(12 * (size[0] - _LEGEND_WIDTH))), fontsize=10)
         maps.supylabel(axis_label(ds, plan.y, width=int(10 * size[1])), fontsize=10)
 
-    handles = []
-    for v in present:
-        hatch = _HATCH_DEGENERATE if v < 0 and v != absent else None
-        edge = "#888888" if v == absent else "none"  # a white patch needs an outline to be seen
-        handles.append(Patch(facecolor=colour(v, stable, absent, undecided), edgecolor=edge, lw=0.5, hatch=hatch, label=class_label(v, system)))
+    handles = [class_patch(v, system) for v in present]
     if drawn["stability"]:
         handles.append(Line2D([], [], color=_BOUNDARY, lw=1.5, label="stability boundary"))
     if drawn["classes"]:
@@ -688,7 +688,6 @@ def fixed_caption(ds: xr.Dataset, chars: int) -> str:
 
     Axes fixed by ``sel`` are in the title, not here.
     """
-    from .info import fixed_parameters, scene_notes
 
     def item(name: str, value: float, units: str) -> str:
         return f"{_symbol(ds, name)} = {value:.6g}" + (f" {_units(units)}" if _units(units) else "")
@@ -926,7 +925,6 @@ def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
     """
     from matplotlib.collections import PolyCollection
     from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
 
     system = systems.of_atlas(ds.attrs)
     along, lab = ds.attrs["critical_along"], system.label
@@ -990,8 +988,7 @@ def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
     else:
         ax.set_yticks([])
     ax.set_xlabel(axis_label(xr.Dataset(coords={along: ((), 0.0, _scanned(ds, system, along, lower))}, attrs=ds.attrs), along, width=60))
-    handles = [Patch(facecolor=colour(c, stable, absent, undecided), edgecolor="#888888" if c == absent else "none", lw=0.5,
-                     hatch=_HATCH_DEGENERATE if c < 0 and c != absent else None, label=class_label(c, system)) for c in present]
+    handles = [class_patch(c, system) for c in present]
     handles.append(Line2D([], [], color="k", marker=".", ls="none", label=f"a change of {_mathtext(system.label_symbol)},\nlocated"))
     fig.legend(handles=handles, loc="outside right upper", alignment="left", frameon=False, title=system.label_title,
                fontsize=9, title_fontsize=9)

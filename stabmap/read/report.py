@@ -12,6 +12,7 @@ import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError
+from .info import unit_suffix
 from .query import CRITICAL_HINT, Label, StableFraction
 
 FORMATS = ("text", "csv", "json")
@@ -46,15 +47,14 @@ def render(result, fmt: str = "text", *, limit: int = 40, atlas: xr.Dataset | No
 
 
 def _units(ds: xr.Dataset | None, name: str) -> str:
-    return str(ds[name].attrs.get("units", "")) if ds is not None and name in ds.coords else ""
+    return unit_suffix(ds[name].attrs.get("units")) if ds is not None and name in ds.coords else ""
 
 
 def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
     lines = []
     for k, v in label.requested.items():
         note = " (outside the grid: nearest edge)" if k in label.outside else ""
-        units = _units(atlas, k)
-        lines.append(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g} {'' if units == '1' else units}".rstrip() + note)
+        lines.append(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g}{_units(atlas, k)}" + note)
     shown = [(k, v) for k, v in label.values.items() if k != label.provenance]
     lines += [f"{k} = {_value(v)}" for k, v in shown]
     if label.provenance is not None:
