@@ -7,10 +7,11 @@ of lambda everywhere (as ``numpy.polynomial``).  This folder is installed as
 modules import each other relatively, so they work under either name.
 """
 
-from .block import charpoly_block, count_block, decide_block, linearise_block
+from .block import box_block, charpoly_block, count_block, decide_block, linearise_block
 from .status import DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL
 
 __all__ = [
+    "box_block",
     "charpoly_block",
     "count_block",
     "decide_block",

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import certify, pencil
-from .charpoly import allocate, block_det, charpoly_point, diagonal_blocks, matrix_point, same_structure
-from .count import allocate_count, count_point
+from . import certify, dd, pencil
+from .charpoly import allocate, block_det, charpoly_point, diagonal_blocks, matrix_box, matrix_point, same_structure
+from .count import allocate_count, count_box, count_point
 from .options import kernel
 from .status import DECIDED_FLOAT, DECIDED_INCLUSION, UNDECIDED, ZERO_POLYNOMIAL
 
@@ -78,11 +78,20 @@ def count_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out_
 def _count_coefficients(body, joint, at, g, E, kappa, nmodes, parent, rowdeg, free, ws, c, cs, starts, reuse, inclusion=True):
     """(N_c, status) of one point from the enclosed coefficients of p, factor by factor (``count_point``)."""
     matrix_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
+    return _count_matrix(ws, rowdeg, c, cs, starts, inclusion, False)
+
+
+@kernel
+def _count_matrix(ws, rowdeg, c, cs, starts, inclusion, box):
+    """(N_c, status) from the interval matrix P in ws[5], factor by factor: the same N_c for every P it holds.
+
+    ``box``: P encloses a box of parameter points, and each factor is counted by ``count_box``.
+    """
     nblocks = diagonal_blocks(ws[5], starts)
     total, status = 0, DECIDED_FLOAT
     for b in range(nblocks):
         d = block_det(ws, rowdeg, starts[b], starts[b + 1], c)
-        nc, st = count_point(c[: d + 1], cs, inclusion)
+        nc, st = count_box(c[: d + 1], cs) if box else count_point(c[: d + 1], cs, inclusion)
         if st == ZERO_POLYNOMIAL or st == UNDECIDED:
             total, status = -1, st
             if st == ZERO_POLYNOMIAL:
@@ -151,3 +160,45 @@ def linearise_block(body, joint, g, E, kappa, nmodes, free, parent, at, out):
         pencil.prepare(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, ws, same_structure(body, joint, at, g, p))
         ok[p] = pencil.linearisation(body[p], E[p], nmodes, parent, ws, out[p], Mo)
     return ok
+
+
+@kernel
+def box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, parent, at, rat, out_nc, out_status):
+    """N_c proved for every parameter point of each of a block of boxes, or UNDECIDED.
+
+    Box p is the set of parameter points within the radii (``rbody``, ``rjoint``, ``rg``, ``rat``,
+    shaped as ``body``, ``joint``, ``g`` and ``at``, all >= 0) of the midpoint given in ``body``,
+    ``joint``, ``g`` and ``at`` (layout as for ``charpoly_block``); E and kappa are exact.  The
+    coefficients of p are enclosed over the whole box, and the Sturm sequence (then, up to
+    ``LAPLACE_MAX`` bodies, root inclusion) proves one N_c for every polynomial in that enclosure:
+    every sign a count needs is proved on the whole box, so the number of real roots, the degree and
+    hence N_c cannot change inside it (docs/certification.md, "Boxes").  Writes ``out_nc``
+    (int16[npts], -1 unless decided) and ``out_status`` (int8[npts]: DECIDED_FLOAT (Sturm),
+    DECIDED_INCLUSION, ZERO_POLYNOMIAL or UNDECIDED).  A box of more than ``LAPLACE_MAX`` bodies is
+    UNDECIDED.
+    """
+    npts, n = body.shape[0], body.shape[1]
+    rowdeg = nmodes + 2
+    degree = int(rowdeg.sum())
+    laplace = n <= LAPLACE_MAX
+    ws = allocate(n if laplace else 1, max(1, nmodes.max()), degree if laplace else 1, parent if laplace else parent[:1])
+    c = np.empty((degree + 1, 3))
+    cs = allocate_count(degree)
+    starts = np.empty(n + 1, np.int64)
+    for p in range(npts):
+        out_nc[p], out_status[p] = -1, UNDECIDED
+        if not laplace or not _box_ok(body[p], rbody[p]):
+            continue
+        matrix_box(body[p], rbody[p], joint[p], rjoint[p], at[p], rat[p], g[p], rg[p], E[p], kappa[p], nmodes, parent, free, ws)
+        out_nc[p], out_status[p] = _count_matrix(ws, rowdeg, c, cs, starts, True, True)
+
+
+@kernel
+def _box_ok(body, rb):
+    """False for a box the enclosures cannot take: a radius not finite and >= 0, or a magnitude beyond dd.LARGE."""
+    for k in range(body.shape[0]):
+        for col in range(6):
+            r = rb[k, col]
+            if not (r >= 0.0 and r < dd.LARGE and abs(body[k, col]) < dd.LARGE):
+                return False
+    return True

@@ -65,7 +65,7 @@ def path_matrix(parent, T):
 
 
 @kernel
-def _lever_arms(body, at, parent, free, J):
+def _lever_arms(body, rb, at, ra, parent, free, J):
     """Write the lever-arm matrix J (docs/model.md, docs/trees.md) into J (n, n, 3).
 
     J[k, k] = c_k; for every body i on the path below body k, J[k, i] is the
@@ -74,69 +74,72 @@ def _lever_arms(body, at, parent, free, J):
     n = body.shape[0]
     J[:] = 0.0
     for k in range(n):
-        J[k, k, 0] = body[k, 3]
+        J[k, k, 0], J[k, k, 2] = body[k, 3], rb[k, 3]
         child = k
         i = parent[k]
         while i >= 0:
-            J[k, i, 0] = at[child]
+            J[k, i, 0], J[k, i, 2] = at[child], ra[child]
             child = i
             i = parent[i]
     if not free:
         return
     mt = (0.0, 0.0, 0.0)
     for k in range(n):
-        mt = dd.add(*mt, body[k, 0], 0.0, 0.0)
+        mt = dd.add(*mt, body[k, 0], 0.0, rb[k, 0])
+    if not dd.certain_nonzero(*mt):  # a box whose total mass may be 0: no enclosure, so nothing is proved
+        J[:] = np.nan
+        return
     for i in range(n):
         s = (0.0, 0.0, 0.0)
         for j in range(n):
-            s = dd.fma(*s, body[j, 0], 0.0, 0.0, J[j, i, 0], J[j, i, 1], J[j, i, 2])
+            s = dd.fma(*s, body[j, 0], 0.0, rb[j, 0], J[j, i, 0], J[j, i, 1], J[j, i, 2])
         mh, ml, mr = dd.div(*s, *mt)
         for k in range(n):
             J[k, i, 0], J[k, i, 1], J[k, i, 2] = dd.add(J[k, i, 0], J[k, i, 1], J[k, i, 2], -mh, -ml, mr)
 
 
 @kernel
-def _stiffness_T(body, joint, at, parent, g, free, sub, K):
+def _stiffness_T(body, rb, joint, rj, at, ra, parent, g, rg, free, sub, K):
     """Write K T (see module docstring) into K (n, n, 3); sub (n, 3) is scratch."""
     n = body.shape[0]
     K[:] = 0.0
     for j in range(1, n):
-        K[j, j, 0] = joint[j]
-        K[parent[j], j, 0] = -joint[j]
+        K[j, j, 0], K[j, j, 2] = joint[j], rj[j]
+        K[parent[j], j, 0], K[parent[j], j, 2] = -joint[j], rj[j]
     if free:
         return
-    K[0, 0, 0] = joint[0]
+    K[0, 0, 0], K[0, 0, 2] = joint[0], rj[0]
     # sub[k]: mass of the subtree of body k; children come after their parent, so go backwards.
     for k in range(n - 1, -1, -1):
         outboard = (0.0, 0.0, 0.0)  # mass of the bodies beyond body k
         leaf = True
-        a = dd.mul(body[k, 0], 0.0, 0.0, body[k, 3], 0.0, 0.0)
+        a = dd.mul(body[k, 0], 0.0, rb[k, 0], body[k, 3], 0.0, rb[k, 3])
         for j in range(k + 1, n):
             if parent[j] != k:
                 continue
             # a_k = m_k c_k + sum over the children j of k of at_j (mass of the subtree of j)
-            a = dd.fma(*a, at[j], 0.0, 0.0, sub[j, 0], sub[j, 1], sub[j, 2])
+            a = dd.fma(*a, at[j], 0.0, ra[j], sub[j, 0], sub[j, 1], sub[j, 2])
             outboard = (sub[j, 0], sub[j, 1], sub[j, 2]) if leaf else dd.add(*outboard, sub[j, 0], sub[j, 1], sub[j, 2])
             leaf = False
         if leaf:
             a = dd.add(*a, 0.0, 0.0, 0.0)  # as m_k c_k + s_k * 0: the same rounding bound as a chain's top body
-        ga = dd.mul(g, 0.0, 0.0, *a)
+        ga = dd.mul(g, 0.0, rg, *a)
         j = k
         while j >= 0:  # row k of -g diag(a) T: the bodies on the path to k
             K[k, j, 0], K[k, j, 1], K[k, j, 2] = dd.add(K[k, j, 0], K[k, j, 1], K[k, j, 2], *dd.neg(*ga))
             j = parent[j]
-        _set(sub, k, dd.add(*outboard, body[k, 0], 0.0, 0.0))
+        _set(sub, k, dd.add(*outboard, body[k, 0], 0.0, rb[k, 0]))
 
 
 @kernel
-def _inertia_T(body, parent, J, M):
+def _inertia_T(body, rb, parent, J, M):
     """Write M T, M = diag(A) + J^T diag(m) J, into M (n, n, 3)."""
     n = body.shape[0]
     for i in range(n):
         for j in range(n):
-            acc = (body[i, 1], 0.0, 0.0) if i == j else (0.0, 0.0, 0.0)
+            acc = (body[i, 1], 0.0, rb[i, 1]) if i == j else (0.0, 0.0, 0.0)
             for k in range(n):
-                t = dd.mul(body[k, 0], 0.0, 0.0, J[k, i, 0], J[k, i, 1], J[k, i, 2])
+                t = dd.mul(body[k, 0], 0.0, rb[k, 0], J[k, i, 0], J[k, i, 1], J[k, i, 2])
                 acc = dd.fma(*acc, *t, J[k, j, 0], J[k, j, 1], J[k, j, 2])
             _set(M[i], j, acc)
     # Column j of M T collects the columns of M of the subtree of j: add each column into its
@@ -150,13 +153,14 @@ def _inertia_T(body, parent, J, M):
 @kernel
 def structure(body, joint, at, g, parent, free, sub, J, M, K):
     """M T and K T of one point (double-double intervals) into M, K (n, n, 3); J, sub are scratch."""
-    _lever_arms(body, at, parent, free, J)
-    _inertia_T(body, parent, J, M)
-    _stiffness_T(body, joint, at, parent, g, free, sub, K)
+    zero, zero1 = np.zeros_like(body), np.zeros(body.shape[0])
+    _lever_arms(body, zero, at, zero1, parent, free, J)
+    _inertia_T(body, zero, parent, J, M)
+    _stiffness_T(body, zero, joint, zero1, at, zero1, parent, g, 0.0, free, sub, K)
 
 
 @kernel
-def _liquid_polys(omega, E, kappa, L, q, w):
+def _liquid_polys(omega, romega, E, kappa, L, q, w):
     """Q = prod_l (lambda + beta_l) into q and R = sum_l E_l prod_{l' != l} (lambda + beta_l') into w."""
     q[: L + 1] = 0.0
     w[: L + 1] = 0.0
@@ -165,7 +169,7 @@ def _liquid_polys(omega, E, kappa, L, q, w):
         kap = kappa[l]
         # two_sum makes kappa - 2 exact, so beta is an exact zero when kappa == 2.
         h, lo = dd.two_sum(kap, -2.0)
-        beta = dd.mul(omega, 0.0, 0.0, h, lo, 0.0)
+        beta = dd.mul(omega, 0.0, romega, h, lo, 0.0)
         beta = dd.div(*beta, kap, 0.0, 0.0)
         # w <- w (lambda + beta) + E_l q ; q <- q (lambda + beta)   (w uses the old q)
         for a in range(l + 1, 0, -1):
@@ -180,24 +184,26 @@ def _liquid_polys(omega, E, kappa, L, q, w):
 
 
 @kernel
-def _matrix(body, joint, at, g, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, reuse):
+def _matrix(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, reuse):
     """Write P = diag(Q) Phi T as interval polynomials into P (n, n, 3 + Lmax, 3).
 
     Row k has degree 2 + nmodes[k]; unused trailing coefficients are exact zeros.
     ``reuse``: M T and K T in M, K are those of this point already (only omega
     or the liquid changed since the previous point).  T from ``path_matrix``.
+    rb, rj, ra, rg: radii of body, joint, at and g (zeros for one point): the
+    enclosures then hold for every parameter value within them (a box).
     """
     n = body.shape[0]
     if not reuse:
-        _lever_arms(body, at, parent, free, J)
-        _inertia_T(body, parent, J, M)
-        _stiffness_T(body, joint, at, parent, g, free, sub, K)
+        _lever_arms(body, rb, at, ra, parent, free, J)
+        _inertia_T(body, rb, parent, J, M)
+        _stiffness_T(body, rb, joint, rj, at, ra, parent, g, rg, free, sub, K)
     P[:] = 0.0
     for k in range(n):
         L = nmodes[k]
-        omega = body[k, 5]
-        _liquid_polys(omega, E[k], kappa[k], L, q, w)
-        G = dd.mul(body[k, 2], 0.0, 0.0, omega, 0.0, 0.0)  # C_k omega_k
+        omega, romega = body[k, 5], rb[k, 5]
+        _liquid_polys(omega, romega, E[k], kappa[k], L, q, w)
+        G = dd.mul(body[k, 2], 0.0, rb[k, 2], omega, 0.0, romega)  # C_k omega_k
         for j in range(n):
             e = P[k, j]
             # P_kj = Q (lambda^2 MT_kj + lambda GT_kj - KT_kj) - T_kj lambda^2 (lambda + omega) R
@@ -216,7 +222,7 @@ def _matrix(body, joint, at, g, E, kappa, nmodes, parent, free, T, sub, J, M, K,
                 for a in range(L):
                     wa = (w[a, 0], w[a, 1], w[a, 2])
                     _set(e, a + 3, dd.add(e[a + 3, 0], e[a + 3, 1], e[a + 3, 2], *dd.neg(*wa)))
-                    _set(e, a + 2, dd.fma(e[a + 2, 0], e[a + 2, 1], e[a + 2, 2], -omega, 0.0, 0.0, *wa))
+                    _set(e, a + 2, dd.fma(e[a + 2, 0], e[a + 2, 1], e[a + 2, 2], -omega, 0.0, romega, *wa))
 
 
 @kernel
@@ -329,7 +335,8 @@ def allocate(n, lmax, degree, parent):
     T = np.empty((n, n), np.bool_)
     path_matrix(parent, T)
     sub = np.empty((n, 3))
-    return J, M, K, q, w, P, D, T, sub
+    zero, zero1 = np.zeros((n, 6)), np.zeros(n)  # the parameters' radii at a single point
+    return J, M, K, q, w, P, D, T, sub, zero, zero1
 
 
 @kernel
@@ -349,8 +356,17 @@ def same_structure(body, joint, at, g, p):
 @kernel
 def matrix_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
     """Build P = diag(Q) Phi T of one point into ws[5]; ws from ``allocate`` (with this parent)."""
-    J, M, K, q, w, P, D, T, sub = ws
-    _matrix(body, joint, at, g, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, reuse)
+    J, M, K, q, w, P, D, T, sub, zero, zero1 = ws
+    _matrix(body, zero, joint, zero1, at, zero1, g, 0.0, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, reuse)
+
+
+@kernel
+def matrix_box(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, ws):
+    """Build P of a box of parameters into ws[5]: every parameter x within its radius r (x +- r) of the
+    midpoint given (rb, rj, ra, rg: radii shaped as body, joint, at and g).  The intervals of P then hold
+    P at every point of the box.  E and kappa are points (they are never scanned)."""
+    J, M, K, q, w, P, D, T, sub, zero, zero1 = ws
+    _matrix(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, False)
 
 
 @kernel

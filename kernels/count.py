@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import dd
+from .boxcount import count_complex_pairs_box
 from .inclusion import count_complex_pairs_inclusion
 from .options import kernel
 from .scaling import nonzero_span, rescale, root_scale
@@ -46,3 +47,24 @@ def count_point(c, ws, inclusion=True):
         return nc, status
     # The exact zero roots are real, so N_c of the reduced polynomial is N_c of p.
     return count_complex_pairs_inclusion(X, d, a, z, R, group, flags)
+
+
+@kernel
+def count_box(c, ws):
+    """(N_c, status) of every polynomial in the wide interval polynomial c (a box's); ws from ``allocate_count``.
+
+    The Sturm sequence proves small boxes cheaply; wider ones need the sign changes and Newton disks of
+    ``boxcount``, which chain no remainders.  UNDECIDED: the box must be split (or its points decided one by one).
+    """
+    W, X, a, z, R, group, flags = ws
+    nc, status = count_complex_pairs(c, W)
+    if status != UNDECIDED:
+        return nc, status
+    low, top = nonzero_span(c)
+    d = top - low
+    if d < 2 or not dd.certain_nonzero(c[top, 0], c[top, 1], c[top, 2]):
+        return nc, status
+    X[: d + 1] = c[low : top + 1]
+    if not rescale(X, d, root_scale(X, d)):
+        return nc, status
+    return count_complex_pairs_box(X, d, a, z, R, group[:d], flags)

@@ -148,6 +148,11 @@ def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
     table = ds[names].stack(point=dims) if dims else ds[names].expand_dims(point=[0])
     lo, hi, olo, ohi = (table[n].transpose("point", "interval").values for n in names)
     units = ds[names[0]].attrs.get("units", "")
+    gaps = None
+    if "n_undecided" in ds:  # critical files before box proofs have no gaps
+        g = ds[["n_undecided", "undecided_lower", "undecided_upper"]]
+        g = g.stack(point=dims) if dims else g.expand_dims(point=[0])
+        gaps = g["n_undecided"].values, g["undecided_lower"].transpose("point", "gap").values, g["undecided_upper"].transpose("point", "gap").values
     lines = []
     for p, label in enumerate(table["point"].values[:limit]):
         where = ", ".join(f"{d} = {v:g}" for d, v in zip(dims, label)) if dims else "the scene"
@@ -159,6 +164,11 @@ def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
         ]
         shown = f" [{unit_suffix(units).strip()}]" if unit_suffix(units) else ""
         lines.append(f"{where}: stable {along}{shown} " + ("; ".join(parts) if parts else "nowhere in the scan"))
+        if gaps is not None and gaps[0][p]:
+            n = int(gaps[0][p])
+            pieces = [f"{a:.10g} to {b:.10g}" for a, b in zip(gaps[1][p, :n][:4], gaps[2][p, :n][:4])]
+            more = f" and {n - 4} more" if n > 4 else ""
+            lines.append(f"  not proved inside {n} gap{'s' if n > 1 else ''}: " + "; ".join(pieces) + more)
     if lo.shape[0] > limit:
         lines.append(f"... and {lo.shape[0] - limit} more points in the file")
     return lines

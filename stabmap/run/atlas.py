@@ -31,7 +31,7 @@ from .chunks import (
     probe_points,
 )
 from .progress import ProgressLine, Rate, wanted
-from .tasks import evaluate_blocks, evaluate_points, point_order, probe
+from .tasks import evaluate_blocks, evaluate_points, point_order, probe, prove_boxes
 
 
 def compute(
@@ -105,6 +105,27 @@ def decide_points(run: runner.Runner, scene: SceneBase, values: dict[str, np.nda
     return out
 
 
+def decide_boxes(run: runner.Runner, scene: SceneBase, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray], *,
+                 chunk_points: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(label, proved) of boxes with corners ``lower`` and ``upper`` (``System.prove_boxes``), in tasks on ``run``.
+
+    A scene whose system proves boxes along none of its axes (``System.box_axes``) answers without a task.
+    """
+    system = systems.of(scene)
+    npts = len(next(iter(lower.values())))
+    label = system.variable(system.label)
+    out = {"label": np.full(npts, label.fill, dtype=label.dtype), "proved": np.zeros(npts, dtype=bool)}
+
+    def keep(bounds, result):
+        a, b = bounds
+        for k, v in result.items():
+            out[k][a:b] = v
+
+    if npts and system.box_axes(scene):
+        run.run(prove_boxes, scene, _Boxes(lower, upper, npts, chunk_points), keep)
+    return out["label"], out["proved"]
+
+
 class _Points:
     """A list of points, handed out as runs of consecutive points (``chunk_points`` each, or as asked)."""
 
@@ -116,6 +137,18 @@ class _Points:
         b = a + min(self.remaining, max(1, self.fixed or points))
         self.start, self.remaining = b, self.remaining - (b - a)
         return ({k: v[a:b] for k, v in self.values.items()},), (a, b), b - a
+
+
+class _Boxes(_Points):
+    """A list of boxes (their two corners), handed out as runs of consecutive boxes."""
+
+    def __init__(self, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray], npts: int, fixed: int | None):
+        super().__init__(lower, npts, fixed)
+        self.upper = upper
+
+    def take(self, points: int):
+        (lower,), (a, b), n = super().take(points)
+        return (lower, {k: v[a:b] for k, v in self.upper.items()}), (a, b), n
 
 
 class _Chunks:
@@ -312,4 +345,4 @@ class _Layout:
                         lambda: self._show(rate))
 
 
-__all__ = ["FileReport", "compute", "compute_to_file", "decide_grid", "decide_points"]
+__all__ = ["FileReport", "compute", "compute_to_file", "decide_boxes", "decide_grid", "decide_points"]

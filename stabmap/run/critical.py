@@ -4,25 +4,30 @@
 point of the scene's other grid axes, without a dense grid along ``along``:
 
 1. **Scan.** N_c is decided at every value of the ``along`` grid axis (the
-   user's ``num`` sets the scan density), for every point of the other axes.
-2. **Brackets.** Every pair of adjacent scan values with different N_c is a
-   bracket: a change of N_c certainly lies between its ends.
-3. **Bisection.** All brackets are halved together, one batch of certified
-   decisions per step (in tasks through the run's runner: threads here or a
-   dask cluster), until hi - lo <= max(rtol * max(|lo|, |hi|), atol).  A midpoint whose
-   N_c differs from both ends reveals two changes; the bracket is split in two
-   and both are followed.
-4. **Intervals.** The brackets and the scan values between them partition the
-   scan range; each maximal piece with N_c = 0 is a stable interval.
+   user's ``num`` sets where the search starts), for every point of the other axes.
+2. **Proof between scan values.** Every scan step is a segment whose two ends
+   have proved N_c.  A box proof (``System.prove_boxes``) shows that N_c is the
+   same at every value of a segment; segments it cannot prove are halved (one
+   batch of certified decisions and box proofs per step, in tasks through the
+   run's runner: threads here or a dask cluster) and their halves tried again.
+   A segment whose ends differ is a bracket of a change and is halved until
+   hi - lo <= max(rtol * max(|lo|, |hi|), atol) / 4.  So a narrow stable window or unstable band between
+   two scan values is found wherever a box proof fails around it: it makes
+   two roots meet, which no box proof can hide.
+3. **Gaps.** A segment with equal ends that is still unproved at that width,
+   or once its point of the other axes has spent its budget of box proofs
+   (BOX_BUDGET per scan step: exactly repeated roots defeat every box proof),
+   is an *undecided gap*, and is listed.  A gap next to a bracket joins it
+   (the bracket's width stays below the tolerance).
+4. **Intervals.** The brackets and the proved segments between them
+   partition the scan range outside the gaps; each maximal piece with N_c = 0
+   is a stable interval, flagged where a gap lies inside it.
 
 N_c stands for the system's label (``System.label``; for gyroscopes the number
-of complex root pairs), and "stable" for its ``stable_label``.  Every label
-involved is a proof (``System.evaluate``), so each located boundary
-lies certainly inside its final bracket, and each stable interval's stored ends
-are points proved stable (the *inner* bounds) next to points proved to have a
-different N_c (the *outer* bounds).  What is assumed is only that nothing
-happens between two scan values with equal N_c: see ``ASSUMPTION`` and
-docs/critical.md.
+of complex root pairs), and "stable" for its ``stable_label``.  A system that
+proves no boxes (``System.box_axes`` without ``along``) leaves every scan step
+with equal ends as a gap, and says so: its changes are searched for only where
+adjacent scan values differ (``POINTS_ONLY``; docs/critical.md).
 """
 
 from __future__ import annotations
@@ -39,7 +44,7 @@ from ..errors import StabmapError
 from ..store.dataset import coordinates, global_attrs
 from ..systems.base import SceneBase
 from . import runner
-from .atlas import decide_grid, decide_points
+from .atlas import decide_boxes, decide_grid, decide_points
 from .chunks import check_chunk_points
 from .progress import wanted
 
@@ -49,12 +54,21 @@ MIN_RTOL = 1e-15  # a few ulps: bisection in float64 cannot go finer anyway
 ATOL_FACTOR = 1e-6  # default atol = ATOL_FACTOR * rtol * max |scan value|, for boundaries at or near 0
 MAX_ITERATIONS = 2200  # bisection of float64 reaches adjacent floats long before (about 2100 halvings worst case)
 
-ASSUMPTION = (
-    "Changes of {label} are searched for only between adjacent scan values whose {label} differ. "
-    "Features narrower than the scan spacing are not found: a stable or unstable interval lying wholly between "
-    "two adjacent scan values, or an even number of changes within one scan step, is invisible unless a "
-    "bisection midpoint happens to land on it. Everything that is reported is {proved}: every located boundary "
-    "lies inside its bracket, whose two ends have {certified}, different {label}."
+# Box proofs that one point of the other axes may spend on segments with equal ends: BOX_BUDGET per scan step,
+# plus BOX_BUDGET_BOUNDARIES for the segments next to its boundaries (each needs a few hundred: docs/critical.md)
+BOX_BUDGET, BOX_BUDGET_BOUNDARIES = 4, 2048
+
+GUARANTEE = (
+    "Every change of {label} in the scan range is reported: between its boundaries, {label} is proved the same at "
+    "every value of the scanned parameter, except inside the undecided gaps listed (undecided_lower, undecided_upper), "
+    "and each boundary lies inside its bracket, whose two ends have proved, different {label}."
+)
+POINTS_ONLY = (
+    "This system proves {label} at points only: every scan step whose ends have equal {label} is an undecided gap, "
+    "and a feature narrower than the scan spacing (an interval wholly between two adjacent scan values, or an even "
+    "number of changes within one scan step) is found only if a bisection midpoint lands on it. Everything that is "
+    "reported is {proved}: every located boundary lies inside its bracket, whose two ends have {certified}, "
+    "different {label}."
 )
 
 
@@ -85,6 +99,8 @@ class _Counts:
 
     scan_points: int = 0
     bisection_points: int = 0
+    box_proofs: int = 0
+    boxes_proved: int = 0
     iterations: int = 0
     provenance: dict = field(default_factory=dict)  # flag value -> points it decided
 
@@ -179,9 +195,11 @@ def critical(
     t0 = time.perf_counter()
     with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run:
         nc = _scan(run, scene, index, progress, chunk_points, counts)
-        brackets = _bisect(run, scene, along, others, _initial_brackets(nc, scan), rtol, atol, chunk_points, counts)
-    ds = _dataset(system, scene, along, others, scan, nc, brackets, _proved(system))
-    ds.attrs.update(_attrs(system, along, scan, rtol, atol, counts))
+        boxes = along in system.box_axes(scene)
+        brackets, gaps = _search(run, scene, along, others, _steps(nc, scan), boxes, rtol, atol, chunk_points, counts)
+    brackets, gaps = _join(brackets, gaps, rtol, atol)
+    ds = _dataset(system, scene, along, others, scan, nc, brackets, gaps, _proved(system))
+    ds.attrs.update(_attrs(system, along, scan, rtol, atol, counts, boxes))
     ds.attrs["history"] += _history(along, counts, time.perf_counter() - t0)
     return ds
 
@@ -198,10 +216,11 @@ def _scan(run, scene, index: int, progress, chunk_points, counts: _Counts) -> np
     return np.ascontiguousarray(nc)
 
 
-def _initial_brackets(nc: np.ndarray, scan: np.ndarray) -> _Brackets:
-    """Every pair of adjacent scan values whose N_c differ."""
+def _steps(nc: np.ndarray, scan: np.ndarray) -> _Brackets:
+    """Every scan step of every point of the other axes, with the labels at its ends."""
     flat = nc.reshape(-1, scan.size)
-    owner, step = np.nonzero(flat[:, 1:] != flat[:, :-1])
+    owner, step = np.indices(flat[:, :-1].shape)
+    owner, step = owner.ravel(), step.ravel()
     return _Brackets(owner.astype(np.int64), scan[step], scan[step + 1], flat[owner, step], flat[owner, step + 1])
 
 
@@ -213,16 +232,36 @@ def _converged(b: _Brackets, rtol: float, atol: float) -> np.ndarray:
     return (width <= np.maximum(rtol * np.maximum(np.abs(b.lo), np.abs(b.hi)), atol)) | no_room
 
 
-def _bisect(run, scene, along, others, brackets: _Brackets, rtol, atol, chunk_points, counts: _Counts) -> _Brackets:
-    """Halve every bracket until converged (one batch of tasks per step); returns all final brackets."""
+def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, atol, chunk_points, counts: _Counts):
+    """Prove or halve every segment (one batch of tasks per step); returns (brackets of changes, undecided gaps).
+
+    Segments are closed intervals of ``along`` (the other axes at one grid point, ``owner``) whose ends have
+    proved labels.  A segment proved by a box proof is done; a segment whose ends differ is halved down to a
+    quarter of the tolerance (a bracket); one whose ends agree is halved while it is wider than that and its
+    owner has box proofs left, else it is a gap.  Without box proofs (``boxes`` False) the segments whose ends
+    agree are gaps at once.
+    """
     system = systems.of(scene)
     shape = tuple(len(a.values) for a in others)
-    done = []
-    active = brackets
+    npoints = max(1, math.prod(shape))
+    budget = BOX_BUDGET * np.bincount(active.owner, minlength=npoints) + BOX_BUDGET_BOUNDARIES
+    spent = np.zeros(npoints, dtype=np.int64)
+    brackets, gaps = [], []
     for _ in range(MAX_ITERATIONS):
-        finished = _converged(active, rtol, atol)
-        done.append(active.take(finished))
-        active = active.take(~finished)
+        if boxes and len(active):
+            label, proved = decide_boxes(run, scene, *_corners(others, shape, along, active), chunk_points=chunk_points)
+            counts.box_proofs += len(active)
+            counts.boxes_proved += int(proved.sum())
+            spent += np.bincount(active.owner, minlength=npoints)
+            if np.any(proved & ((label != active.nc_lo) | (label != active.nc_hi))):  # pragma: no cover - two proofs disagree
+                raise AssertionError(f"a box proof of {system.label} contradicts the proofs at its ends")
+            active = active.take(~proved)
+        differ = active.nc_lo != active.nc_hi
+        small = _converged(active, rtol / 4, atol / 4)
+        stop = small | (spent[active.owner] >= budget[active.owner]) | (not boxes)
+        brackets.append(active.take(differ & small))
+        gaps.append(active.take(~differ & stop))
+        active = active.take(~small & (differ | ~stop))
         if not len(active):
             break
         mid = active.lo + 0.5 * (active.hi - active.lo)
@@ -233,19 +272,48 @@ def _bisect(run, scene, along, others, brackets: _Brackets, rtol, atol, chunk_po
         counts.bisection_points += mid.size
         counts.decided(system, results)
         counts.iterations += 1
-        active = _halve(active, mid, results[system.label])
+        nc_mid = results[system.label]
+        active = _Brackets.concat([
+            _Brackets(active.owner, active.lo, mid, active.nc_lo, nc_mid),
+            _Brackets(active.owner, mid, active.hi, nc_mid, active.nc_hi),
+        ])
     else:  # pragma: no cover - float64 bisection always reaches neighbouring doubles first
         raise RuntimeError("bisection did not converge")
-    return _Brackets.concat(done)
+    return _Brackets.concat(brackets), _Brackets.concat(gaps)
 
 
-def _halve(b: _Brackets, mid: np.ndarray, nc_mid: np.ndarray) -> _Brackets:
-    """Keep the half whose ends differ; keep both when the midpoint differs from both ends (two changes)."""
-    left = nc_mid != b.nc_lo  # a change in (lo, mid]
-    right = nc_mid != b.nc_hi  # a change in (mid, hi]
-    lower = _Brackets(b.owner[left], b.lo[left], mid[left], b.nc_lo[left], nc_mid[left])
-    upper = _Brackets(b.owner[right], mid[right], b.hi[right], nc_mid[right], b.nc_hi[right])
-    return _Brackets.concat([lower, upper])
+def _corners(others, shape, along, seg: _Brackets) -> tuple[dict, dict]:
+    """The boxes of segments: the other axes at their owner's grid values, ``along`` from lo to hi."""
+    idx = np.unravel_index(seg.owner, shape) if shape else ()
+    fixed = {a.name: a.array[i] for a, i in zip(others, idx)}
+    return {**fixed, along: seg.lo}, {**fixed, along: seg.hi}
+
+
+def _join(brackets: _Brackets, gaps: _Brackets, rtol: float, atol: float) -> tuple[_Brackets, _Brackets]:
+    """Gaps that touch a bracket join it (they are at most a quarter of the tolerance wide); touching gaps merge."""
+    if len(gaps):
+        gaps = gaps.take(np.lexsort((gaps.lo, gaps.owner)))
+        keep = np.ones(len(gaps), dtype=bool)
+        small = _converged(gaps, rtol / 4, atol / 4)
+        lower = {(o, x): i for i, (o, x) in enumerate(zip(brackets.owner.tolist(), brackets.lo.tolist()))}
+        upper = {(o, x): i for i, (o, x) in enumerate(zip(brackets.owner.tolist(), brackets.hi.tolist()))}
+        for g in np.flatnonzero(small):
+            o = int(gaps.owner[g])
+            if (o, float(gaps.hi[g])) in lower:
+                brackets.lo[lower[(o, float(gaps.hi[g]))]] = gaps.lo[g]
+                keep[g] = False
+            elif (o, float(gaps.lo[g])) in upper:
+                brackets.hi[upper[(o, float(gaps.lo[g]))]] = gaps.hi[g]
+                keep[g] = False
+        gaps = gaps.take(keep)
+    if len(gaps) > 1:
+        # a run of gaps, each ending where the next starts, is one gap
+        starts = np.ones(len(gaps), dtype=bool)
+        starts[1:] = (gaps.owner[1:] != gaps.owner[:-1]) | (gaps.lo[1:] != gaps.hi[:-1])
+        first = np.flatnonzero(starts)
+        last = np.append(first[1:], len(gaps)) - 1
+        gaps = _Brackets(gaps.owner[first], gaps.lo[first], gaps.hi[last], gaps.nc_lo[first], gaps.nc_hi[last])
+    return brackets, gaps
 
 
 @dataclass
@@ -262,12 +330,22 @@ class _Table:
     nc_below: np.ndarray
     nc_above: np.ndarray
     start: np.ndarray  # the label at the first scan value: with the boundaries, the label everywhere in the scan
+    n_gaps: np.ndarray
+    gap_lower: np.ndarray
+    gap_upper: np.ndarray
+    whole: np.ndarray  # int8 per stable interval: 1 proved stable throughout, 0 a gap lies inside, -1 pad
 
 
-def _table(nc: np.ndarray, scan: np.ndarray, b: _Brackets, stable: int, fill: int) -> _Table:
-    """Stable intervals and boundaries of every point of the other axes."""
+def _table(nc: np.ndarray, scan: np.ndarray, b: _Brackets, gaps: _Brackets, stable: int, fill: int) -> _Table:
+    """Stable intervals, boundaries and undecided gaps of every point of the other axes."""
     flat = nc.reshape(-1, scan.size)
     npoints = flat.shape[0]
+    gaps = gaps.take(np.lexsort((gaps.lo, gaps.owner)))
+    gstarts = np.concatenate([[0], np.cumsum(np.bincount(gaps.owner, minlength=npoints))])
+    ng = max(1, int(np.diff(gstarts).max(initial=0)))
+    gslot = np.arange(len(gaps)) - gstarts[gaps.owner]
+    gap_ends = np.full((2, npoints, ng), np.nan)
+    gap_ends[0, gaps.owner, gslot], gap_ends[1, gaps.owner, gslot] = gaps.lo, gaps.hi
     b = b.take(np.lexsort((b.lo, b.owner)))
     starts = np.concatenate([[0], np.cumsum(np.bincount(b.owner, minlength=npoints))])
     intervals = [_stable_intervals(flat[p, 0], scan, b.take(slice(starts[p], starts[p + 1])), stable) for p in range(npoints)]
@@ -275,15 +353,19 @@ def _table(nc: np.ndarray, scan: np.ndarray, b: _Brackets, stable: int, fill: in
     ni = max(1, int(n_int.max(initial=0)))
     nb = max(1, int(np.diff(starts).max(initial=0)))
     ends = np.full((4, npoints, ni), np.nan)
+    whole = np.full((npoints, ni), -1, dtype=np.int8)
     for p, rows in enumerate(intervals):
+        g = gaps.take(slice(gstarts[p], gstarts[p + 1]))
         for i, row in enumerate(rows):
             ends[:, p, i] = row
+            whole[p, i] = not np.any((g.hi > row[0]) & (g.lo < row[1]))
     slot = np.arange(len(b)) - starts[b.owner]
     bounds = np.full((2, npoints, nb), np.nan)
     counts = np.full((2, npoints, nb), fill, dtype=nc.dtype)
     bounds[0, b.owner, slot], bounds[1, b.owner, slot] = b.lo, b.hi
     counts[0, b.owner, slot], counts[1, b.owner, slot] = b.nc_lo, b.nc_hi
-    return _Table(n_int, *ends, *bounds, *counts, flat[:, 0].copy())
+    n_gaps = np.diff(gstarts).astype(np.int32)
+    return _Table(n_int, *ends, *bounds, *counts, flat[:, 0].copy(), n_gaps, *gap_ends, whole)
 
 
 def _stable_intervals(nc_start: int, scan: np.ndarray, b: _Brackets, stable: int) -> list[tuple[float, float, float, float]]:
@@ -310,13 +392,13 @@ def _proved(system) -> str:
     return "proved" if system.proves_labels else "decided"
 
 
-def _dataset(system, scene, along, others, scan, nc, brackets, proved: str = "proved") -> xr.Dataset:
+def _dataset(system, scene, along, others, scan, nc, brackets, gaps, proved: str = "proved") -> xr.Dataset:
     info = system.parameter(scene, along)
     label = system.variable(system.label)
     dims = tuple(a.name for a in others)
     shape = tuple(len(a.values) for a in others)
-    t = _table(nc, scan, brackets, system.stable_label, label.fill)
-    iv, bd = dims + ("interval",), dims + ("boundary",)
+    t = _table(nc, scan, brackets, gaps, system.stable_label, label.fill)
+    iv, bd, gp = dims + ("interval",), dims + ("boundary",), dims + ("gap",)
     lab = label.name
 
     def grid(a):
@@ -342,6 +424,16 @@ def _dataset(system, scene, along, others, scan, nc, brackets, proved: str = "pr
         "boundary_upper": (bd, grid(t.b_upper), along_attrs(f"upper end of the bracket of a change of {lab}", f"{lab}_above holds here, {proved}; a change lies in (lower, upper]; NaN pads")),
         f"{lab}_below": (bd, grid(t.nc_below), count_attrs(f"{lab} at boundary_lower")),
         f"{lab}_above": (bd, grid(t.nc_above), count_attrs(f"{lab} at boundary_upper")),
+        f"{along}_stable_whole": (iv, grid(t.whole), {
+            "long_name": "stable at every value of the interval", "units": "1",
+            "flag_values": np.array([-1, 0, 1], dtype=np.int8), "flag_meanings": "pad gap_inside proved_throughout",
+            "comment": f"proved_throughout: {proved} stable at every value from lower to upper; gap_inside: {proved} "
+                       "stable at its ends and at the scan values, undecided inside the gaps that overlap it"}),
+        "n_undecided": (dims, grid(t.n_gaps), {"long_name": "number of undecided gaps in the scan range", "units": "1",
+                                               "comment": f"0: {lab} is {proved} at every value of the scan range outside the boundaries' brackets"}),
+        "undecided_lower": (gp, grid(t.gap_lower), along_attrs(
+            "lower end of an undecided gap", f"{lab} is {proved} at both ends of a gap and the same there; inside, no proof was found; NaN pads")),
+        "undecided_upper": (gp, grid(t.gap_upper), along_attrs("upper end of an undecided gap", "NaN pads")),
         f"{lab}_at_scan_start": (dims, grid(t.start), {"long_name": f"{lab} at the first scan value", "units": label.units or "1",
                                                        "comment": f"{proved}; it holds up to boundary_lower of the first boundary, "
                                                                   f"then {lab}_above of each boundary up to the next"}),
@@ -350,7 +442,7 @@ def _dataset(system, scene, along, others, scan, nc, brackets, proved: str = "pr
     return xr.Dataset(data, coords=coordinates(system, scene, skip=(along,)), attrs=attrs)
 
 
-def _attrs(system, along, scan, rtol, atol, counts: _Counts) -> dict:
+def _attrs(system, along, scan, rtol, atol, counts: _Counts, boxes: bool) -> dict:
     attrs = {
         "stabmap_kind": KIND,
         "critical_along": along,
@@ -361,9 +453,11 @@ def _attrs(system, along, scan, rtol, atol, counts: _Counts) -> dict:
         "critical_scan_max_step": float(np.diff(scan).max()),
         "critical_evaluated_points": np.int64(counts.scan_points + counts.bisection_points),
         "critical_bisection_steps": np.int64(counts.iterations),
+        "critical_box_proofs": np.int64(counts.box_proofs),
+        "critical_boxes_proved": np.int64(counts.boxes_proved),
         "comment": "Ends are located until hi - lo <= max(rtol * max(|lo|, |hi|), atol), or lo and hi are neighbouring "
-        "doubles. " + ASSUMPTION.format(label=system.label, proved=_proved(system),
-                                          certified="certified" if system.proves_labels else "decided"),
+        "doubles. " + (GUARANTEE if boxes else POINTS_ONLY).format(
+            label=system.label, proved=_proved(system), certified="certified" if system.proves_labels else "decided"),
     }
     if system.provenance is not None:
         flags = system.variable(system.provenance)
@@ -373,6 +467,7 @@ def _attrs(system, along, scan, rtol, atol, counts: _Counts) -> dict:
 
 def _history(along, counts: _Counts, seconds: float) -> str:
     return (
-        f"; critical values of {along}: {counts.scan_points} scan points and {counts.bisection_points} "
-        f"bisection points ({counts.iterations} steps) in {seconds:.1f} s"
+        f"; critical values of {along}: {counts.scan_points} scan points, {counts.bisection_points} "
+        f"bisection points ({counts.iterations} steps) and {counts.box_proofs} box proofs "
+        f"({counts.boxes_proved} proved) in {seconds:.1f} s"
     )

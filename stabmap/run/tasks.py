@@ -108,3 +108,9 @@ def evaluate_points(scene: SceneBase, values: dict[str, np.ndarray]) -> dict[str
     """Every variable at points given by equal-length 1-D arrays of grid-axis values (the other axes: fixed values)."""
     return systems.of(scene).evaluate(scene, values)
 
+
+
+def prove_boxes(scene: SceneBase, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """``System.prove_boxes`` of boxes given by equal-length 1-D arrays of their corners: {"label", "proved"}."""
+    label, proved = systems.of(scene).prove_boxes(scene, lower, upper)
+    return {"label": label, "proved": proved}

@@ -171,6 +171,21 @@ class System:
         """
         raise NotImplementedError
 
+    def prove_boxes(self, scene: SceneBase, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+        """(label, proved) of each box: ``proved[i]`` says that the label is ``label[i]`` at every point of box i.
+
+        Box i holds the points whose grid-axis values lie between ``lower[name][i]`` and ``upper[name][i]``
+        (closed, equal-length 1-D arrays; axes not named take the scene's fixed values).  A proof says that
+        the label is the same at every point of the box, so a label change cannot hide inside it; where
+        ``proved`` is False, ``label`` means nothing.  None (the default): the system proves labels at
+        points only.
+        """
+        return None
+
+    def box_axes(self, scene: SceneBase) -> set[str]:
+        """The grid axes along which ``prove_boxes`` can prove a box of this scene (default: none)."""
+        return set()
+
     def inferred(self, label: np.ndarray) -> dict[str, np.ndarray] | None:
         """The other variables of points given ``label`` without being computed (adaptive refinement).
 

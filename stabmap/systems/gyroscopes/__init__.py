@@ -103,6 +103,16 @@ class Gyroscopes(System):
         nc = nc.reshape(shape)
         return {"n_complex_pairs": nc, "stability": stability_from_pairs(nc), "decided_by": by.reshape(shape)}
 
+    def box_axes(self, scene: Scene) -> set[str]:
+        from .points import box_axes
+
+        return box_axes(scene)
+
+    def prove_boxes(self, scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+        from .decide import prove_boxes
+
+        return prove_boxes(scene, lower, upper)
+
     def class_name(self, value: int) -> str:
         if value < 0:
             return "degenerate (p \u2261 0)"

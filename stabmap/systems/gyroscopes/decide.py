@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...kernels import DECIDED_DISKS, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, decide_block
+from ...kernels import DECIDED_DISKS, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL, box_block, decide_block
 from . import exact
 from .outputs import BY_DISKS, BY_EXACT, BY_INCLUSION, BY_INERTIA, BY_STURM
-from .points import PointArrays
+from .points import PointArrays, box_arrays, box_axes
 
 _BY_STATUS = {DECIDED_INCLUSION: BY_INCLUSION, DECIDED_INERTIA: BY_INERTIA, DECIDED_DISKS: BY_DISKS, UNDECIDED: BY_EXACT}
 
@@ -40,3 +40,29 @@ def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
     if undecided.size:
         nc[undecided] = exact.decide_points(*points.kernel_args(), undecided)
     return nc, decided_by_from_status(status)
+
+
+def prove_boxes(scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(N_c int16, proved bool) of each box: N_c at every point of box i where proved[i] (``System.prove_boxes``).
+
+    Boxes that span an axis outside ``box_axes`` are not proved, and not tried.
+    """
+    npts = len(next(iter(lower.values()))) if lower else 1
+    allowed = box_axes(scene)
+    spans = np.zeros(npts, dtype=bool)
+    for key in lower:
+        if key not in allowed:
+            spans |= np.asarray(lower[key]) != np.asarray(upper[key])
+    nc = np.full(npts, -1, dtype=np.int16)
+    proved = np.zeros(npts, dtype=bool)
+    todo = np.flatnonzero(~spans)
+    if todo.size == 0:
+        return nc, proved
+    box = box_arrays(scene, {k: np.asarray(v)[todo] for k, v in lower.items()}, {k: np.asarray(v)[todo] for k, v in upper.items()})
+    count = np.empty(todo.size, dtype=np.int16)
+    status = np.empty(todo.size, dtype=np.int8)
+    box_block(*(np.require(a, requirements=("C", "W")) if isinstance(a, np.ndarray) else a for a in box.kernel_args()), count, status)
+    ok = (status != UNDECIDED) & (status != ZERO_POLYNOMIAL)
+    nc[todo[ok]] = count[ok]
+    proved[todo[ok]] = True
+    return nc, proved

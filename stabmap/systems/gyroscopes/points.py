@@ -136,3 +136,81 @@ def point_arrays(scene: Scene, values: dict[str, np.ndarray]) -> PointArrays:
         parent=parent,
         at=kernel_order(at.reshape(npts, scene.n)),
     )
+
+
+@dataclass
+class BoxArrays:
+    """Boxes of parameter points for ``kernels.box_block``: midpoints (``mid``) and radii of body, joint, g and at.
+
+    Every point of box p lies within ``rbody[p]``, ``rjoint[p]``, ``rg[p]`` and ``rat[p]`` of ``mid``'s point p,
+    slot by slot; E and kappa are the same at every point of the box.
+    """
+
+    mid: PointArrays
+    rbody: np.ndarray  # (npts, n, 6)
+    rjoint: np.ndarray  # (npts, n)
+    rg: np.ndarray  # (npts,)
+    rat: np.ndarray  # (npts, n)
+
+    def kernel_args(self):
+        m = self.mid
+        return (m.body, self.rbody, m.joint, self.rjoint, m.g, self.rg, m.E, m.kappa, m.nmodes, m.free, m.parent, m.at, self.rat)
+
+
+def box_axes(scene: Scene) -> set[str]:
+    """The grid axes along which a box can be enclosed: all but those whose kernel inputs are not monotone in them.
+
+    Every kernel input is then a copy of one scanned value, or that value minus a constant (a cavity's tail),
+    so the inputs at a box's two corners bound the inputs at every point of it.  Not enclosed: a cavity's size
+    or density (the modes depend on them), and a column (m, A, C, c) of a body whose cavity's liquid stabmap
+    adds (liquid_in_body = false: the frozen liquid moves the centre of mass with them).
+    """
+    out = set()
+    for axis in scene.grid:
+        name = parse_name(axis.name, scene.n, scene.support)
+        if name.kind == "cavity":
+            continue
+        if name.kind in ("body", "every_body") and name.symbol != "omega":
+            bodies = [scene.bodies[name.index - 1]] if name.kind == "body" else scene.bodies
+            if any(b.cavity is not None and b.cavity.geometric and not b.cavity.liquid_in_body for b in bodies):
+                continue
+        out.add(axis.name)
+    return out
+
+
+def _hull(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Midpoint and radius of a float ball holding [min(a, b), max(a, b)] widened by one ulp each side.
+
+    The widening covers a value computed from the scanned one with one rounding (a cavity's tail subtracted
+    from A): the real value at an interior point lies within an ulp of the rounded corners' hull.
+    """
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    moved = lo != hi
+    lo = np.where(moved, np.nextafter(lo, -np.inf), lo)
+    hi = np.where(moved, np.nextafter(hi, np.inf), hi)
+    mid = np.where(moved, 0.5 * lo + 0.5 * hi, lo)
+    rad = np.where(moved, np.nextafter(np.maximum(hi - mid, mid - lo), np.inf), 0.0)
+    return mid, rad
+
+
+def box_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> BoxArrays:
+    """Boxes with corners ``lower`` and ``upper`` (grid-axis values, arrays that broadcast together).
+
+    Axes missing from both are fixed at the scene's values; an axis with lower == upper is a point.  Raises
+    ValueError for an axis outside ``box_axes`` whose two corners differ.
+    """
+    if set(lower) != set(upper):
+        raise ValueError("lower and upper must name the same axes")
+    allowed = box_axes(scene)
+    for key in lower:
+        if key not in allowed and np.any(np.asarray(lower[key]) != np.asarray(upper[key])):
+            raise ValueError(f"a box cannot be enclosed along {key!r} (box_axes)")
+    lo, hi = point_arrays(scene, lower), point_arrays(scene, upper)
+    if not (np.array_equal(lo.E, hi.E) and np.array_equal(lo.kappa, hi.kappa)):  # pragma: no cover - box_axes rules it out
+        raise ValueError("the liquid modes differ across the box")
+    body, rbody = _hull(lo.body, hi.body)
+    joint, rjoint = _hull(lo.joint, hi.joint)
+    g, rg = _hull(lo.g, hi.g)
+    at, rat = _hull(lo.at, hi.at)
+    mid = PointArrays(body=body, joint=joint, g=g, E=lo.E, kappa=lo.kappa, nmodes=lo.nmodes, free=lo.free, parent=lo.parent, at=at)
+    return BoxArrays(mid, rbody, rjoint, rg, rat)
