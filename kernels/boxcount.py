@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 
 from . import dd
-from .inclusion import POLISH_SWEEPS, _aberth, _polish, _snap_real, _start
+from .inclusion import POLISH_SWEEPS, _aberth, _polish, _snap_real, _start, horner_dd
 from .options import kernel
 from .status import DECIDED_INCLUSION, UNDECIDED
 
@@ -52,17 +52,7 @@ def _sign(h, l, r):
 @kernel
 def _newton_radius(X, d, zr, zi):
     """d |p(z)| / |p'(z)| bounded above over every polynomial in X; inf where |p'(z)| may vanish."""
-    re = (X[d, 0], X[d, 1], X[d, 2])
-    im = (0.0, 0.0, 0.0)
-    dre = (0.0, 0.0, 0.0)
-    dim = (0.0, 0.0, 0.0)
-    for k in range(d - 1, -1, -1):
-        t = dd.add(*dd.mul(*dre, zr, 0.0, 0.0), *dd.neg(*dd.mul(*dim, zi, 0.0, 0.0)))
-        dim = dd.add(*dd.add(*dd.mul(*dre, zi, 0.0, 0.0), *dd.mul(*dim, zr, 0.0, 0.0)), *im)
-        dre = dd.add(*t, *re)
-        t = dd.add(*dd.mul(*re, zr, 0.0, 0.0), *dd.neg(*dd.mul(*im, zi, 0.0, 0.0)))
-        im = dd.add(*dd.mul(*re, zi, 0.0, 0.0), *dd.mul(*im, zr, 0.0, 0.0))
-        re = dd.add(*t, X[k, 0], X[k, 1], X[k, 2])
+    re, im, dre, dim = horner_dd(X, d, zr, zi)
     upper = math.hypot(abs(re[0]) * dd.ABS + re[2], abs(im[0]) * dd.ABS + im[2]) * MU
     # |p'| >= |midpoint| - radius, each part: the midpoint's modulus rounded down, the radii up
     mid = math.hypot(dre[0] + dre[1], dim[0] + dim[1]) / MU

@@ -85,13 +85,8 @@ def _value_and_slope(a, d, x):
 
 
 @kernel
-def _value_dd(X, d, zr, zi):
-    """p(z) for the interval polynomial X at the float point z, in double-double interval arithmetic.
-
-    Returns (p as a complex128 midpoint, an upper bound of |p(z)| over every
-    polynomial in the intervals, p'(z) as a complex128 midpoint).  The bound is
-    rigorous by construction of ``dd``; the derivative only steers iterations.
-    """
+def horner_dd(X, d, zr, zi):
+    """Re p(z), Im p(z), Re p'(z), Im p'(z) as dd intervals, for every polynomial in X (Horner's rule)."""
     re = (X[d, 0], X[d, 1], X[d, 2])
     im = (0.0, 0.0, 0.0)
     dre = (0.0, 0.0, 0.0)
@@ -104,6 +99,18 @@ def _value_dd(X, d, zr, zi):
         t = dd.add(*dd.mul(*re, zr, 0.0, 0.0), *dd.neg(*dd.mul(*im, zi, 0.0, 0.0)))
         im = dd.add(*dd.mul(*re, zi, 0.0, 0.0), *dd.mul(*im, zr, 0.0, 0.0))
         re = dd.add(*t, X[k, 0], X[k, 1], X[k, 2])
+    return re, im, dre, dim
+
+
+@kernel
+def _value_dd(X, d, zr, zi):
+    """p(z) for the interval polynomial X at the float point z, in double-double interval arithmetic.
+
+    Returns (p as a complex128 midpoint, an upper bound of |p(z)| over every
+    polynomial in the intervals, p'(z) as a complex128 midpoint).  The bound is
+    rigorous by construction of ``dd``; the derivative only steers iterations.
+    """
+    re, im, dre, dim = horner_dd(X, d, zr, zi)
     bre = abs(re[0]) * dd.ABS + re[2]
     bim = abs(im[0]) * dd.ABS + im[2]
     bound = math.hypot(bre, bim) * (1.0 + 4.0 * dd.U)  # hypot: the squares would underflow below 1e-154
