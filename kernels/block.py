@@ -169,12 +169,12 @@ def box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, parent,
     Box p is the set of parameter points within the radii (``rbody``, ``rjoint``, ``rg``, ``rat``,
     shaped as ``body``, ``joint``, ``g`` and ``at``, all >= 0) of the midpoint given in ``body``,
     ``joint``, ``g`` and ``at`` (layout as for ``charpoly_block``); E and kappa are exact.  The
-    coefficients of p are enclosed over the whole box, and the Sturm sequence (then, up to
-    ``LAPLACE_MAX`` bodies, root inclusion) proves one N_c for every polynomial in that enclosure:
-    every sign a count needs is proved on the whole box, so the number of real roots, the degree and
-    hence N_c cannot change inside it (docs/certification.md, "Boxes").  Writes ``out_nc``
-    (int16[npts], -1 unless decided) and ``out_status`` (int8[npts]: DECIDED_FLOAT (Sturm),
-    DECIDED_INCLUSION, ZERO_POLYNOMIAL or UNDECIDED).  A box of more than ``LAPLACE_MAX`` bodies is
+    coefficients of p are enclosed over the whole box, and ``count_box`` (the Sturm sequence, then
+    sign changes and Newton disks) proves one N_c for every polynomial in that enclosure: every sign
+    a count needs is proved on the whole box, so the number of real roots, the degree and hence N_c
+    cannot change inside it (docs/certification.md, section 6).  Writes ``out_nc`` (int16[npts], -1
+    unless decided) and ``out_status`` (int8[npts]: DECIDED_FLOAT (Sturm), DECIDED_INCLUSION (signs
+    and disks), ZERO_POLYNOMIAL or UNDECIDED).  A box of more than ``LAPLACE_MAX`` bodies is
     UNDECIDED.
     """
     npts, n = body.shape[0], body.shape[1]

@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 
 from . import dd
-from .inclusion import POLISH_SWEEPS, _aberth, _polish, _snap_real, _start, horner_dd
+from .inclusion import approximate, horner_dd
 from .options import kernel
 from .status import DECIDED_INCLUSION, UNDECIDED
 
@@ -70,17 +70,8 @@ def count_complex_pairs_box(X, d, a, z, R, order, flags):
     X should be scaled so that its roots have modulus near one (``scaling.rescale``).  Scratch: a (d + 1
     floats), z (d complex), R (d floats), order (d ints), flags (d bools).  Returns (N_c, DECIDED_INCLUSION) or (-1, UNDECIDED).
     """
-    for k in range(d + 1):
-        a[k] = X[k, 0]
-    if a[0] == 0.0 or a[d] == 0.0:
+    if not approximate(X, d, a, z, flags):
         return -1, UNDECIDED
-    _start(a, d, z)
-    _aberth(a, d, z, flags)
-    for i in range(d):
-        if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
-            return -1, UNDECIDED
-    _polish(X, d, z, POLISH_SWEEPS)
-    _snap_real(X, d, z)
     # Real approximations in increasing order.
     r = 0
     for i in range(d):

@@ -38,15 +38,28 @@ def count_point(c, ws, inclusion=True):
     nc, status = count_complex_pairs(c, W)
     if status != UNDECIDED or not inclusion:
         return nc, status
-    low, top = nonzero_span(c)
-    d = top - low
-    if d < 2 or not dd.certain_nonzero(c[top, 0], c[top, 1], c[top, 2]):
-        return nc, status
-    X[: d + 1] = c[low : top + 1]
-    if not rescale(X, d, root_scale(X, d)):
+    d = _reduced(c, X)
+    if d < 0:
         return nc, status
     # The exact zero roots are real, so N_c of the reduced polynomial is N_c of p.
     return count_complex_pairs_inclusion(X, d, a, z, R, group, flags)
+
+
+@kernel
+def _reduced(c, X):
+    """c without its exact zero roots, scaled to roots near modulus one (``rescale``), into X; returns its degree.
+
+    -1 where the root counters cannot take it: degree below 2, a leading coefficient not proved nonzero, or
+    a scaled coefficient out of the safe range.
+    """
+    low, top = nonzero_span(c)
+    d = top - low
+    if d < 2 or not dd.certain_nonzero(c[top, 0], c[top, 1], c[top, 2]):
+        return -1
+    X[: d + 1] = c[low : top + 1]
+    if not rescale(X, d, root_scale(X, d)):
+        return -1
+    return d
 
 
 @kernel
@@ -60,11 +73,7 @@ def count_box(c, ws):
     nc, status = count_complex_pairs(c, W)
     if status != UNDECIDED:
         return nc, status
-    low, top = nonzero_span(c)
-    d = top - low
-    if d < 2 or not dd.certain_nonzero(c[top, 0], c[top, 1], c[top, 2]):
-        return nc, status
-    X[: d + 1] = c[low : top + 1]
-    if not rescale(X, d, root_scale(X, d)):
+    d = _reduced(c, X)
+    if d < 0:
         return nc, status
     return count_complex_pairs_box(X, d, a, z, R, group[:d], flags)

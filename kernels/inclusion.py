@@ -241,6 +241,28 @@ def _disk_radii(X, d, z, R):
 
 
 @kernel
+def approximate(X, d, a, z, flags):
+    """Approximations z of all d roots of the interval polynomial X (scaled, no zero root); False if none.
+
+    Aberth iterations on the midpoints a from Bini's start, polished in double-double, simple real roots
+    put exactly on the axis.  They prove nothing: a poor one only makes a disk or a separator useless.
+    Scratch: a (d + 1 floats), flags (d bools).
+    """
+    for k in range(d + 1):
+        a[k] = X[k, 0]
+    if a[0] == 0.0 or a[d] == 0.0:
+        return False
+    _start(a, d, z)
+    _aberth(a, d, z, flags)
+    for i in range(d):
+        if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
+            return False
+    _polish(X, d, z, POLISH_SWEEPS)
+    _snap_real(X, d, z)
+    return True
+
+
+@kernel
 def count_complex_pairs_inclusion(X, d, a, z, R, group, flags):
     """N_c of the interval polynomial X (rows 0..d, (hi, lo, rad), no zero root) by root inclusion.
 
@@ -248,17 +270,8 @@ def count_complex_pairs_inclusion(X, d, a, z, R, group, flags):
     two, as ``sturm._rescale``).  Scratch: a (d + 1 floats), z (d complex),
     R (d floats), group (2 d ints), flags (d bools).  Returns (N_c, status).
     """
-    for k in range(d + 1):
-        a[k] = X[k, 0]
-    if a[0] == 0.0 or a[d] == 0.0:
+    if not approximate(X, d, a, z, flags):
         return -1, UNDECIDED
-    _start(a, d, z)
-    _aberth(a, d, z, flags)
-    for i in range(d):
-        if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
-            return -1, UNDECIDED
-    _polish(X, d, z, POLISH_SWEEPS)
-    _snap_real(X, d, z)
     if not _disk_radii(X, d, z, R):
         return -1, UNDECIDED
     parent, size = group[:d], group[d : 2 * d]

@@ -265,10 +265,7 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
         if not len(active):
             break
         mid = active.lo + 0.5 * (active.hi - active.lo)
-        idx = np.unravel_index(active.owner, shape) if shape else ()
-        values = {a.name: a.array[i] for a, i in zip(others, idx)}
-        values[along] = mid
-        results = decide_points(run, scene, values, chunk_points=chunk_points)
+        results = decide_points(run, scene, {**_owners(others, shape, active.owner), along: mid}, chunk_points=chunk_points)
         counts.bisection_points += mid.size
         counts.decided(system, results)
         counts.iterations += 1
@@ -282,10 +279,15 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
     return _Brackets.concat(brackets), _Brackets.concat(gaps)
 
 
+def _owners(others, shape, owner: np.ndarray) -> dict[str, np.ndarray]:
+    """The values of the other axes at the grid points ``owner`` (flat indices into them)."""
+    idx = np.unravel_index(owner, shape) if shape else ()
+    return {a.name: a.array[i] for a, i in zip(others, idx)}
+
+
 def _corners(others, shape, along, seg: _Brackets) -> tuple[dict, dict]:
     """The boxes of segments: the other axes at their owner's grid values, ``along`` from lo to hi."""
-    idx = np.unravel_index(seg.owner, shape) if shape else ()
-    fixed = {a.name: a.array[i] for a, i in zip(others, idx)}
+    fixed = _owners(others, shape, seg.owner)
     return {**fixed, along: seg.lo}, {**fixed, along: seg.hi}
 
 

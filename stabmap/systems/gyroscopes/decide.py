@@ -7,7 +7,7 @@ import numpy as np
 from ...kernels import DECIDED_DISKS, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL, box_block, decide_block
 from . import exact
 from .outputs import BY_DISKS, BY_EXACT, BY_INCLUSION, BY_INERTIA, BY_STURM
-from .points import PointArrays, box_arrays, box_axes
+from .points import BoxArrays, PointArrays, box_arrays, unenclosed
 
 _BY_STATUS = {DECIDED_INCLUSION: BY_INCLUSION, DECIDED_INERTIA: BY_INERTIA, DECIDED_DISKS: BY_DISKS, UNDECIDED: BY_EXACT}
 
@@ -20,8 +20,8 @@ def decided_by_from_status(status: np.ndarray) -> np.ndarray:
     return by
 
 
-def kernel_args(points: PointArrays) -> tuple:
-    """``points.kernel_args()`` as writable C-contiguous arrays: the types ``pip install`` compiled the kernel for.
+def kernel_args(points: PointArrays | BoxArrays) -> tuple:
+    """``points.kernel_args()`` as writable C-contiguous arrays: the types ``pip install`` compiled the kernels for.
 
     A read-only or strided array (a broadcast view, say) is another numba signature, and
     so a second compilation of the whole kernel on the first call (about 20 s); copying
@@ -48,11 +48,9 @@ def prove_boxes(scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray
     Boxes that span an axis outside ``box_axes`` are not proved, and not tried.
     """
     npts = len(next(iter(lower.values()))) if lower else 1
-    allowed = box_axes(scene)
     spans = np.zeros(npts, dtype=bool)
-    for key in lower:
-        if key not in allowed:
-            spans |= np.asarray(lower[key]) != np.asarray(upper[key])
+    for outside in unenclosed(scene, lower, upper).values():
+        spans |= outside
     nc = np.full(npts, -1, dtype=np.int16)
     proved = np.zeros(npts, dtype=bool)
     todo = np.flatnonzero(~spans)
@@ -61,7 +59,7 @@ def prove_boxes(scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray
     box = box_arrays(scene, {k: np.asarray(v)[todo] for k, v in lower.items()}, {k: np.asarray(v)[todo] for k, v in upper.items()})
     count = np.empty(todo.size, dtype=np.int16)
     status = np.empty(todo.size, dtype=np.int8)
-    box_block(*(np.require(a, requirements=("C", "W")) if isinstance(a, np.ndarray) else a for a in box.kernel_args()), count, status)
+    box_block(*kernel_args(box), count, status)
     ok = (status != UNDECIDED) & (status != ZERO_POLYNOMIAL)
     nc[todo[ok]] = count[ok]
     proved[todo[ok]] = True

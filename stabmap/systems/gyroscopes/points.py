@@ -178,6 +178,12 @@ def box_axes(scene: Scene) -> set[str]:
     return out
 
 
+def unenclosed(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """For each axis outside ``box_axes``: which boxes span it (their two corners differ there)."""
+    allowed = box_axes(scene)
+    return {key: np.asarray(lower[key]) != np.asarray(upper[key]) for key in lower if key not in allowed}
+
+
 def _hull(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Midpoint and radius of a float ball holding [min(a, b), max(a, b)] widened by one ulp each side.
 
@@ -201,9 +207,8 @@ def box_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
     """
     if set(lower) != set(upper):
         raise ValueError("lower and upper must name the same axes")
-    allowed = box_axes(scene)
-    for key in lower:
-        if key not in allowed and np.any(np.asarray(lower[key]) != np.asarray(upper[key])):
+    for key, spans in unenclosed(scene, lower, upper).items():
+        if np.any(spans):
             raise ValueError(f"a box cannot be enclosed along {key!r} (box_axes)")
     lo, hi = point_arrays(scene, lower), point_arrays(scene, upper)
     if not (np.array_equal(lo.E, hi.E) and np.array_equal(lo.kappa, hi.kappa)):  # pragma: no cover - box_axes rules it out
