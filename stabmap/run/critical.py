@@ -248,14 +248,18 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
     spent = np.zeros(npoints, dtype=np.int64)
     brackets, gaps = [], []
     for _ in range(MAX_ITERATIONS):
-        if boxes and len(active):
-            label, proved = decide_boxes(run, scene, *_corners(others, shape, along, active), chunk_points=chunk_points)
-            counts.box_proofs += len(active)
+        same = np.flatnonzero(active.nc_lo == active.nc_hi)  # a segment whose ends differ has no one label to prove
+        if boxes and same.size:
+            tried = active.take(same)
+            label, proved = decide_boxes(run, scene, *_corners(others, shape, along, tried), chunk_points=chunk_points)
+            counts.box_proofs += same.size
             counts.boxes_proved += int(proved.sum())
-            spent += np.bincount(active.owner, minlength=npoints)
-            if np.any(proved & ((label != active.nc_lo) | (label != active.nc_hi))):  # pragma: no cover - two proofs disagree
+            spent += np.bincount(tried.owner, minlength=npoints)
+            if np.any(proved & (label != tried.nc_lo)):  # pragma: no cover - two proofs disagree
                 raise AssertionError(f"a box proof of {system.label} contradicts the proofs at its ends")
-            active = active.take(~proved)
+            keep = np.ones(len(active), dtype=bool)
+            keep[same[proved]] = False
+            active = active.take(keep)
         differ = active.nc_lo != active.nc_hi
         small = _converged(active, rtol / 4, atol / 4)
         stop = small | (spent[active.owner] >= budget[active.owner]) | (not boxes)
