@@ -15,9 +15,17 @@ remainders, and its widths grow with every one, so it proves only tiny boxes.  T
   again.
 
 If the two bounds add up to the degree d, both are exact for every member: N_c is proved for every
-polynomial in the enclosure, so for every parameter point of the box (docs/certification.md, "Boxes").
+polynomial in the enclosure, so for every parameter point of the box (docs/certification.md, section 6).
 The approximations (Aberth iterations on the midpoint polynomial) prove nothing themselves: a poor one
 only leaves the box undecided, and the caller splits it.
+
+**Polynomial in one parameter.** Where p is a polynomial of degree < N in one parameter u of the box (the
+spin-scaled model: degree <= n in u = 1 / omega^2), its coefficients are enclosed at N nodes u_k instead,
+each as narrowly as at a point.  Every value the count needs (p(s), p(z), p'(z)) is then a polynomial of
+degree < N in u, equal to its interpolant through the N nodes: the divided differences of the node values,
+in ``dd`` intervals, and the Newton form evaluated on the interval of u enclose it over the whole box.  This
+follows the values themselves, where Horner's rule on independent coefficient intervals would add up their
+widths (the coefficients move together).  One node (N = 1) is the plain enclosure.
 """
 
 from __future__ import annotations
@@ -42,6 +50,22 @@ def _real_value(X, d, x):
 
 
 @kernel
+def over_box(F, N, u, um, ur):
+    """Enclosure over u in [um - ur, um + ur] of the polynomial of degree < N whose values at the nodes u[:N]
+    lie in F[:N] (dd intervals); F is overwritten by the divided differences.  N = 1: F[0] itself."""
+    for j in range(1, N):
+        for i in range(N - 1, j - 1, -1):
+            t = dd.add(F[i, 0], F[i, 1], F[i, 2], *dd.neg(F[i - 1, 0], F[i - 1, 1], F[i - 1, 2]))
+            sh, sl = dd.two_sum(u[i], -u[i - j])  # the nodes are floats: their difference is exact
+            F[i, 0], F[i, 1], F[i, 2] = dd.div(*t, sh, sl, 0.0)
+    acc = (F[N - 1, 0], F[N - 1, 1], F[N - 1, 2])
+    for j in range(N - 2, -1, -1):
+        sh, sl = dd.two_sum(um, -u[j])
+        acc = dd.fma(F[j, 0], F[j, 1], F[j, 2], sh, sl, ur, *acc)
+    return acc
+
+
+@kernel
 def _sign(h, l, r):
     """+1 or -1 if the interval excludes zero, else 0."""
     if not dd.certain_nonzero(h, l, r):
@@ -50,10 +74,23 @@ def _sign(h, l, r):
 
 
 @kernel
-def _newton_radius(X, d, zr, zi):
-    """d |p(z)| / |p'(z)| bounded above over every polynomial in X; inf where |p'(z)| may vanish."""
-    re, im, dre, dim = horner_dd(X, d, zr, zi)
-    upper = math.hypot(abs(re[0]) * dd.ABS + re[2], abs(im[0]) * dd.ABS + im[2]) * MU
+def _upper(h, l, r):
+    """An upper bound of |x| over the interval."""
+    return abs(h) * dd.ABS + r
+
+
+@kernel
+def _newton_radius(X, N, u, um, ur, d, zr, zi, F):
+    """d |p(z)| / |p'(z)| bounded above over every polynomial of the box; inf where |p'(z)| may vanish."""
+    for k in range(N):
+        re, im, dre, dim = horner_dd(X[k], d, zr, zi)
+        for part, v in enumerate((re, im, dre, dim)):
+            F[part, k, 0], F[part, k, 1], F[part, k, 2] = v
+    re = over_box(F[0], N, u, um, ur)
+    im = over_box(F[1], N, u, um, ur)
+    dre = over_box(F[2], N, u, um, ur)
+    dim = over_box(F[3], N, u, um, ur)
+    upper = math.hypot(_upper(*re), _upper(*im)) * MU
     # |p'| >= |midpoint| - radius, each part: the midpoint's modulus rounded down, the radii up
     mid = math.hypot(dre[0] + dre[1], dim[0] + dim[1]) / MU
     rad = (abs(dre[1]) + dre[2] + abs(dim[1]) + dim[2]) * MU + 8.0 * dd.U * (abs(dre[0]) + abs(dim[0]))
@@ -64,13 +101,16 @@ def _newton_radius(X, d, zr, zi):
 
 
 @kernel
-def count_complex_pairs_box(X, d, a, z, R, order, flags):
-    """N_c of every polynomial in the interval polynomial X (rows 0..d, no zero root, lc proved nonzero).
+def count_complex_pairs_box(X, N, u, um, ur, d, a, z, R, order, flags, F):
+    """N_c of every polynomial of a box: X[:N] (rows 0..d each, no zero root, lc proved nonzero and the same)
+    enclose p at the nodes u[:N] of a parameter in [um - ur, um + ur], p of degree < N in it (module docstring);
+    N = 1: X[0] encloses p over the whole box.
 
-    X should be scaled so that its roots have modulus near one (``scaling.rescale``).  Scratch: a (d + 1
-    floats), z (d complex), R (d floats), order (d ints), flags (d bools).  Returns (N_c, DECIDED_INCLUSION) or (-1, UNDECIDED).
+    The polynomials should share one exact power-of-two scaling that puts the roots near modulus one
+    (``scaling.rescale``).  Scratch: a (d + 1 floats), z (d complex), R (d floats), order (d ints), flags (d
+    bools), F (4, N, 3).  Returns (N_c, DECIDED_INCLUSION) or (-1, UNDECIDED).
     """
-    if not approximate(X, d, a, z, flags):
+    if not approximate(X[N // 2], d, a, z, flags):
         return -1, UNDECIDED
     # Real approximations in increasing order.
     r = 0
@@ -79,15 +119,17 @@ def count_complex_pairs_box(X, d, a, z, R, order, flags):
             R[r] = z[i].real
             r += 1
     R[:r].sort()
-    lead = 1 if X[d, 0] > 0.0 else -1
+    lead = 1 if X[0, d, 0] > 0.0 else -1
     previous = lead if d % 2 == 0 else -lead  # the sign of p at -inf
     real = 0
     for j in range(r):
         if j == r - 1:
             s = lead  # at +inf
         else:
-            h, l, rad = _real_value(X, d, 0.5 * R[j] + 0.5 * R[j + 1])
-            s = _sign(h, l, rad)
+            x = 0.5 * R[j] + 0.5 * R[j + 1]
+            for k in range(N):
+                F[0, k, 0], F[0, k, 1], F[0, k, 2] = _real_value(X[k], d, x)
+            s = _sign(*over_box(F[0], N, u, um, ur))
         if s == 0:
             return -1, UNDECIDED
         if s != previous:
@@ -99,7 +141,7 @@ def count_complex_pairs_box(X, d, a, z, R, order, flags):
     k = 0
     for i in range(d):
         if z[i].imag > 0.0:
-            rho = _newton_radius(X, d, z[i].real, z[i].imag)
+            rho = _newton_radius(X, N, u, um, ur, d, z[i].real, z[i].imag, F)
             if not rho * MU < z[i].imag:
                 return -1, UNDECIDED
             for j in range(k):

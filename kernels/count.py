@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import dd
-from .boxcount import count_complex_pairs_box
+from .boxcount import over_box, count_complex_pairs_box
 from .inclusion import count_complex_pairs_inclusion
 from .options import kernel
-from .scaling import nonzero_span, rescale, root_scale
-from .status import UNDECIDED
+from .scaling import nonzero_span, rescale, rescale_by, root_scale
+from .status import DECIDED_INCLUSION, UNDECIDED, ZERO_POLYNOMIAL
 from .sturm import count_complex_pairs
 
 
@@ -76,4 +78,40 @@ def count_box(c, ws):
     d = _reduced(c, X)
     if d < 0:
         return nc, status
-    return count_complex_pairs_box(X, d, a, z, R, group[:d], flags)
+    one = np.zeros(1)
+    return count_complex_pairs_box(X.reshape((1,) + X.shape), 1, one, 0.0, 0.0, d, a, z, R, group[:d], flags, np.empty((4, 1, 3)))
+
+
+@kernel
+def count_nodes(C, N, u, um, ur, ws, Xn, F):
+    """(N_c, status) of every polynomial of a box whose coefficients are polynomials of degree < N in a parameter
+    u in [um - ur, um + ur], enclosed at the nodes u[:N] in C[:N] (``boxcount``, "Polynomial in one parameter").
+
+    ws from ``allocate_count``; Xn (N, deg + 1, 3) and F (4, N, 3) are scratch.  Coefficients that are exact
+    zeros at every node are zero for every u (a polynomial of degree < N with N zeros), so the exact zero roots
+    and the degree are the box's.
+    """
+    W, X, a, z, R, group, flags = ws
+    low, top = C.shape[1], -1
+    for k in range(N):
+        lk, tk = nonzero_span(C[k])
+        if tk >= 0:
+            low, top = min(low, lk), max(top, tk)
+    if top < 0:
+        return -1, ZERO_POLYNOMIAL
+    d = top - low
+    for k in range(N):
+        F[0, k, 0], F[0, k, 1], F[0, k, 2] = C[k, top, 0], C[k, top, 1], C[k, top, 2]
+    if not dd.certain_nonzero(*over_box(F[0], N, u, um, ur)):
+        return -1, UNDECIDED
+    if d < 2:  # a real polynomial of degree 0 or 1 has only real roots
+        return 0, DECIDED_INCLUSION
+    mid = N // 2
+    for k in range(N):
+        Xn[k, : d + 1] = C[k, low : top + 1]
+    shift = root_scale(Xn[mid], d)
+    e = math.frexp(Xn[mid, d, 0])[1] + shift * d
+    for k in range(N):
+        if not rescale_by(Xn[k], d, shift, e):
+            return -1, UNDECIDED
+    return count_complex_pairs_box(Xn, N, u, um, ur, d, a, z, R, group[:d], flags, F)

@@ -37,7 +37,12 @@ def rescale(X, deg, lam_shift):
     grows by the largest possible rounding error, so the interval still
     encloses the scaled coefficient.
     """
-    e = math.frexp(X[deg, 0])[1] + lam_shift * deg
+    return rescale_by(X, deg, lam_shift, math.frexp(X[deg, 0])[1] + lam_shift * deg)
+
+
+@kernel
+def rescale_by(X, deg, lam_shift, e):
+    """``rescale`` with the exponent e of the scale given (p -> 2**-e p), so that several polynomials can share it."""
     for i in range(deg + 1):
         s = lam_shift * i - e
         X[i, 0] = math.ldexp(X[i, 0], s)

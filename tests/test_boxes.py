@@ -48,11 +48,9 @@ def test_the_window_between_two_scan_values_is_found_and_located():
     assert ds["omega_stable_lower"].values[0] == pytest.approx(EXACT_BOUNDARIES[0], abs=1e-6)
     assert ds["omega_stable_upper"].values[0] == pytest.approx(EXACT_BOUNDARIES[1], abs=1e-6)
     assert "features narrower" not in ds.attrs["comment"]
-    # every gap is reported with equal N_c at its ends, and nothing else is undecided
-    n = int(ds["n_undecided"])
-    ends = np.concatenate([ds["undecided_lower"].values[:n], ds["undecided_upper"].values[:n]])
-    at_ends = _exact(from_dict(WINDOW), {"omega": ends})
-    assert np.array_equal(at_ends[:n], at_ends[n:])
+    # the spin-scaled box proofs leave nothing undecided: both intervals are stable at every value
+    assert int(ds["n_undecided"]) == 0
+    assert ds["omega_stable_whole"].values.tolist() == [1, 1]
 
 
 def _scenes():
@@ -77,6 +75,7 @@ def _scenes():
 
 def test_a_proved_box_has_its_label_at_random_interior_points_in_exact_arithmetic():
     checked = 0
+    spin_scaled = [0, 0]  # proved boxes that move omega (the spin-scaled model), and that do not
     for system, rng in _scenes():
         n = len(system["bodies"])
         axes = {"omega": (1.0, 120.0), "m_1": (0.3, 3.0)}
@@ -91,14 +90,17 @@ def test_a_proved_box_has_its_label_at_random_interior_points_in_exact_arithmeti
             a = rng.uniform(lo, hi, nbox)
             w = (hi - lo) * 10.0 ** rng.uniform(-5, -1, nbox)
             lower[name], upper[name] = a, a + w
+        upper["omega"][::2] = lower["omega"][::2]  # every other box at one spin rate: not spin-scaled
         nc, proved = prove_boxes(scene, lower, upper)
+        spin_scaled[0] += int(proved[1::2].sum())
+        spin_scaled[1] += int(proved[::2].sum())
         for i in np.flatnonzero(proved):
             t = rng.random((4, len(axes)))
             t[0], t[1] = 0.0, 1.0  # two corners, then random interior points
             values = {name: lower[name][i] + t[:, d] * (upper[name][i] - lower[name][i]) for d, name in enumerate(axes)}
             assert np.all(_exact(scene, values) == nc[i]), (system, i)
             checked += 1
-    assert checked >= 60
+    assert checked >= 60 and min(spin_scaled) >= 20, spin_scaled
 
 
 def test_box_arrays_hold_the_kernel_inputs_of_every_interior_point():
@@ -110,9 +112,15 @@ def test_box_arrays_hold_the_kernel_inputs_of_every_interior_point():
     box = box_arrays(scene, lower, upper)
     t = rng.random((50, 3))
     inside = point_arrays(scene, {k: lower[k] + t[:, d] * (upper[k] - lower[k]) for d, k in enumerate(lower)})
-    for got, mid, rad in ((inside.body, box.mid.body, box.rbody), (inside.joint, box.mid.joint, box.rjoint),
+    # omega moves and every body follows it: the box is spin-scaled, its spin column 1 and u = 1/omega^2 in range
+    assert np.all(box.mid.body[..., 5] == 1.0) and np.all(box.rbody[..., 5] == 0.0)
+    assert np.all((box.u_lo <= 1.0 / inside.body[:, 0, 5] ** 2) & (1.0 / inside.body[:, 0, 5] ** 2 <= box.u_hi))
+    for got, mid, rad in ((inside.body[..., :5], box.mid.body[..., :5], box.rbody[..., :5]), (inside.joint, box.mid.joint, box.rjoint),
                           (inside.at, box.mid.at, box.rat), (inside.g, box.mid.g, box.rg)):
         assert np.all(np.abs(got - mid) <= rad)
+    # with omega fixed, the box is not scaled and holds the spin column as it is
+    fixed = box_arrays(scene, dict(lower, omega=lower["omega"]), dict(upper, omega=lower["omega"]))
+    assert np.isnan(fixed.u_lo).all() and np.all(fixed.mid.body[..., 5] == lower["omega"][0])
 
 
 def test_cavity_sizes_are_not_enclosed_so_their_boxes_are_not_proved():

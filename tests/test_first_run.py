@@ -128,14 +128,16 @@ def test_atlas_refine_and_critical_call_only_the_precompiled_signatures():
     code = """
         import json
         import stabmap
-        from stabmap.kernels import box_block, decide_block, precompile
+        from stabmap.kernels import box_block, decide_block, precompile, spin_box_block
         from stabmap.scene.grid import resample
         scene = stabmap.example("paper-n3-fixed")
         small = resample(scene, **{a.name: 9 for a in scene.grid})
         stabmap.compute_atlas(small, progress=False, threads=1)
         stabmap.compute_refined(resample(scene, **{a.name: 17 for a in scene.grid}), progress=False, threads=1)
-        stabmap.critical(small, "omega", progress=False, threads=1)
-        print(json.dumps({"called": sorted(map(str, decide_block.signatures + box_block.signatures)),
+        stabmap.critical(small, "omega", progress=False, threads=1)  # spin-scaled boxes
+        stabmap.critical(small, small.grid[1].name, progress=False, threads=1)  # boxes at one spin rate
+        called = decide_block.signatures + box_block.signatures + spin_box_block.signatures
+        print(json.dumps({"called": sorted(map(str, called)),
                           "precompiled": sorted(str(sig) for _, sig in precompile.signatures())}))
     """
     out = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True, timeout=600,

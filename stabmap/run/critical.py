@@ -296,22 +296,32 @@ def _corners(others, shape, along, seg: _Brackets) -> tuple[dict, dict]:
 
 
 def _join(brackets: _Brackets, gaps: _Brackets, rtol: float, atol: float) -> tuple[_Brackets, _Brackets]:
-    """Gaps that touch a bracket join it (they are at most a quarter of the tolerance wide); touching gaps merge."""
+    """Gaps that touch a bracket join it while it stays within the tolerance (a gap next to a bracket is at most a
+    quarter of it wide, and may be one of a chain); touching gaps merge."""
     if len(gaps):
-        gaps = gaps.take(np.lexsort((gaps.lo, gaps.owner)))
         keep = np.ones(len(gaps), dtype=bool)
-        small = _converged(gaps, rtol / 4, atol / 4)
-        lower = {(o, x): i for i, (o, x) in enumerate(zip(brackets.owner.tolist(), brackets.lo.tolist()))}
-        upper = {(o, x): i for i, (o, x) in enumerate(zip(brackets.owner.tolist(), brackets.hi.tolist()))}
-        for g in np.flatnonzero(small):
-            o = int(gaps.owner[g])
-            if (o, float(gaps.hi[g])) in lower:
-                brackets.lo[lower[(o, float(gaps.hi[g]))]] = gaps.lo[g]
-                keep[g] = False
-            elif (o, float(gaps.lo[g])) in upper:
-                brackets.hi[upper[(o, float(gaps.lo[g]))]] = gaps.hi[g]
-                keep[g] = False
+        small = np.flatnonzero(_converged(gaps, rtol / 4, atol / 4))
+        ends = {"lo": {(o, x): i for i, (o, x) in enumerate(zip(brackets.owner.tolist(), brackets.lo.tolist()))},
+                "hi": {(o, x): i for i, (o, x) in enumerate(zip(brackets.owner.tolist(), brackets.hi.tolist()))}}
+        changed = True
+        while changed:  # a chain of gaps joins one by one, from the bracket outwards
+            changed = False
+            for g in small[keep[small]]:
+                o = int(gaps.owner[g])
+                for side, touch, new in (("lo", gaps.hi[g], gaps.lo[g]), ("hi", gaps.lo[g], gaps.hi[g])):
+                    i = ends[side].get((o, float(touch)))
+                    if i is None:
+                        continue
+                    grown = brackets.take([i])
+                    getattr(grown, side)[0] = new
+                    if _converged(grown, rtol, atol)[0]:
+                        getattr(brackets, side)[i] = new
+                        del ends[side][(o, float(touch))]
+                        ends[side][(o, float(new))] = i
+                        keep[g], changed = False, True
+                        break
         gaps = gaps.take(keep)
+        gaps = gaps.take(np.lexsort((gaps.lo, gaps.owner)))
     if len(gaps) > 1:
         # a run of gaps, each ending where the next starts, is one gap
         starts = np.ones(len(gaps), dtype=bool)

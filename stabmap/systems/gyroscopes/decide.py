@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...kernels import DECIDED_DISKS, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL, box_block, decide_block
+from ...kernels import DECIDED_DISKS, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL, box_block, decide_block, spin_box_block
 from . import exact
 from .outputs import BY_DISKS, BY_EXACT, BY_INCLUSION, BY_INERTIA, BY_STURM
 from .points import BoxArrays, PointArrays, box_arrays, unenclosed
@@ -57,10 +57,18 @@ def prove_boxes(scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray
     if todo.size == 0:
         return nc, proved
     box = box_arrays(scene, {k: np.asarray(v)[todo] for k, v in lower.items()}, {k: np.asarray(v)[todo] for k, v in upper.items()})
-    count = np.empty(todo.size, dtype=np.int16)
-    status = np.empty(todo.size, dtype=np.int8)
-    box_block(*kernel_args(box), count, status)
-    ok = (status != UNDECIDED) & (status != ZERO_POLYNOMIAL)
-    nc[todo[ok]] = count[ok]
-    proved[todo[ok]] = True
+    spin = np.isfinite(box.u_lo)
+    for rows, scaled in ((np.flatnonzero(spin), True), (np.flatnonzero(~spin), False)):
+        if rows.size == 0:
+            continue
+        part = box.take(rows)
+        count = np.empty(rows.size, dtype=np.int16)
+        status = np.empty(rows.size, dtype=np.int8)
+        if scaled:
+            spin_box_block(*kernel_args(part), part.u_lo, part.u_hi, count, status)
+        else:
+            box_block(*kernel_args(part), count, status)
+        ok = (status != UNDECIDED) & (status != ZERO_POLYNOMIAL)
+        nc[todo[rows[ok]]] = count[ok]
+        proved[todo[rows[ok]]] = True
     return nc, proved

@@ -151,8 +151,18 @@ class BoxArrays:
     rjoint: np.ndarray  # (npts, n)
     rg: np.ndarray  # (npts,)
     rat: np.ndarray  # (npts, n)
+    # the spin-scaled boxes (``spin_scaled``): u = 1 / omega^2 in [u_lo, u_hi], the spin column 1; NaN elsewhere
+    u_lo: np.ndarray  # (npts,)
+    u_hi: np.ndarray  # (npts,)
+
+    def take(self, rows: np.ndarray) -> BoxArrays:
+        m = self.mid
+        mid = PointArrays(body=m.body[rows], joint=m.joint[rows], g=m.g[rows], E=m.E[rows], kappa=m.kappa[rows],
+                          nmodes=m.nmodes, free=m.free, parent=m.parent, at=m.at[rows])
+        return BoxArrays(mid, *(getattr(self, f)[rows] for f in ("rbody", "rjoint", "rg", "rat", "u_lo", "u_hi")))
 
     def kernel_args(self):
+        """Arguments of ``kernels.box_block``, and with u_lo and u_hi of ``kernels.spin_box_block``."""
         m = self.mid
         return (m.body, self.rbody, m.joint, self.rjoint, m.g, self.rg, m.E, m.kappa, m.nmodes, m.free, m.parent, m.at, self.rat)
 
@@ -199,6 +209,34 @@ def _hull(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return mid, rad
 
 
+def _outward(x: np.ndarray, direction: float, steps: int = 2) -> np.ndarray:
+    """x moved ``steps`` floats towards ``direction``, except exact zeros (which stay exact)."""
+    for _ in range(steps):
+        x = np.where(x != 0.0, np.nextafter(x, direction), x)
+    return x
+
+
+def spin_scaled(lo: PointArrays, hi: PointArrays) -> tuple[np.ndarray, np.ndarray]:
+    """(u_lo, u_hi) of the boxes that every body spins through at one rate omega, not through 0; NaN elsewhere.
+
+    With lambda = omega mu, Phi(omega mu) = omega^2 Phi_1(mu) with Phi_1 the characteristic matrix at unit spin
+    whose stiffness is K / omega^2 (docs/model.md: M, G, the liquid terms and the poles all scale with omega),
+    and Q_k(omega mu) = omega^L_k Q_k^(1)(mu).  So p(omega mu; omega) = omega^D p_1(mu; u), u = 1 / omega^2,
+    whose real roots (with multiplicity) are those of p: N_c is the same.  The interval of u is rounded outward,
+    and the spin column of those rows of ``lo`` and ``hi`` (the corners' kernel inputs) is set to 1 in place.
+    """
+    w_lo = np.minimum(lo.body[..., 5], hi.body[..., 5])
+    w_hi = np.maximum(lo.body[..., 5], hi.body[..., 5])
+    one_rate = np.all(w_lo == w_lo[:, :1], axis=1) & np.all(w_hi == w_hi[:, :1], axis=1)
+    rows = np.flatnonzero(one_rate & (w_lo[:, 0] != w_hi[:, 0]) & ((w_lo[:, 0] > 0.0) | (w_hi[:, 0] < 0.0)))
+    u_lo, u_hi = np.full(w_lo.shape[0], np.nan), np.full(w_lo.shape[0], np.nan)
+    near = np.minimum(np.abs(w_lo[rows, 0]), np.abs(w_hi[rows, 0]))
+    far = np.maximum(np.abs(w_lo[rows, 0]), np.abs(w_hi[rows, 0]))
+    u_lo[rows], u_hi[rows] = _outward(1.0 / (far * far), -np.inf, 3), _outward(1.0 / (near * near), np.inf, 3)
+    lo.body[rows, :, 5] = hi.body[rows, :, 5] = 1.0
+    return u_lo, u_hi
+
+
 def box_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> BoxArrays:
     """Boxes with corners ``lower`` and ``upper`` (grid-axis values, arrays that broadcast together).
 
@@ -213,9 +251,10 @@ def box_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
     lo, hi = point_arrays(scene, lower), point_arrays(scene, upper)
     if not (np.array_equal(lo.E, hi.E) and np.array_equal(lo.kappa, hi.kappa)):  # pragma: no cover - box_axes rules it out
         raise ValueError("the liquid modes differ across the box")
+    u_lo, u_hi = spin_scaled(lo, hi)
     body, rbody = _hull(lo.body, hi.body)
     joint, rjoint = _hull(lo.joint, hi.joint)
     g, rg = _hull(lo.g, hi.g)
     at, rat = _hull(lo.at, hi.at)
     mid = PointArrays(body=body, joint=joint, g=g, E=lo.E, kappa=lo.kappa, nmodes=lo.nmodes, free=lo.free, parent=lo.parent, at=at)
-    return BoxArrays(mid, rbody, rjoint, rg, rat)
+    return BoxArrays(mid, rbody, rjoint, rg, rat, u_lo, u_hi)
