@@ -7,7 +7,7 @@ of lambda everywhere (as ``numpy.polynomial``).  This folder is installed as
 modules import each other relatively, so they work under either name.
 """
 
-from .block import box_block, charpoly_block, count_block, decide_block, linearise_block, spin_box_block
+from .block import box_block, charpoly_block, count_block, decide_block, linearise_block, nodes_box_block
 from .status import DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL
 
 __all__ = [
@@ -16,7 +16,7 @@ __all__ = [
     "count_block",
     "decide_block",
     "linearise_block",
-    "spin_box_block",
+    "nodes_box_block",
     "DECIDED_DISKS",
     "DECIDED_FLOAT",
     "DECIDED_INERTIA",

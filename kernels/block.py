@@ -205,55 +205,37 @@ def _box_ok(body, rb):
 
 
 @kernel
-def spin_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, parent, at, rat, u_lo, u_hi, out_nc, out_status):
-    """N_c proved for every point of each of a block of boxes in the spin-scaled model, or UNDECIDED.
+def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, parent, at, rat, t, t_lo, t_hi, out_nc, out_status):
+    """N_c proved for every point of each of a block of boxes along whose main parameter p is a polynomial.
 
-    With every body spinning at one rate omega, lambda = omega mu turns p into omega^D p_1(mu), p_1 the
-    polynomial at unit spin with the stiffness K (joints and gravity) multiplied by u = 1 / omega^2; the real
-    roots are the same (docs/certification.md, section 6).  Box p: ``body`` (spin column 1), ``joint``, ``g``
-    and ``at`` within their radii as for ``box_block``, joints and g unscaled, and u in [u_lo[p], u_hi[p]].
-    Each row of P is affine in u, so every coefficient of p_1 is a polynomial of degree <= n in u: it is
-    enclosed at n + 1 Chebyshev nodes, each as narrowly as at a point, and ``count_nodes`` counts over the
-    whole interval of u.  Outputs as for ``box_block``; more than ``LAPLACE_MAX`` bodies: UNDECIDED.
+    Box p moves one parameter t over [t_lo[p], t_hi[p]] (its other parameters within their radii), and every
+    coefficient of p is a polynomial of degree < N in t.  ``t[p]`` holds N distinct nodes in that interval, and
+    ``body[p, k]``, ``joint[p, k]``, ``g[p, k]``, ``at[p, k]`` (with their radii ``rbody`` ... in the same
+    layout) the kernel inputs at node k, layouts as for ``box_block`` with a node axis after the box axis.
+    The coefficients are enclosed at each node as narrowly as at a point, and ``count_nodes`` counts over the
+    whole interval of t (docs/certification.md, section 6).  Outputs as for ``box_block``; more than
+    ``LAPLACE_MAX`` bodies: UNDECIDED.
     """
-    npts, n = body.shape[0], body.shape[1]
+    npts, N, n = body.shape[0], body.shape[1], body.shape[2]
     rowdeg = nmodes + 2
     degree = int(rowdeg.sum())
     laplace = n <= LAPLACE_MAX
     ws = allocate(n if laplace else 1, max(1, nmodes.max()), degree if laplace else 1, parent if laplace else parent[:1])
     cs = allocate_count(degree)
-    N = n + 1
     C = np.empty((N, degree + 1, 3))
     Xn = np.empty((N, degree + 1, 3))
     F = np.empty((4, N, 3))
-    u = np.empty(N)
-    jk, rjk = np.empty(n), np.empty(n)
     for p in range(npts):
         out_nc[p], out_status[p] = -1, UNDECIDED
-        if not laplace or not _box_ok(body[p], rbody[p]) or not 0.0 < u_lo[p] <= u_hi[p] < dd.LARGE:
-            continue
-        um = 0.5 * u_lo[p] + 0.5 * u_hi[p]
-        ur = np.nextafter(max(u_hi[p] - um, um - u_lo[p]), np.inf)
-        distinct = True
+        ok = laplace and t_lo[p] <= t_hi[p] and abs(t_lo[p]) < dd.LARGE and abs(t_hi[p]) < dd.LARGE
         for k in range(N):
-            u[k] = min(u_hi[p], max(u_lo[p], um + (u_hi[p] - um) * np.cos(np.pi * (2 * k + 1) / (2 * N))))
-            distinct = distinct and (k == 0 or u[k] < u[k - 1])
-        if not distinct:  # an interval of u a few floats wide: the divided differences need distinct nodes
+            # distinct nodes in decreasing order, inside the interval: the divided differences divide by their gaps
+            ok = ok and _box_ok(body[p, k], rbody[p, k]) and t_lo[p] <= t[p, k] <= t_hi[p] and (k == 0 or t[p, k] < t[p, k - 1])
+        if not ok:
             continue
+        tm = 0.5 * t_lo[p] + 0.5 * t_hi[p]
+        tr = np.nextafter(max(t_hi[p] - tm, tm - t_lo[p]), np.inf)
         for k in range(N):
-            for j in range(n):
-                jk[j], rjk[j] = _scaled(joint[p, j], rjoint[p, j], u[k])
-            gk, rgk = _scaled(g[p], rg[p], u[k])
-            matrix_box(body[p], rbody[p], jk, rjk, at[p], rat[p], gk, rgk, E[p], kappa[p], nmodes, parent, free, ws)
+            matrix_box(body[p, k], rbody[p, k], joint[p, k], rjoint[p, k], at[p, k], rat[p, k], g[p, k], rg[p, k], E[p], kappa[p], nmodes, parent, free, ws)
             block_det(ws, rowdeg, 0, n, C[k])
-        out_nc[p], out_status[p] = count_nodes(C, N, u, um, ur, cs, Xn, F)
-
-
-@kernel
-def _scaled(x, r, u):
-    """Midpoint and radius of a ball holding (x +- r) times the float u > 0; an exact zero stays exact."""
-    m = x * u
-    if x == 0.0 and r == 0.0:
-        return 0.0, 0.0
-    # |x u - fl(x u)| <= 2^-53 |fl(x u)| + the subnormal floor; r u rounded up likewise
-    return m, (abs(m) * 2.0**-52 + r * u * (1.0 + 2.0**-51)) + 2.0**-1074
+        out_nc[p], out_status[p] = count_nodes(C, N, t[p], tm, tr, cs, Xn, F)

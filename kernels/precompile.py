@@ -20,22 +20,24 @@ import numba
 import numpy as np
 
 from . import options
-from .block import box_block, decide_block, spin_box_block
+from .block import box_block, decide_block, nodes_box_block
 
 
 def signatures() -> list[tuple]:
     """Argument types of every (kernel, signature) the labelled layer calls on C arrays: ``decide_block`` for
-    points, ``box_block`` and ``spin_box_block`` for boxes (critical values)."""
+    points, ``box_block`` and ``nodes_box_block`` for boxes (critical values)."""
     npts, n, lmax = 1, 1, 1
     body, joint, g = np.empty((npts, n, 6)), np.empty((npts, n)), np.empty(npts)
     E, kappa, nmodes = np.empty((npts, n, lmax)), np.empty((npts, n, lmax)), np.empty(n, np.int64)
     parent, at = np.empty(n, np.int64), np.empty((npts, n))
     out = (np.empty(npts, np.int16), np.empty(npts, np.int8))
     args = (body, joint, g, E, kappa, nmodes, False, parent, at) + out
-    boxes = (body, body.copy(), joint, joint.copy(), g, g.copy(), E, kappa, nmodes, False, parent, at, at.copy())
-    box, spin = boxes + out, boxes + (g.copy(), g.copy()) + out  # spin: u_lo, u_hi
+    box = (body, body.copy(), joint, joint.copy(), g, g.copy(), E, kappa, nmodes, False, parent, at, at.copy()) + out
+    # nodes_box_block: the inputs at each node (a node axis after the box axis), the nodes t and t_lo, t_hi
+    b4, j3, g2, a3 = body[:, None], joint[:, None], g[:, None], at[:, None]
+    nodes = (b4, b4.copy(), j3, j3.copy(), g2, g2.copy(), E, kappa, nmodes, False, parent, a3, a3.copy(), g2.copy(), g.copy(), g.copy()) + out
     return [(decide_block, tuple(numba.typeof(a) for a in args)), (box_block, tuple(numba.typeof(a) for a in box)),
-            (spin_box_block, tuple(numba.typeof(a) for a in spin))]
+            (nodes_box_block, tuple(numba.typeof(a) for a in nodes))]
 
 
 def precompile() -> dict:

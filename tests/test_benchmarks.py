@@ -96,3 +96,16 @@ def test_bench_progress_quick(capsys):
     out = runpy.run_path(str(SCRIPTS / "bench_progress.py"))["main"](["--quick"])
     assert [r["code"] for r in out["first"]] == ["this"] and out["first"][0]["run s"] > 0
     assert "| scene | code | first line s |" in capsys.readouterr().out
+
+
+def test_bench_critical_quick(capsys):
+    out = runpy.run_path(str(SCRIPTS / "bench_critical.py"))["main"](["--quick"])
+    rows = {(r["scene"], r["way"]): r for r in out["rows"]}
+    window = "REGIONS.md case"
+    # node bisection alone misses the window between two scan values; the box proofs at nodes find it
+    # (three boundaries) and leave no gap; the plain enclosure finds it too but leaves gaps
+    assert rows[(window, "points only")]["boundaries"] == 1 and rows[(window, "points only")]["box_proofs"] == 0
+    assert rows[(window, "boxes at nodes")]["boundaries"] == 3 and rows[(window, "boxes at nodes")]["gaps"] == 0
+    assert rows[(window, "plain boxes")]["boundaries"] == 3
+    assert rows[("paper-n2-fixed", "boxes at nodes")]["gaps"] == 0
+    assert "| scene | way |" in capsys.readouterr().out

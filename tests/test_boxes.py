@@ -13,7 +13,8 @@ import stabmap
 from stabmap.run.critical import critical
 from stabmap.systems.gyroscopes import exact
 from stabmap.systems.gyroscopes.decide import prove_boxes
-from stabmap.systems.gyroscopes.points import box_arrays, box_axes, point_arrays
+from stabmap.systems.gyroscopes.boxes import BoxArrays, box_arrays, box_axes, boxes
+from stabmap.systems.gyroscopes.points import point_arrays
 from stabmap.systems.gyroscopes.scene import from_dict
 
 # Two-body fixed chain with small liquid modes: a stable window 0.108 rad/s wide near omega = 12, between two
@@ -73,54 +74,77 @@ def _scenes():
             yield scene, rng
 
 
+KINDS = ("spin-scaled", "one axis", "plain")  # box i is of kind i % 3 (boxes.boxes)
+
+
+def _random_boxes(system: dict, rng, nbox: int = 45):
+    """A scene of ``system`` with axes omega, m_1, c_1 (and K_1), and boxes of the three kinds, 1e-5 to 1e-1 wide."""
+    n = len(system["bodies"])
+    axes = {"omega": (1.0, 120.0), "m_1": (0.3, 3.0), "c_1": (-0.1, 0.2)}
+    if n > 1:
+        axes["K_1"] = (0.0, 30.0)
+    scene = from_dict(dict(system, grid={name: {"values": [lo]} for name, (lo, _) in axes.items()}))
+    lower, upper = {}, {}
+    for name, (lo, hi) in axes.items():
+        a = rng.uniform(lo, hi, nbox)
+        lower[name], upper[name] = a, a + (hi - lo) * 10.0 ** rng.uniform(-5, -1, nbox)
+    one = [k for k in axes if k != "omega" and not (scene.free and k == "m_1")]
+    for i in range(nbox):
+        if i % 3 == 0:
+            continue
+        upper["omega"][i] = lower["omega"][i]  # one spin rate: not spin-scaled
+        if i % 3 == 1:  # one mechanical axis moves
+            keep = one[rng.integers(len(one))]
+            for k in axes:
+                if k not in ("omega", keep):
+                    upper[k][i] = lower[k][i]
+    return scene, axes, lower, upper
+
+
 def test_a_proved_box_has_its_label_at_random_interior_points_in_exact_arithmetic():
-    checked = 0
-    spin_scaled = [0, 0]  # proved boxes that move omega (the spin-scaled model), and that do not
+    proved_by_kind = dict.fromkeys(KINDS, 0)
     for system, rng in _scenes():
-        n = len(system["bodies"])
-        axes = {"omega": (1.0, 120.0), "m_1": (0.3, 3.0)}
-        if n > 1:
-            axes["K_1"] = (0.0, 30.0)
-        system = dict(system, grid={name: {"values": [lo]} for name, (lo, _) in axes.items()})
-        scene = from_dict(system)
+        scene, axes, lower, upper = _random_boxes(system, rng)
         assert set(axes) <= box_axes(scene)
-        nbox = 40
-        lower, upper = {}, {}
-        for name, (lo, hi) in axes.items():
-            a = rng.uniform(lo, hi, nbox)
-            w = (hi - lo) * 10.0 ** rng.uniform(-5, -1, nbox)
-            lower[name], upper[name] = a, a + w
-        upper["omega"][::2] = lower["omega"][::2]  # every other box at one spin rate: not spin-scaled
         nc, proved = prove_boxes(scene, lower, upper)
-        spin_scaled[0] += int(proved[1::2].sum())
-        spin_scaled[1] += int(proved[::2].sum())
         for i in np.flatnonzero(proved):
             t = rng.random((4, len(axes)))
             t[0], t[1] = 0.0, 1.0  # two corners, then random interior points
             values = {name: lower[name][i] + t[:, d] * (upper[name][i] - lower[name][i]) for d, name in enumerate(axes)}
             assert np.all(_exact(scene, values) == nc[i]), (system, i)
-            checked += 1
-    assert checked >= 60 and min(spin_scaled) >= 20, spin_scaled
+            proved_by_kind[KINDS[i % 3]] += 1
+    assert min(proved_by_kind.values()) >= 20, proved_by_kind
 
 
-def test_box_arrays_hold_the_kernel_inputs_of_every_interior_point():
-    system, rng = next(_scenes())
-    system = dict(system, grid={"omega": {"values": [1.0]}, "c": {"values": [0.1]}, "m_1": {"values": [1.0]}})
-    scene = from_dict(system)
-    lower = {"omega": np.array([3.0]), "c": np.array([-0.02]), "m_1": np.array([0.7])}
-    upper = {"omega": np.array([3.5]), "c": np.array([0.2]), "m_1": np.array([0.9])}
-    box = box_arrays(scene, lower, upper)
-    t = rng.random((50, 3))
-    inside = point_arrays(scene, {k: lower[k] + t[:, d] * (upper[k] - lower[k]) for d, k in enumerate(lower)})
-    # omega moves and every body follows it: the box is spin-scaled, its spin column 1 and u = 1/omega^2 in range
-    assert np.all(box.mid.body[..., 5] == 1.0) and np.all(box.rbody[..., 5] == 0.0)
-    assert np.all((box.u_lo <= 1.0 / inside.body[:, 0, 5] ** 2) & (1.0 / inside.body[:, 0, 5] ** 2 <= box.u_hi))
-    for got, mid, rad in ((inside.body[..., :5], box.mid.body[..., :5], box.rbody[..., :5]), (inside.joint, box.mid.joint, box.rjoint),
-                          (inside.at, box.mid.at, box.rat), (inside.g, box.mid.g, box.rg)):
-        assert np.all(np.abs(got - mid) <= rad)
-    # with omega fixed, the box is not scaled and holds the spin column as it is
-    fixed = box_arrays(scene, dict(lower, omega=lower["omega"]), dict(upper, omega=lower["omega"]))
-    assert np.isnan(fixed.u_lo).all() and np.all(fixed.mid.body[..., 5] == lower["omega"][0])
+def test_each_box_goes_to_its_narrowest_enclosure_and_holds_its_points():
+    for system, rng in _scenes():
+        scene, axes, lower, upper = _random_boxes(system, rng, nbox=12)
+        parts = boxes(scene, lower, upper)
+        seen = np.concatenate([rows for rows, _ in parts])
+        assert np.array_equal(np.sort(seen), np.arange(12))  # every box once
+        for rows, part in parts:
+            kinds = {KINDS[i % 3] for i in rows}
+            if isinstance(part, BoxArrays):
+                assert kinds <= {"plain", "one axis"}  # a free system's mass is not a node axis
+                inside = point_arrays(scene, {k: lower[k][rows] + 0.37 * (upper[k][rows] - lower[k][rows]) for k in axes})
+                for got, mid, rad in ((inside.body, part.mid.body, part.rbody), (inside.joint, part.mid.joint, part.rjoint),
+                                      (inside.at, part.mid.at, part.rat), (inside.g, part.mid.g, part.rg)):
+                    assert np.all(np.abs(got - mid) <= rad)
+                continue
+            assert kinds in ({"spin-scaled"}, {"one axis"})
+            assert np.all(np.diff(part.t, axis=1) < 0) and np.all((part.t_lo[:, None] <= part.t) & (part.t <= part.t_hi[:, None]))
+            if kinds == {"spin-scaled"}:
+                # u = 1 / omega^2 of every point of the box lies in [t_lo, t_hi]; the spin column is 1
+                w = np.stack([lower["omega"][rows], upper["omega"][rows]])
+                assert np.all((part.t_lo <= 1.0 / w**2) & (1.0 / w**2 <= part.t_hi))
+                assert np.all(part.body[..., 5] == 1.0) and np.all(part.rbody[..., 5] == 0.0)
+            else:
+                # the inputs at each node are the model's at that node, exactly (radius 0)
+                i = int(rows[0])
+                axis = next(k for k in axes if lower[k][i] != upper[k][i])
+                at_nodes = point_arrays(scene, {**{k: np.repeat(lower[k][i], part.t.shape[1]) for k in axes}, axis: part.t[0]})
+                assert np.array_equal(part.body[0], at_nodes.body) and np.array_equal(part.joint[0], at_nodes.joint)
+                assert not part.rbody.any() and not part.rjoint.any()
 
 
 def test_cavity_sizes_are_not_enclosed_so_their_boxes_are_not_proved():

@@ -104,7 +104,7 @@ class Gyroscopes(System):
         return {"n_complex_pairs": nc, "stability": stability_from_pairs(nc), "decided_by": by.reshape(shape)}
 
     def box_axes(self, scene: Scene) -> set[str]:
-        from .points import box_axes
+        from .boxes import box_axes
 
         return box_axes(scene)
 

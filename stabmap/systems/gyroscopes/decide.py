@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...kernels import DECIDED_DISKS, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL, box_block, decide_block, spin_box_block
+from ...kernels import DECIDED_DISKS, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL, box_block, decide_block, nodes_box_block
 from . import exact
 from .outputs import BY_DISKS, BY_EXACT, BY_INCLUSION, BY_INERTIA, BY_STURM
-from .points import BoxArrays, PointArrays, box_arrays, unenclosed
+from .boxes import BoxArrays, NodeBoxes, boxes, unenclosed
+from .points import PointArrays
 
 _BY_STATUS = {DECIDED_INCLUSION: BY_INCLUSION, DECIDED_INERTIA: BY_INERTIA, DECIDED_DISKS: BY_DISKS, UNDECIDED: BY_EXACT}
 
@@ -20,7 +21,7 @@ def decided_by_from_status(status: np.ndarray) -> np.ndarray:
     return by
 
 
-def kernel_args(points: PointArrays | BoxArrays) -> tuple:
+def kernel_args(points: PointArrays | BoxArrays | NodeBoxes) -> tuple:
     """``points.kernel_args()`` as writable C-contiguous arrays: the types ``pip install`` compiled the kernels for.
 
     A read-only or strided array (a broadcast view, say) is another numba signature, and
@@ -45,7 +46,8 @@ def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
 def prove_boxes(scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """(N_c int16, proved bool) of each box: N_c at every point of box i where proved[i] (``System.prove_boxes``).
 
-    Boxes that span an axis outside ``box_axes`` are not proved, and not tried.
+    Each box goes to the kernel of its narrowest enclosure (``boxes.boxes``).  Boxes that span an axis outside
+    ``box_axes`` are not proved, and not tried.
     """
     npts = len(next(iter(lower.values()))) if lower else 1
     spans = np.zeros(npts, dtype=bool)
@@ -56,18 +58,11 @@ def prove_boxes(scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray
     todo = np.flatnonzero(~spans)
     if todo.size == 0:
         return nc, proved
-    box = box_arrays(scene, {k: np.asarray(v)[todo] for k, v in lower.items()}, {k: np.asarray(v)[todo] for k, v in upper.items()})
-    spin = np.isfinite(box.u_lo)
-    for rows, scaled in ((np.flatnonzero(spin), True), (np.flatnonzero(~spin), False)):
-        if rows.size == 0:
-            continue
-        part = box.take(rows)
+    for rows, part in boxes(scene, {k: np.asarray(v)[todo] for k, v in lower.items()}, {k: np.asarray(v)[todo] for k, v in upper.items()}):
         count = np.empty(rows.size, dtype=np.int16)
         status = np.empty(rows.size, dtype=np.int8)
-        if scaled:
-            spin_box_block(*kernel_args(part), part.u_lo, part.u_hi, count, status)
-        else:
-            box_block(*kernel_args(part), count, status)
+        kernel = nodes_box_block if isinstance(part, NodeBoxes) else box_block
+        kernel(*kernel_args(part), count, status)
         ok = (status != UNDECIDED) & (status != ZERO_POLYNOMIAL)
         nc[todo[rows[ok]]] = count[ok]
         proved[todo[rows[ok]]] = True
