@@ -61,8 +61,12 @@ def test_bench_truncation_quick(capsys):
     rows = {(r["N"], r["tail"]): r for r in out["rows"]}
     assert set(rows) == {(N, t) for N in (1, 2, 4, 8) for t in (True, False)}
     assert rows[(8, True)]["max_err"] == 0.0  # the reference against itself
-    # More modes never make the lumped-tail answer worse here, and 4 modes are within 1 % everywhere.
-    assert rows[(4, True)]["max_err"] <= rows[(1, True)]["max_err"] and rows[(4, True)]["off_1pct"] == 0
+    # The lumped tail never makes the answer worse, and 4 modes with it are within 1 % everywhere.  (Since critical
+    # values prove every scan step, they see an unstable band 100.29-101.09 rad/s at N = 4 and 8 that the scan
+    # missed, and the onset at the largest aspect ratio is 1.1e-3 off at N = 4 against 9.0e-4 at N = 1: more modes
+    # are not better at every aspect ratio, so that is no longer asserted.)
+    assert all(rows[(N, True)]["max_err"] <= rows[(N, False)]["max_err"] for N in (1, 2, 4))
+    assert rows[(4, True)]["off_1pct"] == 0
     assert "| scene | N | tail |" in capsys.readouterr().out
 
 
