@@ -42,6 +42,12 @@ class BoxArrays:
     rg: np.ndarray  # (npts,)
     rat: np.ndarray  # (npts, n)
 
+    def take(self, rows: np.ndarray) -> BoxArrays:
+        m = self.mid
+        mid = PointArrays(body=m.body[rows], joint=m.joint[rows], g=m.g[rows], E=m.E[rows], kappa=m.kappa[rows],
+                          nmodes=m.nmodes, free=m.free, parent=m.parent, at=m.at[rows])
+        return BoxArrays(mid, self.rbody[rows], self.rjoint[rows], self.rg[rows], self.rat[rows])
+
     def kernel_args(self):
         m = self.mid
         return (m.body, self.rbody, m.joint, self.rjoint, m.g, self.rg, m.E, m.kappa, m.nmodes, m.free, m.parent, m.at, self.rat)
@@ -177,21 +183,24 @@ def _spin_rows(lo: PointArrays, hi: PointArrays) -> np.ndarray:
     return np.flatnonzero(one_rate & (w_lo[:, 0] != w_hi[:, 0]) & ((w_lo[:, 0] > 0.0) | (w_hi[:, 0] < 0.0)))
 
 
-def _spin_scaled(lo: PointArrays, hi: PointArrays, rows: np.ndarray) -> NodeBoxes:
-    """The boxes ``rows`` in the spin-scaled model (module docstring): u = 1 / omega^2 at n + 1 nodes."""
-    w = np.abs(lo.body[rows, 0, 5]), np.abs(hi.body[rows, 0, 5])
-    near, far = np.minimum(*w), np.maximum(*w)
-    u_lo, u_hi = _outward(1.0 / (far * far), -np.inf, 3), _outward(1.0 / (near * near), np.inf, 3)
-    n = lo.body.shape[1]
-    u = _chebyshev(u_lo, u_hi, n + 1)
-    box = _plain(lo, hi)
+def _spin_scaled(box: BoxArrays, w1: np.ndarray, w2: np.ndarray) -> NodeBoxes:
+    """The plain boxes ``box`` in the spin-scaled model (module docstring): u = 1 / omega^2 at n + 1 nodes, the
+    other parameters within their radii at every node.  omega runs between the corners' w1 and w2 (one sign)."""
     m = box.mid
-    body, rbody = m.body[rows][:, None].repeat(n + 1, axis=1), box.rbody[rows][:, None].repeat(n + 1, axis=1)
+    near, far = np.minimum(np.abs(w1), np.abs(w2)), np.maximum(np.abs(w1), np.abs(w2))
+    u_lo, u_hi = _outward(1.0 / (far * far), -np.inf, 3), _outward(1.0 / (near * near), np.inf, 3)
+    n = m.body.shape[1]
+    u = _chebyshev(u_lo, u_hi, n + 1)
+
+    def at_nodes(x: np.ndarray) -> np.ndarray:
+        return x[:, None].repeat(n + 1, axis=1)
+
+    body, rbody = at_nodes(m.body), at_nodes(box.rbody)
     body[..., 5], rbody[..., 5] = 1.0, 0.0
-    joint, rjoint = _times(m.joint[rows][:, None], box.rjoint[rows][:, None], u[..., None])
-    g, rg = _times(m.g[rows][:, None], box.rg[rows][:, None], u)
-    at, rat = m.at[rows][:, None].repeat(n + 1, axis=1), box.rat[rows][:, None].repeat(n + 1, axis=1)
-    return NodeBoxes(body, rbody, joint, rjoint, g, rg, at, rat, m.E[rows], m.kappa[rows], m.nmodes, m.free, m.parent, u, u_lo, u_hi)
+    joint, rjoint = _times(m.joint[:, None], box.rjoint[:, None], u[..., None])
+    g, rg = _times(m.g[:, None], box.rg[:, None], u)
+    return NodeBoxes(body, rbody, joint, rjoint, g, rg, at_nodes(m.at), at_nodes(box.rat), m.E, m.kappa, m.nmodes, m.free,
+                     m.parent, u, u_lo, u_hi)
 
 
 def _mechanical(scene: Scene, key: str) -> bool:
@@ -239,19 +248,17 @@ def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarra
     pairs that together hold each box once.  Raises ValueError as ``box_arrays``."""
     lo, hi = _corners(scene, lower, upper)
     npts = lo.body.shape[0]
+    plain = _plain(lo, hi)
     out = []
     spin = _spin_rows(lo, hi)
     if spin.size:
-        out.append((spin, _spin_scaled(lo, hi, spin)))
+        out.append((spin, _spin_scaled(plain.take(spin), lo.body[spin, 0, 5], hi.body[spin, 0, 5])))
     rest = np.setdiff1d(np.arange(npts), spin)
     for axis in (k for k in lower if _mechanical(scene, k)):
         one, nodes = _one_axis(scene, lower, upper, lo, hi, rest, axis)
         if nodes is not None:
             out.append((one, nodes))
             rest = np.setdiff1d(rest, one)
-    plain = rest
-    if plain.size:
-        lo_p, hi_p = (PointArrays(body=x.body[plain], joint=x.joint[plain], g=x.g[plain], E=x.E[plain], kappa=x.kappa[plain],
-                                  nmodes=x.nmodes, free=x.free, parent=x.parent, at=x.at[plain]) for x in (lo, hi))
-        out.append((plain, _plain(lo_p, hi_p)))
+    if rest.size:
+        out.append((rest, plain.take(rest)))
     return out
