@@ -156,3 +156,35 @@ def test_cavity_sizes_are_not_enclosed_so_their_boxes_are_not_proved():
     assert not proved.any()
     with pytest.raises(ValueError, match=name):
         box_arrays(scene, {name: value}, {name: value * 1.01})
+
+
+def _label_from_file(ds, x: np.ndarray) -> np.ndarray:
+    """N_c at scan values x from a critical file of one point: the start label, then each boundary's label above."""
+    keep = np.isfinite(ds["boundary_lower"].values)
+    upper, above = ds["boundary_upper"].values[keep], ds["n_complex_pairs_above"].values[keep]
+    out = np.full(x.shape, int(ds["n_complex_pairs_at_scan_start"]))
+    for hi, label in zip(upper, above):
+        out[x >= hi] = label
+    return out
+
+
+@pytest.mark.parametrize("E", [1e-4, 1e-5, 1e-6, 1e-7])
+def test_narrow_liquid_bands_never_hide_in_a_proved_stretch(E):
+    # Smaller E narrows the liquid resonances to bands far below the scan step (1 rad/s).  At random values outside
+    # the brackets and the listed gaps, the label the file gives must be the exact count.
+    system = dict(WINDOW, bodies=[dict(b, fluid=dict(b["fluid"], E=[E])) for b in WINDOW["bodies"]])
+    scene = from_dict(system)
+    ds = critical(scene, "omega", rtol=1e-10, progress=False, threads=1)
+    rng = np.random.default_rng(int(-np.log10(E)))
+    x = rng.uniform(0.5, 99.5, 400)
+    keep = np.isfinite(ds["boundary_lower"].values)
+    n = int(ds["n_undecided"])
+    holes = [(a, b) for a, b in zip(ds["boundary_lower"].values[keep], ds["boundary_upper"].values[keep])]
+    holes += list(zip(ds["undecided_lower"].values[:n], ds["undecided_upper"].values[:n]))
+    outside = np.ones(x.size, dtype=bool)
+    for a, b in holes:
+        outside &= ~((x >= a) & (x <= b))
+    # and just beside every boundary, where a hidden band would sit
+    near = np.concatenate([ds["boundary_lower"].values[keep] - 1e-7, ds["boundary_upper"].values[keep] + 1e-7])
+    x = np.concatenate([x[outside], near])
+    assert np.array_equal(_label_from_file(ds, x), _exact(scene, {"omega": x}))
