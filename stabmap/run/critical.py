@@ -16,8 +16,9 @@ point of the scene's other grid axes, without a dense grid along ``along``:
    two roots meet, which no box proof can hide.
 3. **Gaps.** A segment with equal ends that is still unproved at that width,
    or once its point of the other axes has spent its budget of box proofs
-   (BOX_BUDGET per scan step: exactly repeated roots defeat every box proof),
-   is an *undecided gap*, and is listed.  A gap next to a bracket joins it
+   (BOX_BUDGET per scan step), or proves too few of them to pay (PAYS:
+   clustered or exactly repeated roots defeat box proofs), is an *undecided
+   gap*, and is listed.  A gap next to a bracket joins it
    (the bracket's width stays below the tolerance).
 4. **Intervals.** The brackets and the proved segments between them
    partition the scan range outside the gaps; each maximal piece with N_c = 0
@@ -57,6 +58,11 @@ MAX_ITERATIONS = 2200  # bisection of float64 reaches adjacent floats long befor
 # Box proofs that one point of the other axes may spend on segments with equal ends: BOX_BUDGET per scan step,
 # plus BOX_BUDGET_BOUNDARIES for the segments next to its boundaries (each needs a few hundred: docs/critical.md)
 BOX_BUDGET, BOX_BUDGET_BOUNDARIES = 4, 2048
+# A point whose box proofs of one halving step prove less than PAYS of its segments, when they are at least
+# PAYS_MIN and a quarter of its scan steps, stops halving: a stretch whose structure defeats the proofs (identical
+# cavities' clustered roots) would only double its cost at every step.  (A search for a narrow window halves one
+# or two segments a step, and a coarse scan's first steps are few: both go on.)
+PAYS, PAYS_MIN = 0.25, 32
 
 GUARANTEE = (
     "Every change of {label} in the scan range is reported: between its boundaries, {label} is proved the same at "
@@ -246,6 +252,8 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
     npoints = max(1, math.prod(shape))
     budget = BOX_BUDGET * np.bincount(active.owner, minlength=npoints) + BOX_BUDGET_BOUNDARIES
     spent = np.zeros(npoints, dtype=np.int64)
+    quit = np.zeros(npoints, dtype=bool)
+    steps = np.bincount(active.owner, minlength=npoints)
     brackets, gaps = [], []
     for _ in range(MAX_ITERATIONS):
         same = np.flatnonzero(active.nc_lo == active.nc_hi)  # a segment whose ends differ has no one label to prove
@@ -254,7 +262,10 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
             label, proved = decide_boxes(run, scene, *_corners(others, shape, along, tried), chunk_points=chunk_points)
             counts.box_proofs += same.size
             counts.boxes_proved += int(proved.sum())
-            spent += np.bincount(tried.owner, minlength=npoints)
+            now = np.bincount(tried.owner, minlength=npoints)
+            spent += now
+            broad = now >= np.maximum(PAYS_MIN, steps // 4)
+            quit |= broad & (np.bincount(tried.owner[proved], minlength=npoints) < PAYS * now)
             if np.any(proved & (label != tried.nc_lo)):  # pragma: no cover - two proofs disagree
                 raise AssertionError(f"a box proof of {system.label} contradicts the proofs at its ends")
             keep = np.ones(len(active), dtype=bool)
@@ -262,7 +273,7 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
             active = active.take(keep)
         differ = active.nc_lo != active.nc_hi
         small = _converged(active, rtol / 4, atol / 4)
-        stop = small | (spent[active.owner] >= budget[active.owner]) | (not boxes)
+        stop = small | ((spent >= budget) | quit)[active.owner] | (not boxes)
         brackets.append(active.take(differ & small))
         gaps.append(active.take(~differ & stop))
         active = active.take(~small & (differ | ~stop))
