@@ -244,16 +244,16 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
     Segments are closed intervals of ``along`` (the other axes at one grid point, ``owner``) whose ends have
     proved labels.  A segment proved by a box proof is done; a segment whose ends differ is halved down to a
     quarter of the tolerance (a bracket); one whose ends agree is halved while it is wider than that and its
-    owner has box proofs left, else it is a gap.  Without box proofs (``boxes`` False) the segments whose ends
+    owner has box proofs left that pay (BOX_BUDGET, PAYS), else it is a gap.  Without box proofs (``boxes`` False) the segments whose ends
     agree are gaps at once.
     """
     system = systems.of(scene)
     shape = tuple(len(a.values) for a in others)
     npoints = max(1, math.prod(shape))
-    budget = BOX_BUDGET * np.bincount(active.owner, minlength=npoints) + BOX_BUDGET_BOUNDARIES
-    spent = np.zeros(npoints, dtype=np.int64)
-    quit = np.zeros(npoints, dtype=bool)
     steps = np.bincount(active.owner, minlength=npoints)
+    budget = BOX_BUDGET * steps + BOX_BUDGET_BOUNDARIES
+    spent = np.zeros(npoints, dtype=np.int64)
+    unpaid = np.zeros(npoints, dtype=bool)  # points whose box proofs failed broadly (PAYS)
     brackets, gaps = [], []
     for _ in range(MAX_ITERATIONS):
         same = np.flatnonzero(active.nc_lo == active.nc_hi)  # a segment whose ends differ has no one label to prove
@@ -265,7 +265,7 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
             now = np.bincount(tried.owner, minlength=npoints)
             spent += now
             broad = now >= np.maximum(PAYS_MIN, steps // 4)
-            quit |= broad & (np.bincount(tried.owner[proved], minlength=npoints) < PAYS * now)
+            unpaid |= broad & (np.bincount(tried.owner[proved], minlength=npoints) < PAYS * now)
             if np.any(proved & (label != tried.nc_lo)):  # pragma: no cover - two proofs disagree
                 raise AssertionError(f"a box proof of {system.label} contradicts the proofs at its ends")
             keep = np.ones(len(active), dtype=bool)
@@ -273,7 +273,7 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
             active = active.take(keep)
         differ = active.nc_lo != active.nc_hi
         small = _converged(active, rtol / 4, atol / 4)
-        stop = small | ((spent >= budget) | quit)[active.owner] | (not boxes)
+        stop = small | ((spent >= budget) | unpaid)[active.owner] | (not boxes)
         brackets.append(active.take(differ & small))
         gaps.append(active.take(~differ & stop))
         active = active.take(~small & (differ | ~stop))
