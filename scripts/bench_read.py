@@ -72,7 +72,10 @@ def _block(shape, variable, block_info=None):
     if variable == "stability":
         return stability_from_pairs(nc)
     u, v = i / (shape[0] - 1), k / (shape[1] - 1)
-    return np.where((u > 0.5) & (u < 0.7) & (v > 0.6) & (v < 0.8), 3, 0).astype(np.int8)  # an inferred patch
+    patch = (u > 0.5) & (u < 0.7) & (v > 0.6) & (v < 0.8)
+    if variable == "cell":  # the inferred patch not proved, every other cell node_only
+        return np.where(patch, 3, 0).astype(np.int8)
+    return np.where(patch, 3, 0).astype(np.int8)  # decided_by: an inferred patch
 
 
 def make_atlas(path: str | Path, shape: tuple[int, int], chunk_points: int | None = None) -> Path:
@@ -95,7 +98,7 @@ def make_atlas(path: str | Path, shape: tuple[int, int], chunk_points: int | Non
     chunks = chunk_shape(scene.shape, chunk_points or MAX_CHUNK_POINTS)
     arrays = {
         v.name: da.map_blocks(_block, scene.shape, v.name, chunks=da.core.normalize_chunks(chunks, scene.shape), dtype=v.dtype)
-        for v in system.variables
+        for v in system.atlas_variables
     }
     ds = atlas_dataset(system, scene, arrays)
     ds.attrs["history"] += "; synthetic labels written by scripts/bench_read.py (not computed)"

@@ -131,6 +131,8 @@ def summary_line(system, s: dict, evaluated=None) -> str:
         line = f"{s['points']} points; " + ", ".join(f"{system.class_name(v)}: {c}" for v, c in s[system.label].items())
     if system.provenance in s:
         line += "; decided by " + ", ".join(f"{m.replace('_', ' ')} {c}" for m, c in s[system.provenance].items() if c)
+    if "cell_volume" in s and evaluated is None:
+        line += f"; label proved over {100 * s['cell_volume']['whole_cell']:.1f} % of the scanned volume (whole cells)"
     if evaluated is not None and int(evaluated) >= s["points"]:
         line += ("; refined: nothing to infer, every point computed (the grid is too coarse to refine: the default "
                  "stride is 1 along axes of fewer than 129 points; --coarse-stride sets it, docs/refine.md)")

@@ -173,7 +173,7 @@ def test_facet_panels_are_drawn_in_blocks_no_smaller_than_pixels(big_map):
     import xarray as xr
 
     part = big_map.isel(K_1=slice(0, 900))
-    three = xr.concat([part.assign_coords(m_2=m) for m in (0.5, 1.0, 2.0, 4.0)], dim="m_2").transpose("omega", "K_1", "m_2")
+    three = xr.concat([part.assign_coords(m_2=m) for m in (0.5, 1.0, 2.0, 4.0)], dim="m_2").transpose("omega", "K_1", "m_2", ...)
     three["m_2"].attrs.update(units="kg", long_name="mass of body 2")
     fig = atlas_figure(three)
     fig.set_dpi(150)

@@ -128,8 +128,8 @@ class Blocks:
     """A 2-D label map reduced to blocks of ``factors`` = (rows, columns) points (the last ones may be smaller).
 
     ``low``/``high``: the smallest and largest label in each block (equal where every point of the block has one
-    label); ``mixed_stability``: the block holds stable and not stable points; ``any_flag``: some point of the
-    block is flagged (e.g. inferred), None without flags. ``counts``: how often each label occurs in the whole
+    label); ``mixed_stability``: the block holds stable and not stable points; ``any_flag``: the bitwise OR of
+    the flags (small non-negative integers, bit codes, or booleans) of the block's points, None without flags. ``counts``: how often each label occurs in the whole
     map, at full resolution. With factors (1, 1) the blocks are the points themselves.
     """
 
@@ -186,7 +186,7 @@ def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -
     for block, (reduced, _) in zip(np.ndindex(*grid), done):
         parts[block] = reduced
     low, high, mixed_stable, flagged = (np.block([[p[k] for p in row] for row in parts]) for k in range(4))
-    return Blocks(factors, low.astype(v.dtype), high.astype(v.dtype), mixed_stable.astype(bool), None if flags is None else flagged.astype(bool),
+    return Blocks(factors, low.astype(v.dtype), high.astype(v.dtype), mixed_stable.astype(bool), None if flags is None else flagged,
                   _merge(counted for _, counted in done))
 
 
@@ -208,7 +208,7 @@ def _reduce_block(v: np.ndarray, f: np.ndarray | None, valid: tuple[int, int], *
     else:
         is_stable = cells == stable
         out[2] = is_stable.any(axis=(1, 3)) & ~is_stable.all(axis=(1, 3))
-    out[3] = 0 if f is None else f.reshape(ny, fy, nx, fx).any(axis=(1, 3))
+    out[3] = 0 if f is None else np.bitwise_or.reduce(np.bitwise_or.reduce(f.reshape(ny, fy, nx, fx).astype(np.int32), axis=3), axis=1)
     return out, np.unique(v[: valid[0], : valid[1]], return_counts=True)
 
 

@@ -104,6 +104,11 @@ def describe(ds: xr.Dataset, name: str = "") -> str:
     lines += wrapped(f"{system.label} ({system.label_symbol}): ", [f"{meaning(k)}: {v}" for k, v in s[system.label].items()])
     if system.provenance in s:
         lines += wrapped("decided by: ", [f"{k.replace('_', ' ')} {v}" for k, v in s[system.provenance].items() if v])
+    if "cell" in s:
+        share = s["cell_volume"]
+        lines += wrapped("cells: ", [f"{m.replace('_', ' ')} {n}" for m, n in s["cell"].items() if n])
+        lines += wrapped("  ", [f"the label is proved over {100 * share['whole_cell']:.2f} % of the scanned volume, "
+                                f"a change of label in {100 * share['contains_change']:.2f} %; docs/cells.md"])
     lines += provenance(a)
     return "\n".join(lines)
 

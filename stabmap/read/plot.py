@@ -18,6 +18,9 @@ boundaries between classes.
   vermillion, ...); each class always has the same colour. Degenerate points (p identically zero) are grey and
   cross-hatched, points whose class was not proved (``System.undecided_label``) dark grey and cross-hatched; points of an adaptive atlas that were inferred from their cell's corners (``decided_by`` = 3)
   carry a light diagonal hatch (a light veil in very large adaptive atlases).
+- Cells (``cell``, docs/cells.md): a cell whose label is proved at its node only is dotted (a light veil when
+  there are very many); a cell proved to hold a change of label is filled as a boundary (black where stable
+  cells are next to it, dark grey between other classes), so a band narrower than the grid still shows.
 - Boundaries are drawn on grid-cell edges, between every two neighbouring points whose N_c differ: thick where
   one side is stable and the other not, thin where only the number of pairs changes. A line is drawn only where
   two grid points differ, never interpolated between them. Cell edges are the midpoints between grid values
@@ -38,7 +41,7 @@ import xarray as xr
 from ..errors import StabmapError
 from .. import systems
 from ..store.files import check_writable
-from ..store.variables import INFERRED
+from ..store.variables import CELL, INFERRED
 from .blocks import block_factors, reduce_blocks
 from .info import fixed_parameters, scene_notes, unit_suffix
 
@@ -55,6 +58,9 @@ _UNDECIDED = "#707070"  # not proved (System.undecided_label): darker than degen
 _BOUNDARY = "#000000"
 _CLASS_EDGE = "#333333"
 _HATCH_INFERRED = "////"
+_HATCH_NODE_ONLY = "...."
+# Bits of the flag map reduced with the labels (blocks.reduce_blocks ORs them over a block)
+_FLAG_INFERRED, _FLAG_NODE_ONLY, _FLAG_CHANGE = 1, 2, 4
 _HATCH_DEGENERATE = "xxxx"
 _HATCH_RUNS = 100_000  # more separate runs of inferred cells than this: a light veil instead of a hatch
 _VECTOR_RUNS = 20_000  # a panel with more runs of equal cells along x is filled as an image (lines and text stay vector)
@@ -353,12 +359,13 @@ def _overlay(ax, mask: np.ndarray, xe: np.ndarray, ye: np.ndarray, gid: str) -> 
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path as MplPath
 
-    if gid == "inferred-cells" and len(_runs(mask)[0]) > _HATCH_RUNS:
+    if gid in ("inferred-cells", "node-only-cells") and len(_runs(mask)[0]) > _HATCH_RUNS:
         veil = np.ma.masked_where(~mask, np.ones(mask.shape))
         mesh = ax.pcolormesh(xe, ye, veil, cmap=_white_cmap(), vmin=0, vmax=1, alpha=0.45, shading="flat", rasterized=True, zorder=2)
         mesh.set_gid(gid)
         return True
-    hatch, colour_ = (_HATCH_INFERRED, "#00000066") if gid == "inferred-cells" else (_HATCH_DEGENERATE, "#000000AA")
+    hatch, colour_ = {"inferred-cells": (_HATCH_INFERRED, "#00000066"), "node-only-cells": (_HATCH_NODE_ONLY, "#00000066")}.get(
+        gid, (_HATCH_DEGENERATE, "#000000AA"))
     path = MplPath.make_compound_path_from_polys(np.array(_rectangles(mask, xe, ye)))
     patch = PathPatch(path, facecolor="none", edgecolor=colour_, linewidth=0, hatch=hatch, zorder=2)
     if hasattr(patch, "set_hatchcolor"):  # matplotlib >= 3.10
@@ -369,10 +376,44 @@ def _overlay(ax, mask: np.ndarray, xe: np.ndarray, ye: np.ndarray, gid: str) -> 
     return False
 
 
-def _paint(ax, mask: np.ndarray, xe: np.ndarray, ye: np.ndarray, colour_: str, gid: str) -> None:
-    """Fill the marked cells in one colour, as an image (blocks of a reduced map: about one pixel each)."""
+def _flag_map(ds: xr.Dataset, system) -> xr.DataArray | None:
+    """The bits drawn over the classes, per grid point: _FLAG_INFERRED (decided_by says inferred, or cell says
+    not_proved), _FLAG_NODE_ONLY and _FLAG_CHANGE (``cell``); None for an atlas with neither variable."""
+    bits = None
+    if system.provenance in ds:
+        flags = system.variable(system.provenance)
+        if INFERRED in flags.meanings:
+            bits = (ds[system.provenance] == flags.value(INFERRED)).astype(np.int8) * _FLAG_INFERRED
+    if CELL.name in ds:
+        cell = ds[CELL.name]
+        more = ((cell == CELL.value("not_proved")) * _FLAG_INFERRED + (cell == CELL.value("node_only")) * _FLAG_NODE_ONLY
+                + (cell == CELL.value("contains_change")) * _FLAG_CHANGE).astype(np.int8)
+        bits = more if bits is None else bits | more
+    return bits
+
+
+def _touches_stability(blocks, stable: int) -> np.ndarray:
+    """Blocks next to (or holding) both stable and not stable points: where a change of label is a stability
+    boundary."""
+    from scipy.ndimage import maximum_filter
+
+    some_stable = (blocks.low == stable) | (blocks.high == stable) | blocks.mixed_stability
+    some_other = (blocks.low != stable) | (blocks.high != stable)
+    return maximum_filter(some_stable, size=3, mode="nearest") & maximum_filter(some_other, size=3, mode="nearest")
+
+
+def _paint(ax, mask: np.ndarray, xe: np.ndarray, ye: np.ndarray, colour_: str, gid: str, vector: bool = False) -> None:
+    """Fill the marked cells in one colour, as an image (blocks of a reduced map: about one pixel each), or with
+    ``vector`` as rectangles unless they form too many runs (grid cells of a map drawn point for point)."""
+    from matplotlib.collections import PolyCollection
     from matplotlib.colors import ListedColormap
 
+    if vector and len(_runs(mask)[0]) <= _VECTOR_RUNS:
+        cells = PolyCollection(_rectangles(mask, xe, ye), facecolors=colour_, edgecolors=colour_, linewidths=0.3,
+                               antialiaseds=False, zorder=2.5)
+        cells.set_gid(gid)
+        ax.add_collection(cells, autolim=False)
+        return
     cells = np.ma.masked_where(~mask, np.ones(mask.shape))
     mesh = ax.pcolormesh(xe, ye, cells, cmap=ListedColormap([colour_]), vmin=0, vmax=1, shading="flat", rasterized=True, zorder=2.5)
     mesh.set_gid(gid)
@@ -484,9 +525,8 @@ def atlas_figure(
     fix = {k: i for k, (i, _) in plan.fixed.items()}
     system = systems.of_atlas(ds.attrs)
     nc = ds[system.label].isel(fix)
-    by = ds[system.provenance].isel(fix) if system.provenance in ds else None
-    flags = system.variable(system.provenance) if by is not None else None
-    inferred_value = flags.value(INFERRED) if flags is not None and INFERRED in flags.meanings else None
+    flag_map = _flag_map(ds, system)
+    flag_map = None if flag_map is None else flag_map.isel(fix)
     order = (plan.y, plan.x) if plan.y else (plan.x,)
     panels = [(r, c) for r in (plan.row_index or (None,)) for c in (plan.facet_index or (None,))]
 
@@ -514,7 +554,7 @@ def atlas_figure(
     shape = (ds.sizes[plan.y] if plan.y else 1, ds.sizes[plan.x])
     factors = block_factors(shape, panel_pixels(width, nrows, ncols, facets=plan.facet is not None, strip=plan.y is None))
     data = [
-        reduce_blocks(cut(nc, r, c), None if inferred_value is None else cut(by, r, c) == inferred_value, stable, factors)
+        reduce_blocks(cut(nc, r, c), None if flag_map is None else cut(flag_map, r, c), stable, factors)
         for r, c in panels
     ]
     totals: dict[int, int] = {}
@@ -549,18 +589,30 @@ def atlas_figure(
     for ax in grid.ravel()[len(panels) :]:
         ax.remove()
 
-    drawn = {"stability": False, "classes": False, "inferred": False, "light": False}
+    drawn = {"stability": False, "classes": False, "inferred": False, "light": False, "node-only": False,
+             "node-only-light": False, "change": False}
     for ax, blocks, (r, c) in zip(axes, data, panels):
         values, mixed = blocks.low, blocks.mixed
         _fill(ax, values, xe, ye, cmap, norm, stable, absent, undecided)
-        for mask, gid in ((blocks.any_flag, "inferred-cells"), ((values < 0) & (values != absent) & ~mixed, "degenerate-cells")):
-            if mask is not None and mask.any():
-                drawn["inferred"] |= gid == "inferred-cells"
-                drawn["light"] |= _overlay(ax, mask, xe, ye, gid)
-        codes, state = _block_classes(blocks, stable)
-        for mask, col, gid in ((mixed & ~blocks.mixed_stability, _CLASS_EDGE, "mixed-class-blocks"), (blocks.mixed_stability, _BOUNDARY, "mixed-stability-blocks")):
+        bits = np.zeros(values.shape, dtype=np.int32) if blocks.any_flag is None else blocks.any_flag
+        inferred = (bits & _FLAG_INFERRED) > 0
+        node_only = ((bits & _FLAG_NODE_ONLY) > 0) & ~inferred
+        for mask, gid in ((inferred, "inferred-cells"), (node_only, "node-only-cells"),
+                          ((values < 0) & (values != absent) & ~mixed, "degenerate-cells")):
             if mask.any():
-                _paint(ax, mask, xe, ye, col, gid)
+                light = _overlay(ax, mask, xe, ye, gid)
+                if gid == "inferred-cells":
+                    drawn["inferred"], drawn["light"] = True, drawn["light"] | light
+                elif gid == "node-only-cells":
+                    drawn["node-only"], drawn["node-only-light"] = True, drawn["node-only-light"] | light
+        codes, state = _block_classes(blocks, stable)
+        change = (bits & _FLAG_CHANGE) > 0
+        near_stable = _touches_stability(blocks, stable) if stable is not None else np.zeros(values.shape, dtype=bool)
+        drawn["change"] |= bool(change.any())
+        for mask, col, gid in ((mixed & ~blocks.mixed_stability, _CLASS_EDGE, "mixed-class-blocks"), (blocks.mixed_stability, _BOUNDARY, "mixed-stability-blocks"),
+                               (change & ~near_stable, _CLASS_EDGE, "change-cells"), (change & near_stable, _BOUNDARY, "stability-change-cells")):
+            if mask.any():
+                _paint(ax, mask, xe, ye, col, gid, vector=gid.endswith("-cells") and tuple(blocks.factors) == (1, 1))
         stab, other = cell_edge_boundaries(codes, xe, ye, stable, state=state)
         span = panel_points(width, nrows, ncols, facets=plan.facet is not None, strip=plan.y is None)
         for segs, width_, col, gid in ((other, 0.6, _CLASS_EDGE, "class-boundary"), (stab, 1.5, _BOUNDARY, "stability-boundary")):
@@ -620,6 +672,12 @@ def atlas_figure(
         handles.append(Patch(facecolor="white", edgecolor="#00000066", lw=0, hatch=_HATCH_INFERRED, label="inferred from cell\ncorners (not computed)"))
     elif drawn["inferred"]:
         handles.append(Patch(facecolor="#DDDDDD", edgecolor="none", label="lighter: inferred from cell\ncorners (not computed)"))
+    if drawn["node-only"] and not drawn["node-only-light"]:
+        handles.append(Patch(facecolor="white", edgecolor="#00000066", lw=0, hatch=_HATCH_NODE_ONLY, label="proved at the grid node,\nnot over its cell"))
+    elif drawn["node-only"]:
+        handles.append(Patch(facecolor="#DDDDDD", edgecolor="none", label="lighter: proved at the grid\nnode, not over its cell"))
+    if drawn["change"]:
+        handles.append(Patch(facecolor=_CLASS_EDGE, edgecolor="none", label="cell proved to hold\na change of label"))
     legend = {"frameon": False, "title": system.label_title, "fontsize": 9, "title_fontsize": 9}
     if plan.facet is None:
         fig.legend(handles=handles, loc="outside right upper", alignment="left", **legend)

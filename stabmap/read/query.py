@@ -294,7 +294,7 @@ def label_at(ds: xr.Dataset, **point: float) -> Label:
     system = systems.of_atlas(ds.attrs)
     sel, = compute(sel)  # one point of every variable: a lazy atlas reads one chunk of each
     values = {}
-    for v in system.variables:
+    for v in system.atlas_variables:
         if v.name in sel:
             x = sel[v.name].values
             values[v.name] = v.meaning(int(x)) if v.flags else (x.item() if x.ndim == 0 else x)

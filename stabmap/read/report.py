@@ -56,7 +56,7 @@ def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
         note = " (outside the grid: nearest edge)" if k in label.outside else ""
         lines.append(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g}{_units(atlas, k)}" + note)
     shown = [(k, v) for k, v in label.values.items() if k != label.provenance]
-    lines += [f"{k} = {_value(v)}" for k, v in shown]
+    lines += [f"{k} = {_value(v)}" + (f" ({CELL_TEXT[v]})" if k == "cell" and v in CELL_TEXT else "") for k, v in shown]
     if label.provenance is not None:
         how = label.values[label.provenance]
         # How the point was decided qualifies its verdict (stability, else the label: the critical node), not
@@ -72,6 +72,14 @@ def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
             else f" (decided by {how.replace('_', ' ')})"
         )
     return "\n".join(lines)
+
+
+CELL_TEXT = {  # what the cell flag says about the requested point, which lies in the grid point's cell
+    "whole_cell": "the label is proved at every point of this grid cell, the requested point included",
+    "contains_change": "this grid cell is proved to hold a change of label: at the requested point it may differ",
+    "node_only": "the label is proved at the grid point only; at the requested point it is not decided",
+    "not_proved": "not proved even at the grid point",
+}
 
 
 def _value(v) -> str:

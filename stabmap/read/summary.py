@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import numpy as np
 import xarray as xr
 
 from .. import systems
+from ..scene.grid import edges
+from ..store.variables import CELL
 
 
 def _counts(values) -> dict[int, int]:
@@ -21,7 +24,8 @@ def summary(ds: xr.Dataset) -> dict:
     system's ``absent_label``: nothing to decide there), ``undecided`` (its ``undecided_label``: not proved),
     ``stable_fraction``, the label's name (a
     histogram, e.g. ``n_complex_pairs``) and the provenance variable's name (counts by flag meaning, e.g.
-    ``decided_by``).
+    ``decided_by``).  An atlas with cells (``stabmap.run.cells``) adds ``cell`` (counts by flag meaning) and
+    ``cell_volume`` (each meaning's share of the scanned volume, cells weighted by their size).
     """
     system = systems.of_atlas(ds.attrs)
     label = _counts(ds[system.label].data)
@@ -40,4 +44,34 @@ def summary(ds: xr.Dataset) -> dict:
         flags = system.variable(system.provenance)
         by = _counts(ds[system.provenance].data)
         out[system.provenance] = {m: by.get(v, 0) for v, m in flags.flags}
+    if CELL.name in ds:
+        cells = _counts(ds[CELL.name].data)
+        out[CELL.name] = {m: cells.get(v, 0) for v, m in CELL.flags}
+        out["cell_volume"] = volume_shares(ds)
     return out
+
+
+def cell_sizes(ds: xr.Dataset, dim: str) -> np.ndarray:
+    """The widths of the grid cells along ``dim`` (the midpoints between its values; ``stabmap.scene.grid.edges``);
+    an axis of one value has one cell of width 1, so that it weighs nothing."""
+    e = edges(ds[dim].values)
+    return np.abs(np.diff(e)) if e.size > 2 else np.ones(ds[dim].size)
+
+
+def volume_shares(ds: xr.Dataset) -> dict[str, float]:
+    """Each ``cell`` meaning's share of the scanned volume (cells weighted by their size), chunk by chunk."""
+    import dask.array as da
+
+    from .blocks import as_dask, compute
+
+    cell = as_dask(ds[CELL.name].data)
+    weight = da.ones((), dtype=np.float64)
+    total = 1.0
+    for axis, dim in enumerate(ds[CELL.name].dims):
+        w = cell_sizes(ds, dim)
+        total *= float(w.sum())
+        shape = [1] * cell.ndim
+        shape[axis] = -1
+        weight = weight * da.from_array(w, chunks=(cell.chunks[axis],)).reshape(shape)
+    sums = compute(*(da.where(cell == v, weight, 0.0).sum() for v, _ in CELL.flags))
+    return {m: float(x) / total if total else float("nan") for (_, m), x in zip(CELL.flags, sums)}

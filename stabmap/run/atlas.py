@@ -42,6 +42,7 @@ def compute(
     threads: int | None = None,
     progress: bool | None = None,
     chunk_points: int | None = None,
+    prove_cells: bool = True,
 ):
     """Compute the atlas of ``scene`` as a labelled Dataset (in memory).
 
@@ -61,14 +62,19 @@ def compute(
     chunk_points : int, optional
         Points per chunk of the grid and per task (default: chunks of about an eighth of a second of work, as
         timed by a probe, and tasks of several chunks, about half a second each; see ``stabmap.run.chunks``).
+    prove_cells : bool
+        Decide the grid cell by cell (default): boxes proved first, nodes computed only where no box proves, and
+        the ``cell`` variable saying what is proved about each cell (``stabmap.run.cells``).  False: every node
+        computed on its own, every cell ``node_only``.
     """
     chunk_points = check_chunk_points(chunk_points)
     with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run:
-        arrays = decide_grid(run, scene, progress=progress, chunk_points=chunk_points)
+        arrays = decide_grid(run, scene, progress=progress, chunk_points=chunk_points, prove_cells=prove_cells)
     return atlas_dataset(systems.of(scene), scene, arrays)
 
 
-def decide_grid(run: runner.Runner, scene: SceneBase, *, progress: bool | None = None, chunk_points: int | None = None) -> dict:
+def decide_grid(run: runner.Runner, scene: SceneBase, *, progress: bool | None = None, chunk_points: int | None = None,
+                prove_cells: bool = True) -> dict:
     """Every variable on the whole grid of ``scene`` (numpy arrays), decided by ``run``'s threads or cluster."""
     arrays = empty_arrays(systems.of(scene), scene)
 
@@ -77,7 +83,7 @@ def decide_grid(run: runner.Runner, scene: SceneBase, *, progress: bool | None =
         for k, v in block.items():
             arrays[k][where] = v
 
-    with _Layout(run, scene, progress, chunk_points) as layout:
+    with _Layout(run, scene, progress, chunk_points, prove_cells=prove_cells) as layout:
         layout.run(list(range(len(layout.locations))), keep)
     return arrays
 
@@ -154,8 +160,8 @@ class _Boxes(_Points):
 class _Chunks:
     """Chunks of the grid, handed out as tasks of one chunk or (``batch``) of as many as fit the points asked."""
 
-    def __init__(self, locations: list, todo: list[int], batch: bool):
-        self.locations, self.batch = locations, batch
+    def __init__(self, locations: list, todo: list[int], batch: bool, prove_cells: bool):
+        self.locations, self.batch, self.prove_cells = locations, batch, prove_cells
         self.size = {i: math.prod(b - a for a, b in locations[i]) for i in todo}
         self.queue = deque(todo)
         self.remaining = sum(self.size.values())
@@ -167,7 +173,7 @@ class _Chunks:
             chunks.append(self.queue.popleft())
             n += self.size[chunks[-1]]
         self.remaining -= n
-        return ([self.locations[i] for i in chunks],), chunks, n
+        return ([self.locations[i] for i in chunks], self.prove_cells), chunks, n
 
 
 class _Once:
@@ -201,6 +207,7 @@ def compute_to_file(
     progress: bool | None = None,
     chunk_points: int | None = None,
     resume: bool = False,
+    prove_cells: bool = True,
 ) -> FileReport:
     """Compute the atlas of ``scene`` straight into ``path`` (``.nc``: netCDF4; ``.zarr``: Zarr).
 
@@ -215,6 +222,8 @@ def compute_to_file(
         Finish the interrupted run of the same scene saved in ``PATH.partial/``
         (start afresh if there is none).  Without it, an existing
         ``PATH.partial/`` is an error, so that no finished work is thrown away unasked.
+    prove_cells : bool
+        As for ``compute``; a resumed run keeps the interrupted run's choice.
     """
     path = check_writable(path)
     where = partial_dir(path)
@@ -232,13 +241,14 @@ def compute_to_file(
                 f"the interrupted run in {str(where)!r} was computed from a different scene; give the same scene to "
                 f"resume it, or delete {str(where)!r} to start over"
             )
+        prove_cells = checkpoint.prove_cells
     chunk_points = check_chunk_points(chunk_points)
     try:
         with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run, _Layout(
-            run, scene, progress, chunk_points, checkpoint
+            run, scene, progress, chunk_points, checkpoint, prove_cells
         ) as layout:
             if checkpoint is None:
-                checkpoint = Checkpoint.create(where, system, scene, layout.chunks)
+                checkpoint = Checkpoint.create(where, system, scene, layout.chunks, prove_cells)
             done = checkpoint.done()
             todo = [i for i in range(len(layout.locations)) if i not in done]
             try:
@@ -273,8 +283,9 @@ class _Layout:
     chunks about TASK_SECONDS, resized as tasks finish.
     """
 
-    def __init__(self, run: runner.Runner, scene, progress, chunk_points: int | None, checkpoint: Checkpoint | None = None):
-        self.scene, self.runner = scene, run
+    def __init__(self, run: runner.Runner, scene, progress, chunk_points: int | None, checkpoint: Checkpoint | None = None,
+                 prove_cells: bool = True):
+        self.scene, self.runner, self.prove_cells = scene, run, prove_cells
         self.progress = ProgressLine(wanted(progress))
         self.progress.redraw = lambda: self._show(self._rate)
         self._rate: Rate | None = None
@@ -341,7 +352,7 @@ class _Layout:
             rate.add(sum(sizes[i] for i in chunks))
             self._show(rate)
 
-        self.runner.run(evaluate_blocks, self.scene, _Chunks(self.locations, order, self.batch), handle,
+        self.runner.run(evaluate_blocks, self.scene, _Chunks(self.locations, order, self.batch, self.prove_cells), handle,
                         lambda: self._show(rate))
 
 

@@ -34,6 +34,7 @@ import numpy as np
 from .. import systems
 from ..errors import StabmapError
 from ..store.dataset import atlas_dataset, empty_arrays
+from ..store.variables import CELL
 from ..systems.base import SceneBase
 from . import runner
 from .atlas import decide_points
@@ -218,6 +219,7 @@ class _Evaluator:
         rest = ~self.computed
         for k, v in self.system.inferred(self.label[rest]).items():
             self.arrays[k][rest] = v
+        self.arrays[CELL.name][...] = np.where(rest, CELL.value("not_proved"), CELL.value("node_only"))
         return self.arrays
 
     def _decide(self, flat: np.ndarray, stride: int) -> dict[str, np.ndarray]:
@@ -369,4 +371,6 @@ def compute_refined(
     ds.attrs["refine_coarse_stride"] = np.array(strides, dtype=np.int32)
     ds.attrs["refine_margin"] = np.int32(margin)
     ds.attrs["n_evaluated_points"] = np.int64(ev.evaluated)
+    # The file says at the top that some of its labels are not proved (cell = not_proved marks which).
+    ds.attrs["stabmap_inferred_labels"] = np.int64(total - ev.evaluated)
     return ds

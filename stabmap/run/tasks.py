@@ -19,8 +19,10 @@ import numpy as np
 
 from .. import systems
 from ..errors import StabmapError
+from ..store.variables import CELL
 from ..systems.base import SceneBase
 from ..version import __version__
+from . import cells
 
 PROBE_SECONDS = 0.2  # a probe stops once it has timed this much work
 
@@ -70,17 +72,26 @@ def block_values(scene: SceneBase, location, order: tuple[int, ...] | None = Non
     return values
 
 
-def evaluate_block(scene: SceneBase, location: tuple[tuple[int, int], ...]) -> dict[str, np.ndarray]:
-    """Every variable on the block ``location`` = ((start, stop) per grid axis), in grid order."""
+def evaluate_block(scene: SceneBase, location: tuple[tuple[int, int], ...], prove_cells: bool = True) -> dict[str, np.ndarray]:
+    """Every variable and ``cell`` on the block ``location`` = ((start, stop) per grid axis), in grid order.
+
+    ``prove_cells``: by boxes where the system proves them (``stabmap.run.cells``); otherwise (or False) every
+    node is computed and every cell is ``node_only``.
+    """
+    system = systems.of(scene)
     order = point_order(scene)
-    out = systems.of(scene).evaluate(scene, block_values(scene, location, order))
+    if prove_cells and cells.provable(scene):
+        return cells.decide_chunk(scene, location, lambda values: system.evaluate(scene, values), order)
+    out = system.evaluate(scene, block_values(scene, location, order))
     back = tuple(np.argsort(order))
-    return {k: v.transpose(back + tuple(range(len(order), v.ndim))).copy(order="C") for k, v in out.items()}
+    out = {k: v.transpose(back + tuple(range(len(order), v.ndim))).copy(order="C") for k, v in out.items()}
+    out[CELL.name] = np.full(tuple(b - a for a, b in location), cells.NODE_ONLY, dtype=CELL.dtype)
+    return out
 
 
-def evaluate_blocks(scene: SceneBase, locations: list) -> list[dict[str, np.ndarray]]:
+def evaluate_blocks(scene: SceneBase, locations: list, prove_cells: bool = True) -> list[dict[str, np.ndarray]]:
     """``evaluate_block`` of each of ``locations``: one task may decide several chunks of the grid."""
-    return [evaluate_block(scene, location) for location in locations]
+    return [evaluate_block(scene, location, prove_cells) for location in locations]
 
 
 def probe(scene: SceneBase, values: dict[str, np.ndarray]) -> tuple[int, float]:

@@ -24,7 +24,7 @@ import numpy as np
 from ..errors import StabmapError
 from .dataset import atlas_dataset
 
-FORMAT = 2  # 1: .npy files and a manifest.json (stabmap 0.1 before the Zarr checkpoint)
+FORMAT = 3  # 1: .npy files and a manifest.json (stabmap 0.1 before the Zarr checkpoint); 2: Zarr; 3: cell, prove_cells
 DONE = "chunk_done"
 
 
@@ -36,27 +36,29 @@ def partial_dir(output: str | Path) -> Path:
 class Checkpoint:
     """Finished chunks of one atlas run: the scene (TOML), the grid's shape and the chunk sizes fix its layout."""
 
-    def __init__(self, path: Path, scene_toml: str, shape: tuple[int, ...], chunks: tuple[int, ...], dims: dict[str, tuple]):
-        self.path, self.scene_toml = Path(path), scene_toml
+    def __init__(self, path: Path, scene_toml: str, shape: tuple[int, ...], chunks: tuple[int, ...], dims: dict[str, tuple],
+                 prove_cells: bool = True):
+        self.path, self.scene_toml, self.prove_cells = Path(path), scene_toml, prove_cells
         self.shape, self.chunks = tuple(shape), tuple(chunks)
         self.dims = dims  # the dimensions of every variable, the grid's first
         self._arrays = None  # the store's arrays, opened at the first save (Zarr region writes)
 
     @classmethod
-    def create(cls, path: Path, system, scene, chunks: tuple[int, ...]) -> Checkpoint:
-        """A new, empty checkpoint for ``scene`` cut into ``chunks``, created atomically at ``path``."""
+    def create(cls, path: Path, system, scene, chunks: tuple[int, ...], prove_cells: bool = True) -> Checkpoint:
+        """A new, empty checkpoint for ``scene`` cut into ``chunks``, created atomically at ``path``; ``prove_cells``:
+        how its chunks are decided (``stabmap.run.atlas.compute``), kept for a resumed run."""
         import dask.array as da
 
         nchunks = int(np.prod([-(-n // c) for n, c in zip(scene.shape, chunks)], dtype=np.int64))
         extra = system.dims(scene)
         lazy = {}
-        for v in system.variables:
+        for v in system.atlas_variables:
             sizes = tuple(extra[d] for d in v.dims)
             lazy[v.name] = da.zeros(scene.shape + sizes, chunks=tuple(chunks) + sizes, dtype=v.dtype)
         ds = atlas_dataset(system, scene, lazy)
         ds[DONE] = ("chunk", da.zeros((nchunks,), chunks=1, dtype=np.int8))
         ds.attrs.update({"stabmap_checkpoint_format": FORMAT, "stabmap_checkpoint_shape": list(scene.shape),
-                         "stabmap_checkpoint_chunks": list(chunks)})
+                         "stabmap_checkpoint_chunks": list(chunks), "stabmap_checkpoint_prove_cells": int(prove_cells)})
         tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
         try:
             ds.to_zarr(tmp, mode="w-", compute=False, consolidated=False)
@@ -81,7 +83,8 @@ class Checkpoint:
                 if a.get("stabmap_checkpoint_format") != FORMAT:
                     raise ValueError(f"format {a.get('stabmap_checkpoint_format')!r}, expected {FORMAT}")
                 dims = {k: ds[k].dims for k in ds.data_vars if k != DONE}
-                return cls(path, a["scene"], tuple(a["stabmap_checkpoint_shape"]), tuple(a["stabmap_checkpoint_chunks"]), dims)
+                return cls(path, a["scene"], tuple(a["stabmap_checkpoint_shape"]), tuple(a["stabmap_checkpoint_chunks"]), dims,
+                           bool(a["stabmap_checkpoint_prove_cells"]))
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise StabmapError(f"{str(path)!r} is not a readable partial stabmap run ({exc}); delete it to start over") from None
 

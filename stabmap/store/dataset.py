@@ -8,19 +8,25 @@ import datetime as dt
 import numpy as np
 import xarray as xr
 
+from ..scene.grid import bounds
 from ..version import __version__
 
-FORMAT_VERSION = 4  # 4: stabmap_system; every variable of the system written as declared
+BOUNDS_DIM = "bnds"  # the CF bounds variables' second dimension: a cell's two edges
+FORMAT_VERSION = 5  # 4: stabmap_system; every variable of the system written as declared; 5: cell and axis bounds
 
 
 def coordinates(system, scene, skip: tuple[str, ...] = ()) -> dict:
-    """The grid axes (except ``skip``) and every fixed parameter as CF coordinates with units."""
+    """The grid axes (except ``skip``) with their cells' CF bounds, and every fixed parameter, as CF coordinates."""
     coords = {}
     for axis in scene.grid:
         if axis.name in skip:
             continue
         info = system.parameter(scene, axis.name)
-        coords[axis.name] = (axis.name, axis.array, {"units": info.units, "long_name": info.long_name, "scale": axis.scale})
+        name = f"{axis.name}_bounds"
+        coords[axis.name] = (axis.name, axis.array, {"units": info.units, "long_name": info.long_name, "scale": axis.scale,
+                                                     "bounds": name})
+        coords[name] = ((axis.name, BOUNDS_DIM), bounds(axis.array), {"units": info.units,
+                        "long_name": f"edges of the grid cells along {axis.name} (midpoints between grid values)"})
     for key, value in system.fixed_values(scene).items():
         info = system.parameter(scene, key)
         coords[key] = ((), np.float64(value), {"units": info.units, "long_name": info.long_name})
@@ -46,7 +52,7 @@ def global_attrs(system, scene, kind: str) -> dict:
 def atlas_dataset(system, scene, arrays: dict) -> xr.Dataset:
     """The atlas Dataset of ``scene`` from one array (numpy or dask) per declared variable, in grid shape."""
     dims = tuple(a.name for a in scene.grid)
-    data = {v.name: (dims + v.dims, arrays[v.name], v.attrs()) for v in system.variables}
+    data = {v.name: (dims + v.dims, arrays[v.name], v.attrs()) for v in system.atlas_variables}
     coords = coordinates(system, scene)
     coords.update({d: (d, values, attrs) for d, (values, attrs) in system.dim_coords(scene).items()})
     return xr.Dataset(data, coords=coords, attrs=global_attrs(system, scene, "stabmap atlas"))
@@ -56,4 +62,4 @@ def empty_arrays(system, scene, shape: tuple[int, ...] | None = None) -> dict[st
     """Uninitialised arrays of every variable for ``shape`` (default: the grid's)."""
     shape = scene.shape if shape is None else shape
     extra = system.dims(scene)
-    return {v.name: np.empty(shape + tuple(extra[d] for d in v.dims), dtype=v.dtype) for v in system.variables}
+    return {v.name: np.empty(shape + tuple(extra[d] for d in v.dims), dtype=v.dtype) for v in system.atlas_variables}

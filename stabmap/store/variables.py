@@ -65,3 +65,19 @@ class Variable:
         if self.comment:
             out["comment"] = self.comment
         return out
+
+
+# Every atlas's one variable beyond its system's own: what is proved about the cell around each node
+# (stabmap.run.cells; docs/cells.md).  Declared here, once, for every system.
+CELL = Variable(
+    "cell",
+    "int8",
+    "what is proved about the grid cell around this node",
+    comment="A node's cell reaches halfway to its neighbours along every grid axis (the scan's first and last values "
+    "close the outermost cells; the bounds variables give its edges). "
+    "whole_cell: the node's label is proved at every point of its cell; "
+    "contains_change: the cell is proved to hold two labels, so a boundary lies in it; "
+    "node_only: the label is proved at the node only, the rest of the cell is not decided; "
+    f"not_proved: not even the node is proved (the label was {INFERRED}, an opt-in --refine atlas)",
+    flags=((0, "node_only"), (1, "whole_cell"), (2, "contains_change"), (3, "not_proved")),
+)

@@ -25,7 +25,7 @@ import numpy as np
 from ..scene import text
 from ..scene.grid import Axis
 from ..scene.values import Parameter
-from ..store.variables import Variable
+from ..store.variables import CELL, Variable
 
 
 class SceneBase:
@@ -186,6 +186,13 @@ class System:
         """The grid axes along which ``prove_boxes`` can prove a box of this scene (default: none)."""
         return set()
 
+    def proved_box(self, label: np.ndarray) -> dict[str, np.ndarray]:
+        """The other variables of nodes whose ``label`` a box proof holds (``prove_boxes``), not computed one by one.
+
+        Required of a system whose ``box_axes`` are not empty: its provenance flag says "proved over a box".
+        """
+        raise NotImplementedError(f"the {self.name} system proves boxes but does not say what a box-proved node holds")
+
     def inferred(self, label: np.ndarray) -> dict[str, np.ndarray] | None:
         """The other variables of points given ``label`` without being computed (adaptive refinement).
 
@@ -194,8 +201,13 @@ class System:
         return None
 
     # ------------------------------------------------------------------ outputs
+    @property
+    def atlas_variables(self) -> tuple[Variable, ...]:
+        """Every variable of an atlas file: the system's ``variables`` and ``cell`` (``stabmap.run.cells``)."""
+        return tuple(self.variables) + (CELL,)
+
     def variable(self, name: str) -> Variable:
-        for v in self.variables:
+        for v in self.atlas_variables:
             if v.name == name:
                 return v
         raise KeyError(f"the {self.name} system has no variable {name!r}")

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..base import Cost, System
 from . import scene as _scene
-from .outputs import BY_INFERRED, N_COMPLEX_PAIRS, VARIABLES, stability_from_pairs
+from .outputs import BY_BOX, BY_INFERRED, N_COMPLEX_PAIRS, VARIABLES, stability_from_pairs
 from .scene import Body, Scene
 
 REFERENCES = (
@@ -112,6 +112,9 @@ class Gyroscopes(System):
         from .decide import prove_boxes
 
         return prove_boxes(scene, lower, upper)
+
+    def proved_box(self, label: np.ndarray) -> dict[str, np.ndarray]:
+        return {"stability": stability_from_pairs(label), "decided_by": np.full(np.shape(label), BY_BOX, dtype=np.int8)}
 
     def class_name(self, value: int) -> str:
         if value < 0:
