@@ -1,0 +1,193 @@
+"""Cells of an atlas (stabmap.run.cells): what ``cell`` claims about the grid cell around each node, checked in
+exact rational arithmetic (python-flint) at points inside the cells, and against the exact boundaries of
+narrow windows and bands (the roots of the discriminant in omega, tests/test_boxes.py)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+import xarray as xr
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import stabmap
+from stabmap.run.critical import critical
+from stabmap.scene.grid import Axis, edges, resample
+from stabmap.store.variables import CELL
+from stabmap.systems.gyroscopes import exact
+from stabmap.systems.gyroscopes.outputs import BY_BOX
+from stabmap.systems.gyroscopes.points import point_arrays
+from stabmap.systems.gyroscopes.scene import from_dict
+
+WHOLE, CHANGE, NODE = (CELL.value(m) for m in ("whole_cell", "contains_change", "node_only"))
+
+# The two-body chain of tests/test_boxes.py: a stable window 0.108 rad/s wide near omega = 12 between scan values
+# 1 rad/s apart; exact boundaries 11.909452, 12.017778, 13.838770.
+WINDOW = {
+    "support": "fixed", "g": 9.81, "joints": [10.0],
+    "bodies": [
+        {"m": 1.0, "A": 0.02, "C": 0.06, "c": 0.1, "s": 0.2, "fluid": {"E": [5e-4], "kappa": [-2.5]}},
+        {"m": 1.0, "A": 0.05, "C": 0.06, "c": 0.05, "fluid": {"E": [5e-4], "kappa": [4.5]}},
+    ],
+    "grid": {"omega": {"start": 0.5, "stop": 99.5, "num": 100}},
+}
+EXACT_BOUNDARIES = (11.909452, 12.017778, 13.838770)
+
+
+def _exact(scene, values: dict[str, np.ndarray]) -> np.ndarray:
+    pts = point_arrays(scene, {k: np.asarray(v, dtype=float) for k, v in values.items()})
+    return exact.decide_points(*pts.kernel_args(), np.arange(pts.body.shape[0]))
+
+
+def _atlas(scene, **kwargs):
+    return stabmap.compute_atlas(scene, threads=1, progress=False, **kwargs)
+
+
+def _cell_points(scene, index: tuple[int, ...], rng, k: int) -> dict[str, np.ndarray]:
+    """k random points of the cell of the node ``index`` (uniform in its box)."""
+    out = {}
+    for axis, i in zip(scene.grid, index):
+        e = edges(axis.array)
+        out[axis.name] = rng.uniform(min(e[i], e[i + 1]), max(e[i], e[i + 1]), k)
+    return out
+
+
+def _cells_containing(scene, x: float) -> list[int]:
+    """The cells of a 1-D scan that hold the value x (two where x is an edge)."""
+    e = edges(scene.grid[0].array)
+    return [i for i in range(len(e) - 1) if min(e[i], e[i + 1]) <= x <= max(e[i], e[i + 1])]
+
+
+# ---------------------------------------------------------------------------------------------- bounds
+def test_cells_tile_the_scan_and_are_written_as_cf_bounds(tmp_path):
+    scene = resample(stabmap.example("paper-n1-fixed"), omega=7, c_1=5)
+    ds = _atlas(scene)
+    for axis in scene.grid:
+        b = ds[f"{axis.name}_bounds"].values
+        assert ds[axis.name].attrs["bounds"] == f"{axis.name}_bounds"
+        assert b[0, 0] == axis.values[0] and b[-1, 1] == axis.values[-1]
+        assert np.array_equal(b[1:, 0], b[:-1, 1])  # no gap, no overlap
+        assert np.all((b[:, 0] <= axis.array) & (axis.array <= b[:, 1]))
+        assert np.allclose(b[1:, 0], 0.5 * (axis.array[1:] + axis.array[:-1]), rtol=0, atol=1e-15)
+    path = tmp_path / "a.nc"
+    stabmap.write_atlas(ds, path)
+    back = xr.load_dataset(path)
+    assert back["omega"].attrs["bounds"] == "omega_bounds" and back["omega_bounds"].shape == (7, 2)
+    assert back["cell"].attrs["flag_meanings"] == " ".join(CELL.meanings)
+
+
+# ---------------------------------------------------------------------------------- narrow windows and bands
+def test_the_narrow_window_is_drawn_as_change_never_as_a_whole_cell():
+    scene = from_dict(WINDOW)
+    ds = _atlas(scene)
+    cell = ds["cell"].values
+    for x in EXACT_BOUNDARIES:
+        for i in _cells_containing(scene, x):
+            assert cell[i] == CHANGE, (x, i, CELL.meaning(int(cell[i])))
+    # the label between two nodes that agree (N_c = 1 at omega = 11.5 and 12.5) is not claimed for the window's cells
+    assert ds["n_complex_pairs"].sel(omega=[11.5, 12.5]).values.tolist() == [1, 1]
+
+
+@pytest.mark.parametrize("E", [1e-4, 1e-6, 1e-8])
+def test_narrow_liquid_bands_never_hide_in_a_whole_cell(E):
+    # Smaller E narrows the liquid resonances to bands far below the scan step; the boundaries come from critical
+    # values (checked against the exact discriminant in tests/test_boxes.py), each located to 1e-10.
+    system = dict(WINDOW, bodies=[dict(b, fluid=dict(b["fluid"], E=[E])) for b in WINDOW["bodies"]])
+    scene = from_dict(system)
+    ds = _atlas(scene)
+    crit = critical(scene, "omega", rtol=1e-10, progress=False, threads=1)
+    keep = np.isfinite(crit["boundary_lower"].values)
+    cell = ds["cell"].values
+    for a, b in zip(crit["boundary_lower"].values[keep], crit["boundary_upper"].values[keep]):
+        for i in set(_cells_containing(scene, a)) | set(_cells_containing(scene, b)):
+            assert cell[i] != WHOLE, (E, a, i)
+    # and every whole cell holds its label at random interior points, exactly
+    rng = np.random.default_rng(int(-np.log10(E)))
+    whole = np.flatnonzero(cell == WHOLE)
+    pick = rng.choice(whole, min(40, whole.size), replace=False)
+    x = np.concatenate([_cell_points(scene, (i,), rng, 3)["omega"] for i in pick])
+    assert np.array_equal(_exact(scene, {"omega": x}), np.repeat(ds["n_complex_pairs"].values[pick], 3))
+
+
+# --------------------------------------------------------------------------------------- random scenes (2-D)
+def _random_scene(seed: int):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 4))
+    bodies = []
+    for _ in range(n):
+        body = {"m": float(rng.uniform(0.5, 2)), "A": float(rng.uniform(0.01, 0.05)), "C": float(rng.uniform(0.01, 0.08)),
+                "c": float(rng.uniform(-0.05, 0.15)), "s": float(rng.uniform(0.1, 0.3))}
+        if rng.random() < 0.7:
+            L = int(rng.integers(1, 3))
+            body["fluid"] = {"E": [float(x) for x in rng.uniform(1e-4, 2e-3, L)],
+                             "kappa": [float(x) for x in rng.choice([-2.5, 1.3, 2.7, 4.5], L, replace=False)]}
+        bodies.append(body)
+    other = str(rng.choice(["K_1", "m_1", "c_1", "g"])) if n > 1 else str(rng.choice(["m_1", "c_1", "g"]))
+    start = {"K_1": 0.0, "m_1": 0.5, "c_1": -0.05, "g": 0.0}[other]
+    stop = {"K_1": 40.0, "m_1": 3.0, "c_1": 0.2, "g": 20.0}[other]
+    system = {"support": "fixed", "g": 9.81, "bodies": bodies, "joints": [float(x) for x in rng.uniform(0, 20, n - 1)],
+              "grid": {"omega": {"start": float(rng.uniform(1, 10)), "stop": float(rng.uniform(30, 120)), "num": int(rng.integers(5, 13))},
+                       other: {"start": start, "stop": stop, "num": int(rng.integers(4, 9))}}}
+    return from_dict(system)
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**31 - 1))
+def test_a_whole_cell_has_its_label_at_random_interior_points_in_exact_arithmetic(seed):
+    scene = _random_scene(seed)
+    ds = _atlas(scene)
+    cell, label = ds["cell"].values, ds["n_complex_pairs"].values
+    rng = np.random.default_rng(seed)
+    whole = np.argwhere(cell == WHOLE)
+    for index in whole[rng.permutation(len(whole))[:6]]:
+        pts = _cell_points(scene, tuple(index), rng, 4)
+        assert np.all(_exact(scene, pts) == label[tuple(index)]), (seed, tuple(index))
+    # a claimed change: two labels inside the cell (node or corner labels, else random points find the other)
+    change = np.argwhere(cell == CHANGE)
+    for index in change[rng.permutation(len(change))[:2]]:
+        corners = {a.name: edges(a.array)[[i, i + 1]] for a, i in zip(scene.grid, index)}
+        grid = np.meshgrid(*corners.values(), indexing="ij")
+        seen = set(_exact(scene, {k: g.ravel() for k, g in zip(corners, grid)}).tolist()) | {int(label[tuple(index)])}
+        if len(seen) == 1:
+            seen |= set(_exact(scene, _cell_points(scene, tuple(index), rng, 300)).tolist())
+        assert len(seen) > 1, (seed, tuple(index))
+
+
+def test_cells_keep_every_node_label_and_compute_fewer_nodes():
+    for name in ("paper-n1-fixed", "paper-n2-fixed", "paper-n2-free", "paper-n3-fixed-split", "tree-two-rotors-free"):
+        scene = resample(stabmap.example(name), **{a.name: 24 for a in stabmap.example(name).grid})
+        nodes, cells = _atlas(scene, prove_cells=False), _atlas(scene)
+        assert np.array_equal(nodes["n_complex_pairs"].values, cells["n_complex_pairs"].values), name
+        assert np.all(nodes["cell"].values == NODE)
+        computed = cells["decided_by"].values != BY_BOX
+        assert np.array_equal(nodes["decided_by"].values[computed], cells["decided_by"].values[computed]), name
+        # a node a box proved lies in a whole cell
+        assert np.all(cells["cell"].values[~computed] == WHOLE), name
+
+
+def test_systems_without_box_proofs_answer_node_only():
+    for name in ("closed-hinge", "reactions-square-plate"):
+        scene = stabmap.example(name)
+        scene = resample(scene, **{a.name: min(6, len(a.values)) for a in scene.grid})
+        ds = _atlas(scene)
+        assert np.all(ds["cell"].values == NODE), name
+
+
+def test_a_cavity_axis_leaves_cells_node_only():
+    # The liquid modes depend on the cavity's half height: no box encloses them (boxes.box_axes), so no cell is proved.
+    scene = stabmap.example("top-cylinder-cavity")
+    scene = resample(scene, omega=6, half_height_1=5)
+    ds = _atlas(scene)
+    assert np.all(ds["cell"].values == NODE)
+    assert np.array_equal(ds["n_complex_pairs"].values, _atlas(scene, prove_cells=False)["n_complex_pairs"].values)
+
+
+def test_query_says_whether_the_cell_is_proved(tmp_path):
+    scene = dataclasses.replace(from_dict(WINDOW), grid=(Axis("omega", tuple(np.linspace(0.5, 99.5, 100))),))
+    ds = _atlas(scene)
+    from stabmap.read.query import label_at
+
+    assert label_at(ds, omega=12.0).cell == "contains_change"
+    assert label_at(ds, omega=60.0).cell == "whole_cell"
