@@ -205,18 +205,23 @@ def _box_ok(body, rb):
 
 
 @kernel
-def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, parent, at, rat, t, t_lo, t_hi, out_nc, out_status):
-    """N_c proved for every point of each of a block of boxes along whose main parameter p is a polynomial.
+def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, parent, at, rat, t, t_lo, t_hi, t2, t2_lo, t2_hi,
+                    out_nc, out_status):
+    """N_c proved for every point of each of a block of boxes along whose one or two main parameters p is a polynomial.
 
-    Box p moves one parameter t over [t_lo[p], t_hi[p]] (its other parameters within their radii), and every
-    coefficient of p is a polynomial of degree < N in t.  ``t[p]`` holds N distinct nodes in that interval, and
-    ``body[p, k]``, ``joint[p, k]``, ``g[p, k]``, ``at[p, k]`` (with their radii ``rbody`` ... in the same
-    layout) the kernel inputs at node k, layouts as for ``box_block`` with a node axis after the box axis.
-    The coefficients are enclosed at each node as narrowly as at a point, and ``count_nodes`` counts over the
-    whole interval of t (docs/certification.md, section 6).  Outputs as for ``box_block``; more than
-    ``LAPLACE_MAX`` bodies: UNDECIDED.
+    Box p moves t over [t_lo[p], t_hi[p]] and t2 over [t2_lo[p], t2_hi[p]] (its other parameters within their
+    radii), and every coefficient of p is a polynomial of degree < N1 in t and < N2 in t2.  ``t[p]`` holds N1
+    distinct nodes in the interval of t, ``t2[p]`` N2 in that of t2; N2 = 1 (t2 = t2_lo = t2_hi = 0) is a box along
+    t alone.  ``body[p, k]``, ``joint[p, k]``, ``g[p, k]``, ``at[p, k]`` (with their radii ``rbody`` ... in the same
+    layout) are the kernel inputs at node k = i N2 + j, (t[p, i], t2[p, j]), layouts as for ``box_block`` with a
+    node axis after the box axis.  The coefficients are enclosed at each node as narrowly as at a point, and
+    ``count_nodes`` counts over the whole box (docs/certification.md, section 6).  Outputs as for ``box_block``;
+    more than ``LAPLACE_MAX`` bodies: UNDECIDED.  ValueError unless the node axis has N1 N2 entries.
     """
     npts, N, n = body.shape[0], body.shape[1], body.shape[2]
+    N1, N2 = t.shape[1], t2.shape[1]
+    if N != N1 * N2:
+        raise ValueError("nodes_box_block: the node axis must hold t.shape[1] * t2.shape[1] nodes")
     rowdeg = nmodes + 2
     degree = int(rowdeg.sum())
     laplace = n <= LAPLACE_MAX
@@ -225,17 +230,32 @@ def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, p
     C = np.empty((N, degree + 1, 3))
     Xn = np.empty((N, degree + 1, 3))
     F = np.empty((4, N, 3))
+    G = np.empty((N1, 3))
     for p in range(npts):
         out_nc[p], out_status[p] = -1, UNDECIDED
-        ok = laplace and t_lo[p] <= t_hi[p] and abs(t_lo[p]) < dd.LARGE and abs(t_hi[p]) < dd.LARGE
+        ok = laplace and _nodes_ok(t[p], t_lo[p], t_hi[p]) and _nodes_ok(t2[p], t2_lo[p], t2_hi[p])
         for k in range(N):
-            # distinct nodes in decreasing order, inside the interval: the divided differences divide by their gaps
-            ok = ok and _box_ok(body[p, k], rbody[p, k]) and t_lo[p] <= t[p, k] <= t_hi[p] and (k == 0 or t[p, k] < t[p, k - 1])
+            ok = ok and _box_ok(body[p, k], rbody[p, k])
         if not ok:
             continue
-        tm = 0.5 * t_lo[p] + 0.5 * t_hi[p]
-        tr = np.nextafter(max(t_hi[p] - tm, tm - t_lo[p]), np.inf)
+        grid = (N1, t[p], *_ball(t_lo[p], t_hi[p]), N2, t2[p], *_ball(t2_lo[p], t2_hi[p]))
         for k in range(N):
             matrix_box(body[p, k], rbody[p, k], joint[p, k], rjoint[p, k], at[p, k], rat[p, k], g[p, k], rg[p, k], E[p], kappa[p], nmodes, parent, free, ws)
             block_det(ws, rowdeg, 0, n, C[k])
-        out_nc[p], out_status[p] = count_nodes(C, N, t[p], tm, tr, cs, Xn, F)
+        out_nc[p], out_status[p] = count_nodes(C, grid, cs, Xn, F, G)
+
+
+@kernel
+def _nodes_ok(t, lo, hi):
+    """Distinct nodes in decreasing order inside a finite [lo, hi]: the divided differences divide by their gaps."""
+    ok = lo <= hi and abs(lo) < dd.LARGE and abs(hi) < dd.LARGE
+    for k in range(t.shape[0]):
+        ok = ok and lo <= t[k] <= hi and (k == 0 or t[k] < t[k - 1])
+    return ok
+
+
+@kernel
+def _ball(lo, hi):
+    """Midpoint and radius of a float ball holding [lo, hi]."""
+    m = 0.5 * lo + 0.5 * hi
+    return m, np.nextafter(max(hi - m, m - lo), np.inf)

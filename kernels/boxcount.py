@@ -26,6 +26,14 @@ degree < N in u, equal to its interpolant through the N nodes: the divided diffe
 in ``dd`` intervals, and the Newton form evaluated on the interval of u enclose it over the whole box.  This
 follows the values themselves, where Horner's rule on independent coefficient intervals would add up their
 widths (the coefficients move together).  One node (N = 1) is the plain enclosure.
+
+**Polynomial in two parameters.** Where p has degree < N1 in t1 and < N2 in t2 (a box moving two axes), it is
+enclosed on the tensor grid of N1 x N2 nodes (t1[i], t2[j]), node k = i N2 + j.  Its tensor interpolant is p:
+p(t1, t2) = sum_a N_a(t1) q_a(t2), q_a(t2) = sum_b c_ab M_b(t2), with N_a, M_b the Newton bases of the two node
+sets and c_ab the divided differences of the node values along t2, then along t1 (linear in the node values, so
+enclosed from their enclosures).  The Newton form of each q_a, evaluated on the interval of t2, encloses q_a
+there; the Newton form in t1 with those intervals as coefficients, on the interval of t1, encloses p on the whole
+box (``over_grid``).  N2 = 1 is the one-parameter case, operation for operation.
 """
 
 from __future__ import annotations
@@ -50,19 +58,56 @@ def _real_value(X, d, x):
 
 
 @kernel
-def over_box(F, N, u, um, ur):
-    """Enclosure over u in [um - ur, um + ur] of the polynomial of degree < N whose values at the nodes u[:N]
-    lie in F[:N] (dd intervals); F is overwritten by the divided differences.  N = 1: F[0] itself."""
+def _divided(F, N, u):
+    """F[:N] (dd intervals, the values at the distinct nodes u[:N]) overwritten by their divided differences."""
     for j in range(1, N):
         for i in range(N - 1, j - 1, -1):
             t = dd.add(F[i, 0], F[i, 1], F[i, 2], *dd.neg(F[i - 1, 0], F[i - 1, 1], F[i - 1, 2]))
             sh, sl = dd.two_sum(u[i], -u[i - j])  # the nodes are floats: their difference is exact
             F[i, 0], F[i, 1], F[i, 2] = dd.div(*t, sh, sl, 0.0)
+
+
+@kernel
+def _newton(F, N, u, um, ur):
+    """Enclosure over u in [um - ur, um + ur] of the Newton form with the divided differences F[:N] at the nodes u."""
     acc = (F[N - 1, 0], F[N - 1, 1], F[N - 1, 2])
     for j in range(N - 2, -1, -1):
         sh, sl = dd.two_sum(um, -u[j])
         acc = dd.fma(F[j, 0], F[j, 1], F[j, 2], sh, sl, ur, *acc)
     return acc
+
+
+@kernel
+def over_box(F, N, u, um, ur):
+    """Enclosure over u in [um - ur, um + ur] of the polynomial of degree < N whose values at the nodes u[:N]
+    lie in F[:N] (dd intervals); F is overwritten by the divided differences.  N = 1: F[0] itself."""
+    _divided(F, N, u)
+    return _newton(F, N, u, um, ur)
+
+
+@kernel
+def over_grid(F, grid, G):
+    """Enclosure over the box ``grid`` = (N1, t1, m1, r1, N2, t2, m2, r2) (t_a in [m_a - r_a, m_a + r_a]) of the
+    polynomial of degree < N1 in t1 and < N2 in t2 whose values at the nodes (t1[i], t2[j]) lie in F[i N2 + j]
+    (module docstring).  F and the scratch G (>= N1, 3) are overwritten.  N2 = 1: ``over_box`` along t1, operation
+    for operation."""
+    N1, t1, m1, r1, N2, t2, m2, r2 = grid
+    # The tensor divided differences first, on the narrow node values (they are linear in them, so the order of the
+    # two axes does not matter); only then the Newton form on the intervals.  Evaluating along t2 first and
+    # interpolating the resulting wide intervals along t1 would divide their widths by the node gaps.
+    for i in range(N1):
+        _divided(F[i * N2 : (i + 1) * N2], N2, t2)
+    for j in range(N2):
+        _divided(F[j::N2], N1, t1)
+    for i in range(N1):
+        G[i, 0], G[i, 1], G[i, 2] = _newton(F[i * N2 : (i + 1) * N2], N2, t2, m2, r2)
+    return _newton(G, N1, t1, m1, r1)
+
+
+@kernel
+def middle(grid):
+    """The node nearest the middle of the grid: the one whose polynomial the approximations start from."""
+    return (grid[0] // 2) * grid[4] + grid[4] // 2
 
 
 @kernel
@@ -80,16 +125,16 @@ def _upper(h, l, r):
 
 
 @kernel
-def _newton_radius(X, N, u, um, ur, d, zr, zi, F):
+def _newton_radius(X, grid, d, zr, zi, F, G):
     """d |p(z)| / |p'(z)| bounded above over every polynomial of the box; inf where |p'(z)| may vanish."""
-    for k in range(N):
+    for k in range(grid[0] * grid[4]):
         re, im, dre, dim = horner_dd(X[k], d, zr, zi)
         for part, v in enumerate((re, im, dre, dim)):
             F[part, k, 0], F[part, k, 1], F[part, k, 2] = v
-    re = over_box(F[0], N, u, um, ur)
-    im = over_box(F[1], N, u, um, ur)
-    dre = over_box(F[2], N, u, um, ur)
-    dim = over_box(F[3], N, u, um, ur)
+    re = over_grid(F[0], grid, G)
+    im = over_grid(F[1], grid, G)
+    dre = over_grid(F[2], grid, G)
+    dim = over_grid(F[3], grid, G)
     upper = math.hypot(_upper(*re), _upper(*im)) * MU
     # |p'| >= |midpoint| - radius, each part: the midpoint's modulus rounded down, the radii up
     mid = math.hypot(dre[0] + dre[1], dim[0] + dim[1]) / MU
@@ -101,16 +146,17 @@ def _newton_radius(X, N, u, um, ur, d, zr, zi, F):
 
 
 @kernel
-def count_complex_pairs_box(X, N, u, um, ur, d, a, z, R, order, flags, F):
+def count_complex_pairs_box(X, grid, d, a, z, R, order, flags, F, G):
     """N_c of every polynomial of a box: X[:N] (rows 0..d each, no zero root, lc proved nonzero and the same)
-    enclose p at the nodes u[:N] of a parameter in [um - ur, um + ur], p of degree < N in it (module docstring);
-    N = 1: X[0] encloses p over the whole box.
+    enclose p at the N = N1 N2 nodes of ``grid`` (``over_grid``), p of degree < N1 in t1 and < N2 in t2 (module
+    docstring); N = 1: X[0] encloses p over the whole box.
 
     The polynomials should share one exact power-of-two scaling that puts the roots near modulus one
     (``scaling.rescale``).  Scratch: a (d + 1 floats), z (d complex), R (d floats), order (d ints), flags (d
-    bools), F (4, N, 3).  Returns (N_c, DECIDED_INCLUSION) or (-1, UNDECIDED).
+    bools), F (4, N, 3), G (N1, 3).  Returns (N_c, DECIDED_INCLUSION) or (-1, UNDECIDED).
     """
-    if not approximate(X[N // 2], d, a, z, flags):
+    N = grid[0] * grid[4]
+    if not approximate(X[middle(grid)], d, a, z, flags):
         return -1, UNDECIDED
     # Real approximations in increasing order.
     r = 0
@@ -129,7 +175,7 @@ def count_complex_pairs_box(X, N, u, um, ur, d, a, z, R, order, flags, F):
             x = 0.5 * R[j] + 0.5 * R[j + 1]
             for k in range(N):
                 F[0, k, 0], F[0, k, 1], F[0, k, 2] = _real_value(X[k], d, x)
-            s = _sign(*over_box(F[0], N, u, um, ur))
+            s = _sign(*over_grid(F[0], grid, G))
         if s == 0:
             return -1, UNDECIDED
         if s != previous:
@@ -141,7 +187,7 @@ def count_complex_pairs_box(X, N, u, um, ur, d, a, z, R, order, flags, F):
     k = 0
     for i in range(d):
         if z[i].imag > 0.0:
-            rho = _newton_radius(X, N, u, um, ur, d, z[i].real, z[i].imag, F)
+            rho = _newton_radius(X, grid, d, z[i].real, z[i].imag, F, G)
             if not rho * MU < z[i].imag:
                 return -1, UNDECIDED
             for j in range(k):

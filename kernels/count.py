@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from . import dd
-from .boxcount import over_box, count_complex_pairs_box
+from .boxcount import count_complex_pairs_box, middle, over_grid
 from .inclusion import count_complex_pairs_inclusion
 from .options import kernel
 from .scaling import nonzero_span, rescale, rescale_by, root_scale
@@ -79,19 +79,23 @@ def count_box(c, ws):
     if d < 0:
         return nc, status
     one = np.zeros(1)
-    return count_complex_pairs_box(X.reshape((1,) + X.shape), 1, one, 0.0, 0.0, d, a, z, R, group[:d], flags, np.empty((4, 1, 3)))
+    point = (1, one, 0.0, 0.0, 1, one, 0.0, 0.0)  # one node: X encloses p over the whole box
+    return count_complex_pairs_box(X.reshape((1,) + X.shape), point, d, a, z, R, group[:d], flags, np.empty((4, 1, 3)), np.empty((1, 3)))
 
 
 @kernel
-def count_nodes(C, N, u, um, ur, ws, Xn, F):
-    """(N_c, status) of every polynomial of a box whose coefficients are polynomials of degree < N in a parameter
-    u in [um - ur, um + ur], enclosed at the nodes u[:N] in C[:N] (``boxcount``, "Polynomial in one parameter").
+def count_nodes(C, grid, ws, Xn, F, G):
+    """(N_c, status) of every polynomial of a box whose coefficients are polynomials of degree < N1 in t1 and < N2
+    in t2, enclosed at the N = N1 N2 nodes of ``grid`` in C[:N] (``boxcount``, "Polynomial in one parameter" and
+    "in two parameters").
 
-    ws from ``allocate_count``; Xn (N, deg + 1, 3) and F (4, N, 3) are scratch.  Coefficients that are exact
-    zeros at every node are zero for every u (a polynomial of degree < N with N zeros), so the exact zero roots
-    and the degree are the box's.
+    ws from ``allocate_count``; Xn (N, deg + 1, 3), F (4, N, 3) and G (N1, 3) are scratch.  Coefficients that are
+    exact zeros at every node are zero on the whole box (a polynomial of degree < N1 in t1 and < N2 in t2 that
+    vanishes on the grid: each row's interpolant is zero, then each column's), so the exact zero roots and the
+    degree are the box's.
     """
     W, X, a, z, R, group, flags = ws
+    N = grid[0] * grid[4]
     low, top = C.shape[1], -1
     for k in range(N):
         lk, tk = nonzero_span(C[k])
@@ -102,11 +106,11 @@ def count_nodes(C, N, u, um, ur, ws, Xn, F):
     d = top - low
     for k in range(N):
         F[0, k, 0], F[0, k, 1], F[0, k, 2] = C[k, top, 0], C[k, top, 1], C[k, top, 2]
-    if not dd.certain_nonzero(*over_box(F[0], N, u, um, ur)):
+    if not dd.certain_nonzero(*over_grid(F[0], grid, G)):
         return -1, UNDECIDED
     if d < 2:  # a real polynomial of degree 0 or 1 has only real roots
         return 0, DECIDED_INCLUSION
-    mid = N // 2
+    mid = middle(grid)
     for k in range(N):
         Xn[k, : d + 1] = C[k, low : top + 1]
     shift = root_scale(Xn[mid], d)
@@ -114,4 +118,4 @@ def count_nodes(C, N, u, um, ur, ws, Xn, F):
     for k in range(N):
         if not rescale_by(Xn[k], d, shift, e):
             return -1, UNDECIDED
-    return count_complex_pairs_box(Xn, N, u, um, ur, d, a, z, R, group[:d], flags, F)
+    return count_complex_pairs_box(Xn, grid, d, a, z, R, group[:d], flags, F, G)

@@ -1,16 +1,17 @@
 """Boxes of parameter points for the box kernels: enclosures that hold every point of a box.
 
-A box moves some grid axes over closed intervals and fixes the others.  Three ways to hand it to the kernels,
-the narrowest first (docs/certification.md, section 6):
+A box moves some grid axes over closed intervals and fixes the others.  Five ways to hand it to the kernels,
+the narrowest first (docs/certification.md, section 6; the degree bounds in ``nodes``):
 
-- **spin-scaled** (``kernels.nodes_box_block``): every body spins at one rate omega that the box moves, not
-  through 0.  With lambda = omega mu, p(omega mu; omega) = omega^D p_1(mu; u), u = 1 / omega^2, p_1 the
-  polynomial at unit spin with the stiffness (joints and gravity) times u: the same real roots.  Each row of
-  P is affine in u, so p_1 is a polynomial of degree <= n in u, enclosed at n + 1 nodes.
-- **one mechanical axis** (``kernels.nodes_box_block``): the box moves one axis whose kernel inputs are copies
-  of its value (a mass, inertia, length, stiffness or g).  Every row of P is a polynomial of degree <= 2 in it
-  (M = diag(A) + J^T diag(m) J, J linear in lengths), so p has degree <= 2n: 2n + 1 nodes.  Not a mass of a
-  free system (it divides by the total mass).
+- **spin and one mechanical axis** (``kernels.nodes_box_block``): every body spins at the one rate omega of one
+  grid axis, which the box moves, not through 0, and the box moves one more axis whose kernel inputs are copies
+  of its value (a mass, inertia, length, stiffness or g).  With lambda = omega mu, p(omega mu; omega) =
+  omega^D p_1(mu; u), u = 1 / omega^2, p_1 the polynomial at unit spin with the stiffness (joints and gravity)
+  times u: the same real roots.  p_1 has degree <= n in u and <= 2n in the axis: the tensor grid of (n + 1) x
+  (2n + 1) nodes.
+- **two mechanical axes**: (2n + 1) x (2n + 1) nodes.
+- **spin-scaled**: the spin as above, other moving axes within their radii: n + 1 nodes in u.
+- **one mechanical axis**: 2n + 1 nodes.  Not a mass of a free system (it divides by the total mass).
 - **plain** (``kernels.box_block``): the hull of the corners' inputs, as intervals.
 """
 
@@ -20,12 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .nodes import NodeBoxes, mechanical, spin_scaled
 from .parameters import parse_name
 from .points import PointArrays, point_arrays
 from .scene import Scene
 
-ROUNDING = 2.0**-52  # relative bound of one rounding, with a factor 2 of margin
-TINY = 2.0**-1074
+__all__ = ["BoxArrays", "NodeBoxes", "box_arrays", "box_axes", "boxes", "unenclosed"]
 
 
 @dataclass
@@ -51,36 +52,6 @@ class BoxArrays:
     def kernel_args(self):
         m = self.mid
         return (m.body, self.rbody, m.joint, self.rjoint, m.g, self.rg, m.E, m.kappa, m.nmodes, m.free, m.parent, m.at, self.rat)
-
-
-@dataclass
-class NodeBoxes:
-    """Boxes for ``kernels.nodes_box_block``: the kernel inputs at N nodes t of each box's main parameter.
-
-    ``body``, ``joint``, ``g``, ``at`` and their radii have a node axis after the box axis; t (npts, N) holds the
-    nodes, distinct and decreasing, inside [t_lo, t_hi].
-    """
-
-    body: np.ndarray
-    rbody: np.ndarray
-    joint: np.ndarray
-    rjoint: np.ndarray
-    g: np.ndarray
-    rg: np.ndarray
-    at: np.ndarray
-    rat: np.ndarray
-    E: np.ndarray
-    kappa: np.ndarray
-    nmodes: np.ndarray
-    free: bool
-    parent: np.ndarray
-    t: np.ndarray
-    t_lo: np.ndarray
-    t_hi: np.ndarray
-
-    def kernel_args(self):
-        return (self.body, self.rbody, self.joint, self.rjoint, self.g, self.rg, self.E, self.kappa, self.nmodes, self.free,
-                self.parent, self.at, self.rat, self.t, self.t_lo, self.t_hi)
 
 
 def box_axes(scene: Scene) -> set[str]:
@@ -125,13 +96,6 @@ def _hull(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return mid, rad
 
 
-def _outward(x: np.ndarray, direction: float, steps: int = 2) -> np.ndarray:
-    """x moved ``steps`` floats towards ``direction``, except exact zeros (which stay exact)."""
-    for _ in range(steps):
-        x = np.where(x != 0.0, np.nextafter(x, direction), x)
-    return x
-
-
 def _corners(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> tuple[PointArrays, PointArrays]:
     """The kernel inputs at the two corners of the boxes; ValueError for a box that spans an axis outside box_axes."""
     if set(lower) != set(upper):
@@ -161,86 +125,25 @@ def box_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
     return _plain(*_corners(scene, lower, upper))
 
 
-def _chebyshev(lo: np.ndarray, hi: np.ndarray, N: int) -> np.ndarray:
-    """N Chebyshev nodes of each [lo, hi] (rows), decreasing, clamped inside (the kernel checks they are distinct)."""
-    mid = 0.5 * lo + 0.5 * hi
-    t = mid[:, None] + (hi - mid)[:, None] * np.cos(np.pi * (2 * np.arange(N) + 1) / (2 * N))[None, :]
-    return np.clip(t, lo[:, None], hi[:, None])
-
-
-def _times(x: np.ndarray, r: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A ball (midpoint, radius) holding (x +- r) u for floats u > 0 (broadcast); an exact zero stays exact."""
-    m = x * u
-    rad = np.abs(m) * ROUNDING + r * u * (1.0 + 2.0 * ROUNDING) + TINY
-    return m, np.where((x == 0.0) & (r == 0.0), 0.0, rad)
-
-
-def _spin_rows(lo: PointArrays, hi: PointArrays) -> np.ndarray:
-    """Boxes that every body spins through at one rate omega, not through 0."""
+def _spin_rows(scene: Scene, lo: PointArrays, hi: PointArrays, moves: dict[str, np.ndarray]) -> np.ndarray:
+    """Boxes that every body spins through at one rate omega, not through 0: one spin axis moves, and every body's
+    spin column with it (two spin axes over the same interval hold points where the bodies spin apart)."""
+    spins = sum(moves[k].astype(int) for k in moves if _is_spin(scene, k))
     w_lo = np.minimum(lo.body[..., 5], hi.body[..., 5])
     w_hi = np.maximum(lo.body[..., 5], hi.body[..., 5])
-    one_rate = np.all(w_lo == w_lo[:, :1], axis=1) & np.all(w_hi == w_hi[:, :1], axis=1)
+    one_rate = np.all(w_lo == w_lo[:, :1], axis=1) & np.all(w_hi == w_hi[:, :1], axis=1) & (spins == 1)
     return np.flatnonzero(one_rate & (w_lo[:, 0] != w_hi[:, 0]) & ((w_lo[:, 0] > 0.0) | (w_hi[:, 0] < 0.0)))
 
 
-def _spin_scaled(box: BoxArrays, w1: np.ndarray, w2: np.ndarray) -> NodeBoxes:
-    """The plain boxes ``box`` in the spin-scaled model (module docstring): u = 1 / omega^2 at n + 1 nodes, the
-    other parameters within their radii at every node.  omega runs between the corners' w1 and w2 (one sign)."""
-    m = box.mid
-    near, far = np.minimum(np.abs(w1), np.abs(w2)), np.maximum(np.abs(w1), np.abs(w2))
-    u_lo, u_hi = _outward(1.0 / (far * far), -np.inf, 3), _outward(1.0 / (near * near), np.inf, 3)
-    n = m.body.shape[1]
-    u = _chebyshev(u_lo, u_hi, n + 1)
-
-    def at_nodes(x: np.ndarray) -> np.ndarray:
-        return x[:, None].repeat(n + 1, axis=1)
-
-    body, rbody = at_nodes(m.body), at_nodes(box.rbody)
-    body[..., 5], rbody[..., 5] = 1.0, 0.0
-    joint, rjoint = _times(m.joint[:, None], box.rjoint[:, None], u[..., None])
-    g, rg = _times(m.g[:, None], box.rg[:, None], u)
-    return NodeBoxes(body, rbody, joint, rjoint, g, rg, at_nodes(m.at), at_nodes(box.rat), m.E, m.kappa, m.nmodes, m.free,
-                     m.parent, u, u_lo, u_hi)
+def _is_spin(scene: Scene, key: str) -> bool:
+    return parse_name(key, scene.n, scene.support).symbol == "omega"
 
 
 def _mechanical(scene: Scene, key: str) -> bool:
-    """An axis whose inputs enter every row of P polynomially, with degree <= 2 (module docstring)."""
+    """An axis whose inputs enter every row of P polynomially, with degree <= 2 (``nodes``)."""
     name = parse_name(key, scene.n, scene.support)
     kinds = ("body", "every_body", "joint", "every_joint", "position", "global")
     return name.kind in kinds and name.symbol != "omega" and not (scene.free and name.symbol == "m")
-
-
-def _one_axis(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray], lo: PointArrays, hi: PointArrays,
-              rows: np.ndarray, axis: str) -> tuple[np.ndarray, NodeBoxes | None]:
-    """The boxes among ``rows`` that move ``axis`` alone, with every moving input a copy of it: 2n + 1 nodes."""
-    moves = {k: np.asarray(lower[k])[rows] != np.asarray(upper[k])[rows] for k in lower}
-    sel = rows[moves[axis] & (sum(m.astype(int) for m in moves.values()) == 1)]
-    t_lo = np.minimum(np.asarray(lower[axis])[sel], np.asarray(upper[axis])[sel])
-    t_hi = np.maximum(np.asarray(lower[axis])[sel], np.asarray(upper[axis])[sel])
-    if sel.size == 0:
-        return sel, None
-    # every input that moves must be the axis value itself at both corners (not, e.g., A minus a cavity's tail)
-    copies = np.ones(sel.size, dtype=bool)
-    for name in ("body", "joint", "g", "at"):
-        a, b = getattr(lo, name)[sel], getattr(hi, name)[sel]
-        shape = (-1,) + (1,) * (a.ndim - 1)
-        low, high = np.minimum(a, b), np.maximum(a, b)
-        ok = (low == high) | ((low == t_lo.reshape(shape)) & (high == t_hi.reshape(shape)))
-        copies &= ok.reshape(sel.size, -1).all(axis=1)
-    sel, t_lo, t_hi = sel[copies], t_lo[copies], t_hi[copies]
-    if sel.size == 0:
-        return sel, None
-    N = 2 * scene.n + 1
-    t = _chebyshev(t_lo, t_hi, N)
-    values = {k: np.repeat(np.asarray(lower[k])[sel], N) for k in lower}
-    values[axis] = t.ravel()
-    pts = point_arrays(scene, values)
-
-    def by_node(x: np.ndarray) -> np.ndarray:
-        return x.reshape((sel.size, N) + x.shape[1:])
-
-    arrays = [a for x in (pts.body, pts.joint, pts.g, pts.at) for a in (by_node(x), np.zeros_like(by_node(x)))]
-    return sel, NodeBoxes(*arrays, lo.E[sel], lo.kappa[sel], pts.nmodes, pts.free, pts.parent, t, t_lo, t_hi)
 
 
 def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> list[tuple[np.ndarray, BoxArrays | NodeBoxes]]:
@@ -248,17 +151,34 @@ def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarra
     pairs that together hold each box once.  Raises ValueError as ``box_arrays``."""
     lo, hi = _corners(scene, lower, upper)
     npts = lo.body.shape[0]
+    lower = {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,)) for k, v in lower.items()}
+    upper = {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,)) for k, v in upper.items()}
+    moves = {k: lower[k] != upper[k] for k in lower}
+    others = sum((m.astype(int) for k, m in moves.items() if not _is_spin(scene, k)), np.zeros(npts, dtype=int))
+    mech = [k for k in lower if _mechanical(scene, k)]
     plain = _plain(lo, hi)
     out = []
-    spin = _spin_rows(lo, hi)
-    if spin.size:
-        out.append((spin, _spin_scaled(plain.take(spin), lo.body[spin, 0, 5], hi.body[spin, 0, 5])))
-    rest = np.setdiff1d(np.arange(npts), spin)
-    for axis in (k for k in lower if _mechanical(scene, k)):
-        one, nodes = _one_axis(scene, lower, upper, lo, hi, rest, axis)
+
+    def route(rows: np.ndarray, axes: tuple[str, ...], spin: bool) -> np.ndarray:
+        """Hand the boxes among ``rows`` that move exactly ``axes`` (besides the spin) to the node path; the rest."""
+        sel = rows[np.all([moves[a][rows] for a in axes], axis=0) & (others[rows] == len(axes))]
+        kept, nodes = mechanical(scene, lower, upper, lo, hi, sel, axes, spin)
         if nodes is not None:
-            out.append((one, nodes))
-            rest = np.setdiff1d(rest, one)
+            out.append((kept, nodes))
+        return np.setdiff1d(rows, kept)
+
+    spin = _spin_rows(scene, lo, hi, moves)
+    rest = spin
+    for axis in mech:
+        rest = route(rest, (axis,), True)
+    if rest.size:
+        out.append((rest, spin_scaled(plain.take(rest), lo.body[rest, 0, 5], hi.body[rest, 0, 5])))
+    rest = np.setdiff1d(np.arange(npts), spin)
+    for axis in mech:
+        rest = route(rest, (axis,), False)
+    for i, a in enumerate(mech):
+        for b in mech[i + 1 :]:
+            rest = route(rest, (a, b), False)
     if rest.size:
         out.append((rest, plain.take(rest)))
     return out
