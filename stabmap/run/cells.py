@@ -31,9 +31,10 @@ from ..store.variables import CELL
 from ..systems.base import SceneBase
 
 SUB_ROUNDS = 2  # rounds of halving inside one cell before it is left node_only
-# Box proofs stop where they fail broadly (clustered roots, say): a round of at least PAYS_MIN boxes of which
-# under PAYS prove is the last; its boxes' nodes are then computed, and its cells left node_only.
-PAYS, PAYS_MIN = 0.25, 32
+# Box proofs stop where they fail broadly (clustered roots, say): a round of at least PAYS_MIN boxes of at most
+# PAYS_CELLS cells each, of which under PAYS prove, is the last; its boxes' nodes are then computed, and its cells
+# left node_only.  Larger boxes fail for their size alone (roots move past the separators), so they never stop it.
+PAYS, PAYS_MIN, PAYS_CELLS = 0.25, 32, 16
 
 NODE_ONLY, WHOLE_CELL, CONTAINS_CHANGE = (CELL.value(m) for m in ("node_only", "whole_cell", "contains_change"))
 
@@ -68,7 +69,7 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
         for b in np.flatnonzero(proved):
             where = tuple(slice(a, z) for a, z in zip(lo[b], hi[b]))
             label[where], cell[where], known[where] = got[b], WHOLE_CELL, True
-        pays = _pays(proved)
+        pays = _pays(proved) or np.prod(hi - lo, axis=1).max() > PAYS_CELLS
         if not pays:
             break
         lo, hi = lo[~proved], hi[~proved]
