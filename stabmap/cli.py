@@ -67,12 +67,15 @@ def cli() -> None:
 @click.option("--png", metavar="FILE", help="also draw the atlas to this PNG/PDF")
 @_options(_cluster)
 @click.option("--resume", is_flag=True, help="finish an interrupted run from OUTPUT.partial/, computing only the missing chunks")
-@click.option("--refine", is_flag=True, help="adaptive: a coarse lattice, refined only where labels change (docs/refine.md)")
+@click.option("--refine", is_flag=True, help="opt-in, not proved: a coarse lattice, the other points inferred from their cell's corners "
+              "and marked so (docs/refine.md)")
 @click.option("--coarse-stride", type=int, metavar="S", help="with --refine: grid steps between coarse nodes, a power of two")
 @click.option("--margin", type=int, metavar="M", help="with --refine: cells split around every disagreeing cell (default 2)")
+@click.option("--node-by-node", is_flag=True, help="prove every grid node on its own, no box proofs: every cell node_only (docs/cells.md)")
 @_overwrite
 @click.option("-q", "--quiet", is_flag=True, help="no progress line")
-def atlas(scene, example, output, png, threads, workers, scheduler, chunk_points, resume, refine, coarse_stride, margin, overwrite, quiet):
+def atlas(scene, example, output, png, threads, workers, scheduler, chunk_points, resume, refine, coarse_stride, margin, node_by_node,
+          overwrite, quiet):
     """Compute an atlas from a scene and write netCDF4 or Zarr, here or on a dask cluster."""
     from . import jobs
     from .run.runner import quiet_dask_logs
@@ -81,7 +84,7 @@ def atlas(scene, example, output, png, threads, workers, scheduler, chunk_points
         with quiet_dask_logs(scheduler is not None or workers is not None):
             _report(jobs.atlas(
                 jobs.scene(scene, example), output, png=png, refine=refine, coarse_stride=coarse_stride, margin=margin,
-                resume=resume, overwrite=overwrite, chunk_points=chunk_points, progress=not quiet, **_where(scheduler, workers, threads),
+                prove_cells=not node_by_node, resume=resume, overwrite=overwrite, chunk_points=chunk_points, progress=not quiet, **_where(scheduler, workers, threads),
             ))
     except KeyboardInterrupt:
         raise Interrupted(jobs.interrupted(output)) from None

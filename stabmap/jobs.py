@@ -55,6 +55,7 @@ def atlas(
     refine: bool = False,
     coarse_stride: int | None = None,
     margin: int | None = None,
+    prove_cells: bool = True,
     resume: bool = False,
     overwrite: bool = False,
     client=None,
@@ -88,6 +89,8 @@ def atlas(
             raise StabmapError(f"{given[0]} applies to adaptive atlases only; add --refine")
     elif resume:
         raise StabmapError("--resume applies to dense atlases; an adaptive atlas (--refine) has no checkpoint to resume")
+    elif not prove_cells:
+        raise StabmapError("--node-by-node and --refine are two ways to decide an atlas; give one of them")
     system = systems.of(scene)
     t0 = time.perf_counter()
     where = {"client": client, "workers": workers, "threads": threads, "progress": progress, "chunk_points": chunk_points}
@@ -99,7 +102,7 @@ def atlas(
         write_atlas(ds, output)
         stats = summary_line(system, summary(ds), ds.attrs.get("n_evaluated_points"))
     else:
-        report = compute_to_file(scene, output, resume=resume, **where)
+        report = compute_to_file(scene, output, resume=resume, prove_cells=prove_cells, **where)
         with open_atlas(output, lazy=True) as ds:
             stats = summary_line(system, summary(ds))
         if report.reused:

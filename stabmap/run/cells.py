@@ -6,14 +6,18 @@ atlas is decided here (``decide_chunk``):
 
 1. The chunk's cells, taken together as one box, go to ``System.prove_boxes``.  A proved box gives its label to
    every node inside it and ``whole_cell`` to every cell: no node of it is computed.
-2. A box that does not prove is split in two along each axis it spans with more than one cell, and its parts
-   are tried in the next round, down to single cells.  The rounds run all the chunk's boxes of one size in one
+2. A box that does not prove is split in two along each of its long axes (those with at least half as many cells
+   as its longest), and its parts are tried in the next round, down to single cells.  The rounds run all the chunk's boxes of one size in one
    call of the kernels.
-3. A single cell that does not prove has its node computed (``System.evaluate``), and then its corners.  A
-   corner with another label proves a change of label in the cell (``contains_change``).  Otherwise the cell
-   is cut at its node into sub-boxes, proved in up to SUB_ROUNDS rounds of halving: all proved with the
-   node's label is ``whole_cell``, one proved with another label is ``contains_change``, and anything left
-   undecided is ``node_only``: the node is proved, the rest of the cell is not.
+3. A single cell that does not prove has its node computed (``System.evaluate``), and, where a neighbouring
+   node has another label, its corners: a corner with another label proves a change of label in the cell
+   (``contains_change``).  Otherwise the cell is cut at its node into sub-boxes, proved in up to SUB_ROUNDS
+   rounds of halving: all proved with the node's label is ``whole_cell``, one proved with another label is
+   ``contains_change``, and anything left undecided is ``node_only``: the node is proved, the rest of the cell
+   is not.
+
+Box proofs stop where they do not pay (PAYS) and at a budget (BOX_BUDGET), so that a cell-by-cell atlas never
+costs much more than a node-by-node one; the cells they leave are ``node_only``, never guessed.
 
 No label is inferred: every node's label is a box proof that holds it, or its own computation.  A system that
 proves no boxes along some scanned axis gives ``node_only`` cells, every node computed.
@@ -22,6 +26,7 @@ proves no boxes along some scanned axis gives ``node_only`` cells, every node co
 from __future__ import annotations
 
 import itertools
+import math
 
 import numpy as np
 
@@ -34,7 +39,11 @@ SUB_ROUNDS = 2  # rounds of halving inside one cell before it is left node_only
 # Box proofs stop where they fail broadly (clustered roots, say): a round of at least PAYS_MIN boxes of at most
 # PAYS_CELLS cells each, of which under PAYS prove, is the last; its boxes' nodes are then computed, and its cells
 # left node_only.  Larger boxes fail for their size alone (roots move past the separators), so they never stop it.
-PAYS, PAYS_MIN, PAYS_CELLS = 0.25, 32, 16
+PAYS, PAYS_MIN, PAYS_CELLS = 0.25, 32, 4
+# Box proofs of a chunk cost at most BOX_BUDGET node proofs a cell (``System.box_cost`` prices one box): a chunk
+# costs at most 1 + BOX_BUDGET times its nodes computed one by one (and the corners of cells beside a change of
+# label), however few of its boxes prove.  A coarse grid, whose cells are too wide to prove, stays cheap.
+BOX_BUDGET, MIN_BOXES = 2.0, 16  # and at least MIN_BOXES boxes a chunk, so small grids prove cells too
 
 NODE_ONLY, WHOLE_CELL, CONTAINS_CHANGE = (CELL.value(m) for m in ("node_only", "whole_cell", "contains_change"))
 
@@ -60,21 +69,23 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
     label = np.zeros(shape, dtype=out[system.label].dtype)
     cell = np.full(shape, NODE_ONLY, dtype=CELL.dtype)
     known = np.zeros(shape, dtype=bool)
+    failed_cell = np.zeros(shape, dtype=bool)  # single cells whose own box was tried and failed
 
     lo = np.zeros((1, len(shape)), dtype=np.int64)
     hi = np.array([shape], dtype=np.int64)
     pays = chunk.provable
     while lo.shape[0] and pays:
-        got, proved = chunk.prove(lo, hi)
+        got, proved, tried = chunk.prove(lo, hi)
         for b in np.flatnonzero(proved):
             where = tuple(slice(a, z) for a, z in zip(lo[b], hi[b]))
             label[where], cell[where], known[where] = got[b], WHOLE_CELL, True
-        pays = _pays(proved) or np.prod(hi - lo, axis=1).max() > PAYS_CELLS
-        if not pays:
-            break
-        lo, hi = lo[~proved], hi[~proved]
-        many = ~np.all(hi - lo == 1, axis=1)
-        lo, hi = _halves(lo[many], hi[many])
+        one = np.all(hi - lo == 1, axis=1)
+        failed = one & ~proved
+        failed[tried:] = False
+        failed_cell[tuple(lo[failed].T)] = True
+        pays = tried == lo.shape[0] and (_pays(proved) or np.prod(hi - lo, axis=1).max() > PAYS_CELLS)
+        lo, hi = lo[~proved & ~one], hi[~proved & ~one]
+        lo, hi = _halves(lo, hi)
 
     if known.any():
         for k, v in system.proved_box(label[known]).items():
@@ -88,7 +99,8 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
         computed = evaluate(chunk.values(nodes))
         for k, v in computed.items():
             out[k][where] = v
-        cell[where] = chunk.classify(nodes, computed[system.label], pays)
+        label[where] = computed[system.label]
+        cell[where] = chunk.classify(nodes, label, failed_cell[where] if pays else np.zeros(nodes.shape[0], dtype=bool))
     out[CELL.name] = cell
     return out
 
@@ -98,21 +110,33 @@ def _pays(proved: np.ndarray) -> bool:
     return proved.size < PAYS_MIN or proved.mean() >= PAYS
 
 
+def _beside_change(label: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+    """Which of ``nodes`` (rows of indices into ``label``) have a neighbour along some axis with another label."""
+    out = np.zeros(nodes.shape[0], dtype=bool)
+    for d in range(label.ndim):
+        for step in (-1, 1):
+            other = nodes.copy()
+            other[:, d] += step
+            inside = (other[:, d] >= 0) & (other[:, d] < label.shape[d])
+            out[inside] |= label[tuple(other[inside].T)] != label[tuple(nodes[inside].T)]
+    return out
+
+
 def _halves(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Boxes (rows of index ranges [lo, hi)) cut in two along every axis where they hold more than one cell."""
+    """Boxes (rows of index ranges [lo, hi)) cut in two along their long axes: those holding at least half as many
+    cells as the longest (a chunk's long, thin boxes become square before they are cut across)."""
     if lo.shape[0] == 0:
         return lo, hi
     d = lo.shape[1]
     mid = (lo + hi) // 2
-    split = hi - lo > 1
+    size = hi - lo
+    split = (size > 1) & (2 * size >= size.max(axis=1, keepdims=True))
     out_lo, out_hi = [], []
     for side in itertools.product((0, 1), repeat=d):
         side = np.array(side, dtype=bool)
         keep = np.all(split | ~side, axis=1)  # the upper half only along axes that split
-        a = np.where(side, mid, lo)[keep]
-        b = np.where(side | ~split, hi, mid)[keep]
-        out_lo.append(a)
-        out_hi.append(b)
+        out_lo.append(np.where(side, mid, lo)[keep])
+        out_hi.append(np.where(side | ~split, hi, mid)[keep])
     return np.concatenate(out_lo), np.concatenate(out_hi)
 
 
@@ -125,56 +149,69 @@ class _Chunk:
         self.nodes = [a.array[s:e] for a, (s, e) in zip(scene.grid, location)]
         self.edges = [edges(a.array)[s : e + 1] for a, (s, e) in zip(scene.grid, location)]
         self.provable = provable(scene)
+        self.cost = self.system.box_cost(scene) if self.provable else 1.0
+        self.budget = max(BOX_BUDGET * math.prod(e - s for s, e in location), MIN_BOXES * self.cost)  # in node proofs
 
     def values(self, index: np.ndarray) -> dict[str, np.ndarray]:
         """Grid-axis values of the nodes ``index`` (rows of chunk indices)."""
         return {name: v[index[:, d]] for d, (name, v) in enumerate(zip(self.names, self.nodes))}
 
-    def prove(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(label, proved) of the boxes of cells [lo, hi) (chunk indices per axis)."""
-        if not self.provable or lo.shape[0] == 0:
-            return np.zeros(lo.shape[0], dtype=np.int64), np.zeros(lo.shape[0], dtype=bool)
+    def prove(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+        """(label, proved, tried) of the boxes of cells [lo, hi) (chunk indices per axis): the first ``tried`` of
+        them as far as the budget reaches, the others not tried (not proved)."""
         return self._prove({n: e[lo[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))},
                            {n: e[hi[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))})
 
-    def _prove(self, lower: dict, upper: dict) -> tuple[np.ndarray, np.ndarray]:
-        label, proved = self.system.prove_boxes(self.scene, lower, upper)
-        return np.asarray(label), np.asarray(proved, dtype=bool)
+    def _prove(self, lower: dict, upper: dict) -> tuple[np.ndarray, np.ndarray, int]:
+        npts = len(next(iter(lower.values())))
+        label, proved = np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=bool)
+        tried = min(npts, int(self.budget // self.cost)) if self.provable else 0
+        if tried:
+            got, ok = self.system.prove_boxes(self.scene, {k: v[:tried] for k, v in lower.items()},
+                                              {k: v[:tried] for k, v in upper.items()})
+            label[:tried], proved[:tried] = got, ok
+            self.budget -= tried * self.cost
+        return label, proved, tried
 
-    def classify(self, nodes: np.ndarray, node_label: np.ndarray, sub_boxes: bool = True) -> np.ndarray:
-        """The ``cell`` flag of the cells of ``nodes`` (computed nodes, labels ``node_label``), none proved whole.
+    def classify(self, nodes: np.ndarray, label: np.ndarray, sub_boxes: np.ndarray) -> np.ndarray:
+        """The ``cell`` flag of the cells of ``nodes`` (computed; ``label`` holds the chunk's labels), none proved whole.
 
-        ``sub_boxes``: try to prove parts of the cells (False where box proofs were seen to fail broadly).
+        Corners are computed for the cells beside a change of label; sub-boxes are tried in the cells marked in
+        ``sub_boxes`` (those whose own box failed where box proofs pay).
         """
         cell = np.full(nodes.shape[0], NODE_ONLY, dtype=CELL.dtype)
         if not self.provable:
             return cell
+        node_label = label[tuple(nodes.T)]
         d = nodes.shape[1]
-        # Corners: the labels at the cell's 2^d corners, each corner computed once however many cells share it.
-        corners = np.concatenate([nodes + np.array(s) for s in itertools.product((0, 1), repeat=d)])
-        unique, back = np.unique(corners, axis=0, return_inverse=True)
-        at = {n: e[unique[:, k]] for k, (n, e) in enumerate(zip(self.names, self.edges))}
-        corner_label = self.system.evaluate(self.scene, at)[self.system.label].reshape(-1)[back.reshape(-1)]
-        changed = np.any(corner_label.reshape(2**d, -1) != node_label[None, :], axis=0)
-        cell[changed] = CONTAINS_CHANGE
-        # Sub-boxes between the node and the cell's edges, halved while they fail.
-        todo = np.flatnonzero(~changed) if sub_boxes else np.zeros(0, dtype=np.int64)
+        near = np.flatnonzero(_beside_change(label, nodes))
+        if near.size:
+            # the labels at those cells' 2^d corners, each corner computed once however many cells share it
+            sides = [np.array(s) for s in itertools.product((0, 1), repeat=d)]
+            corners = np.concatenate([nodes[near] + s for s in sides])
+            unique, back = np.unique(corners, axis=0, return_inverse=True)
+            at = {n: e[unique[:, k]] for k, (n, e) in enumerate(zip(self.names, self.edges))}
+            corner_label = self.system.evaluate(self.scene, at)[self.system.label].reshape(-1)[back.reshape(-1)]
+            changed = np.any(corner_label.reshape(len(sides), -1) != node_label[near][None, :], axis=0)
+            cell[near[changed]] = CONTAINS_CHANGE
+        # Sub-boxes between the node and the cell's edges, halved while they fail and pay.
+        todo = np.flatnonzero(sub_boxes & (cell == NODE_ONLY))
         lower, upper, owner = self._sub_boxes(nodes[todo], todo)
-        whole = np.ones(nodes.shape[0], dtype=bool)
+        whole = np.zeros(nodes.shape[0], dtype=bool)
+        whole[todo] = True
         for _ in range(SUB_ROUNDS):
             if owner.size == 0:
                 break
-            got, proved = self._prove(lower, upper)
+            got, proved, tried = self._prove(lower, upper)
             other = proved & (got != node_label[owner])
             cell[owner[other]] = CONTAINS_CHANGE
             failed = ~proved
-            if not _pays(proved):
+            if tried < owner.size or not _pays(proved):
                 owner = owner[failed]
                 break
             lower, upper, owner = self._halve({k: v[failed] for k, v in lower.items()},
                                               {k: v[failed] for k, v in upper.items()}, owner[failed])
         whole[owner] = False  # a sub-box still undecided after the last round
-        whole[np.setdiff1d(np.arange(nodes.shape[0]), todo)] = False
         cell[(cell == NODE_ONLY) & whole] = WHOLE_CELL
         return cell
 

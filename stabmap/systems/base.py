@@ -182,6 +182,11 @@ class System:
         """
         return None
 
+    def box_cost(self, scene: SceneBase) -> float:
+        """What one box proof of a box along this scene's grid axes costs, in proofs of one point (default 1):
+        the budget of box proofs in an atlas (``stabmap.run.cells``)."""
+        return 1.0
+
     def box_axes(self, scene: SceneBase) -> set[str]:
         """The grid axes along which ``prove_boxes`` can prove a box of this scene (default: none)."""
         return set()

@@ -108,6 +108,11 @@ class Gyroscopes(System):
 
         return box_axes(scene)
 
+    def box_cost(self, scene: Scene) -> float:
+        from .boxes import box_cost
+
+        return box_cost(scene)
+
     def prove_boxes(self, scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
         from .decide import prove_boxes
 

@@ -182,3 +182,12 @@ def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarra
     if rest.size:
         out.append((rest, plain.take(rest)))
     return out
+
+
+def box_cost(scene: Scene) -> float:
+    """A box proof along the scene's scanned axes, in point proofs: its enclosure's nodes, each about one point's
+    coefficients (n + 1 along the spin, 2n + 1 along a mechanical axis, their product for two axes; plain: 1)."""
+    n = scene.n
+    per_axis = [n + 1 if _is_spin(scene, a.name) else 2 * n + 1 if _mechanical(scene, a.name) else 1
+                for a in scene.grid if len(a.values) > 1]
+    return float(np.prod(per_axis)) if len(per_axis) <= 2 else 1.0
