@@ -113,3 +113,15 @@ def test_bench_critical_quick(capsys):
     assert rows[(window, "plain boxes")]["proved"] < rows[(window, "boxes at nodes")]["proved"]
     assert rows[("paper-n2-fixed", "boxes at nodes")]["gaps"] == 0
     assert "| scene | way |" in capsys.readouterr().out
+
+
+def test_bench_cells_quick(capsys):
+    out = runpy.run_path(str(SCRIPTS / "bench_cells.py"))["main"](["--quick"])
+    # compare() checks that cells and node by node give every node one label; each row's classes tile the grid
+    for r in out["ladder"]:
+        assert abs(sum(r["shares"].values()) - 1.0) < 1e-12 and r["shares"]["not_proved"] == 0.0
+        assert r["node_proofs_per_cell"] > 0 and r["box_proofs_per_cell"] > 0
+    # the stress scene: no boundary in a whole cell, and every whole cell's label holds inside it, exactly
+    (stress,) = out["stress"]
+    assert stress["boundaries"] >= 3 and stress["false_whole"] == 0 and stress["wrong_interior"] == 0 and stress["checked"] > 0
+    assert "| scene | degree | points |" in capsys.readouterr().out

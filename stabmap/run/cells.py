@@ -43,7 +43,7 @@ PAYS, PAYS_MIN, PAYS_CELLS = 0.25, 32, 4
 # Box proofs of a chunk cost at most BOX_BUDGET node proofs a cell (``System.box_cost`` prices one box): a chunk
 # costs at most 1 + BOX_BUDGET times its nodes computed one by one (and the corners of cells beside a change of
 # label), however few of its boxes prove.  A coarse grid, whose cells are too wide to prove, stays cheap.
-BOX_BUDGET, MIN_BOXES = 2.0, 16  # and at least MIN_BOXES boxes a chunk, so small grids prove cells too
+BOX_BUDGET, MIN_BOXES = 2.0, 1  # and at least the chunk as one box
 
 NODE_ONLY, WHOLE_CELL, CONTAINS_CHANGE = (CELL.value(m) for m in ("node_only", "whole_cell", "contains_change"))
 
