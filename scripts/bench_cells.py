@@ -80,17 +80,17 @@ class Tally:
         prove, classify = self.saved
         tally = self
 
-        def counted_prove(chunk, lower, upper):
-            label, proved, tried = prove(chunk, lower, upper)
+        def counted_prove(chunk, lower, upper, tile):
+            label, proved, tried = prove(chunk, lower, upper, tile)
             with tally.lock:
-                tally.counts["boxes"] += tried
+                tally.counts["boxes"] += int(tried.sum())
                 tally.counts["proved boxes"] += int(proved.sum())
             return label, proved, tried
 
         def counted_classify(chunk, nodes, label, sub_boxes):
             with tally.lock:
                 tally.counts["nodes"] += nodes.shape[0]
-                near = cells._beside_change(label, nodes) if chunk.provable else np.zeros(0, dtype=bool)
+                near = cells._beside_change(label, nodes, chunk.axis_tile) if chunk.provable else np.zeros(0, dtype=bool)
                 if near.any():  # the corners of those cells, each computed once per chunk
                     d = nodes.shape[1]
                     corners = np.concatenate([nodes[near] + np.array(s) for s in np.ndindex(*(2,) * d)])

@@ -109,8 +109,10 @@ examples:
   stabmap query a.nc --boundaries omega K_1=0:10           where N_c changes along omega (grid brackets)
   stabmap query a.nc --smallest-stable omega --over K_1    smallest stable omega for each K_1
   stabmap query a.nc --smallest-stable omega=0: --csv      ... of positive spin rates only, as CSV
+  stabmap query a.nc --boundaries omega K_1=3 --locate     every change, however narrow, located to 1e-10
 \b
-Boundaries are known to grid resolution only; 'stabmap critical' locates them to 1e-10 (docs/critical.md)."""
+Without --locate, boundaries are known to grid resolution only; --locate computes critical values of the
+atlas's scene along the selected lines: complete, and located to 1e-10 (docs/critical.md)."""
 )
 @click.argument("atlas")
 @click.argument("items", nargs=-1, metavar="[NAME=VALUE | NAME=LO:HI]...")
@@ -119,10 +121,12 @@ Boundaries are known to grid resolution only; 'stabmap critical' locates them to
 @click.option("--smallest-stable", is_flag=False, flag_value="omega", default=None, metavar="[AXIS]",
               help="the smallest stable grid value of AXIS (default omega), for every point of the other axes")
 @click.option("--over", metavar="NAME", help="with --smallest-stable: the one axis that labels the answer")
+@click.option("--locate", is_flag=True, help="with --boundaries or --smallest-stable: critical values of the atlas's scene, "
+              "every change located to 1e-10, undecided stretches listed (computes)")
 @click.option("--csv", "fmt", flag_value="csv", help="print CSV (every row)")
 @click.option("--json", "fmt", flag_value="json", help="print JSON (every row)")
 @click.option("--limit", type=int, default=40, metavar="N", help="rows of a text table (default 40; 0: all)")
-def query(atlas, items, fraction, boundaries, smallest_stable, over, fmt, limit):
+def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, fmt, limit):
     """Ask a saved atlas: the label at a point, the stable fraction, boundaries, the smallest stable value.
 
     NAME=VALUE selects the grid value of NAME nearest to VALUE (the value used is printed); NAME=LO:HI keeps the
@@ -131,7 +135,7 @@ def query(atlas, items, fraction, boundaries, smallest_stable, over, fmt, limit)
     from . import jobs
 
     click.echo(jobs.query(atlas, items, fraction=fraction, boundaries=boundaries, smallest_stable=smallest_stable,
-                          over=over, fmt=fmt or "text", limit=limit))
+                          over=over, locate=locate, fmt=fmt or "text", limit=limit))
 
 
 @cli.command(short_help="Draw an atlas (or critical values) to a PNG or PDF file.")

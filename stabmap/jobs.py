@@ -213,12 +213,16 @@ def query(
     boundaries: str | None = None,
     smallest_stable: str | None = None,
     over: str | None = None,
+    locate: bool = False,
     fmt: str = "text",
     limit: int = 40,
+    progress: bool | None = None,
 ) -> str:
     """``stabmap query``: the label at a point, or the answer to one question about a slice (docs/query.md).
 
     ``items`` are ``NAME=VALUE`` or ``NAME=LO:HI``; a question's axis may also come first among them.
+    ``locate``: answer --boundaries and --smallest-stable with critical values of the atlas's scene (complete,
+    located to 1e-10: ``stabmap.read.located``) instead of the grid.
     """
     from .read import query as q
     from .read.report import render
@@ -230,6 +234,8 @@ def query(
         raise StabmapError(f"ask one question at a time: {' and '.join(asked)} were both given")
     if limit < 0:
         raise StabmapError(f"--limit must be >= 0 (0 shows every row), got {limit}")
+    if locate and boundaries is None and smallest_stable is None:
+        raise StabmapError("--locate applies to --boundaries and --smallest-stable, e.g. --boundaries omega --locate K_1=3")
     if over is not None and smallest_stable is None:
         raise StabmapError("--over applies to --smallest-stable only, e.g. --smallest-stable omega --over K_1")
     for option, axis in (("--boundaries", boundaries), ("--smallest-stable", smallest_stable)):
@@ -242,7 +248,14 @@ def query(
     if ds.attrs.get("stabmap_kind") == "critical values":
         raise StabmapError(f"{path} holds critical values, not an atlas; 'stabmap info {path}' lists its intervals")
     sel = q.parse_selection(items)
-    if boundaries is not None:
+    if locate:
+        from .read import located
+
+        if boundaries is not None:
+            result = located.located_boundaries(ds, boundaries, progress=progress, **sel)
+        else:
+            result = located.located_smallest_stable(ds, smallest_stable, over, progress=progress, **sel)
+    elif boundaries is not None:
         result = q.boundaries(ds, boundaries, **sel)
     elif smallest_stable is not None:
         result = q.smallest_stable(ds, smallest_stable, over, **sel)

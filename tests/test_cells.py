@@ -79,15 +79,19 @@ def test_cells_tile_the_scan_and_are_written_as_cf_bounds(tmp_path):
 
 
 # ---------------------------------------------------------------------------------- narrow windows and bands
-def test_the_narrow_window_is_drawn_as_change_never_as_a_whole_cell():
+def test_the_narrow_window_never_lies_in_a_whole_cell():
     scene = from_dict(WINDOW)
     ds = _atlas(scene)
     cell = ds["cell"].values
+    # the window lies between two nodes that agree (N_c = 1 at omega = 11.5 and 12.5): their label is not claimed
+    # for the window's cell, which is node_only (its sub-boxes straddle the window), and the boundary at 13.84
+    # between nodes that differ lies in a cell proved to hold the change
+    assert ds["n_complex_pairs"].sel(omega=[11.5, 12.5]).values.tolist() == [1, 1]
     for x in EXACT_BOUNDARIES:
         for i in _cells_containing(scene, x):
-            assert cell[i] == CHANGE, (x, i, CELL.meaning(int(cell[i])))
-    # the label between two nodes that agree (N_c = 1 at omega = 11.5 and 12.5) is not claimed for the window's cells
-    assert ds["n_complex_pairs"].sel(omega=[11.5, 12.5]).values.tolist() == [1, 1]
+            assert cell[i] != WHOLE, (x, i)
+    assert [CELL.meaning(int(cell[i])) for i in _cells_containing(scene, EXACT_BOUNDARIES[2])] == ["contains_change"]
+    assert (cell == WHOLE).sum() >= 90  # all but the low-spin cells and the window's
 
 
 @pytest.mark.parametrize("E", [1e-4, 1e-6, 1e-8])
@@ -189,5 +193,34 @@ def test_query_says_whether_the_cell_is_proved(tmp_path):
     ds = _atlas(scene)
     from stabmap.read.query import label_at
 
-    assert label_at(ds, omega=12.0).cell == "contains_change"
+    assert label_at(ds, omega=12.0).cell == "node_only"  # the window's cell: N_c = 1 at its node, not claimed in it
+    assert label_at(ds, omega=13.9).cell == "contains_change"
     assert label_at(ds, omega=60.0).cell == "whole_cell"
+
+
+# ------------------------------------------------------------------------- located answers (query --locate)
+def test_located_boundaries_and_smallest_stable_find_the_window_the_grid_misses(tmp_path, capsys):
+    from stabmap.cli import main
+    from stabmap.read import query
+    from stabmap.read.located import located_boundaries, located_smallest_stable
+
+    ds = _atlas(from_dict(WINDOW))
+    grid = query.boundaries(ds, "omega")
+    assert grid.sizes["boundary"] == 1  # the window lies between two grid values with N_c = 1
+    b = located_boundaries(ds, "omega", progress=False)
+    assert b.attrs["located"] == 1 and b.attrs["n_undecided"] == 0
+    assert b.sizes["boundary"] == 3
+    for lo, hi, x in zip(b["boundary_lower"].values, b["boundary_upper"].values, EXACT_BOUNDARIES):
+        assert hi - lo <= 1e-10 * hi and abs(0.5 * (lo + hi) - x) < 1e-6
+    assert b["n_complex_pairs_below"].values.tolist() == [1, 0, 1] and b["n_complex_pairs_above"].values.tolist() == [0, 1, 0]
+    s = located_smallest_stable(ds, "omega", progress=False)
+    assert float(s["smallest_stable"]) == pytest.approx(EXACT_BOUNDARIES[0], abs=1e-6)
+    assert not bool(s["stable_to_scan_end"]) and not bool(s["undecided_below"])
+    assert float(query.smallest_stable(ds, "omega")["smallest_stable"]) > 13.8  # the grid's answer: 14 % too high
+    path = tmp_path / "w.nc"
+    stabmap.write_atlas(ds, path)
+    assert main(["query", str(path), "--boundaries", "omega", "--locate"]) == 0
+    out = capsys.readouterr().out
+    assert "3 changes of N_c on 1 of 1 line, each located to 1e-10 relative" in out and "the list is complete" in out
+    assert main(["query", str(path), "omega=12", "--locate"]) == 2
+    assert "--locate applies to --boundaries and --smallest-stable" in capsys.readouterr().err

@@ -311,7 +311,7 @@ def test_cli_label_keeps_its_form(atlas_file, capsys):
         "c_1 = 0.1 -> nearest grid point 0.1 m",
         "n_complex_pairs = 0",
         "stability = stable (decided by interval sturm sequence)",
-        "cell = whole_cell (the label is proved at every point of this grid cell, the requested point included)",
+        "cell = node_only (the label is proved at the grid point only; at the requested point it is not decided)",
     ]
     code, out, _ = run(capsys, atlas_file, "omega=0", "c_1=0.1", "--json")
     assert json.loads(out)["n_complex_pairs"] == 1 and json.loads(out)["grid_point"] == {"omega": 0.0, "c_1": 0.1}

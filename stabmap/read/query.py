@@ -264,7 +264,7 @@ def _fixed_names(axes: dict[str, AxisSelection]) -> str:
     return " ".join(a.name for a in axes.values() if a.fixed)
 
 
-def _selection_text(axes: dict[str, AxisSelection]) -> str:
+def selection_text(axes: dict[str, AxisSelection]) -> str:
     """The fixed and ranged axes, one description each, joined by '; ' (a netCDF-safe string attribute)."""
     return "; ".join(a.describe() for a in axes.values() if a.requested is not None)
 
@@ -330,7 +330,7 @@ def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
     >>> stable_fraction(ds, omega=(20, 60))         # 20 <= omega <= 60, every K_1
     """
     sub, axes = select(ds, sel)
-    system = _stable_system(ds, "the stable fraction")
+    system = stable_system(ds, "the stable fraction")
     nc = sub[system.label].data
     inferred = _inferred(sub, system).data
     stable = nc == system.stable_label
@@ -355,13 +355,13 @@ def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
     )
 
 
-def _along(ds: xr.Dataset, along, dims: list[str], role: str) -> str:
+def check_axis(ds: xr.Dataset, along, dims: list[str], role: str) -> str:
     if not isinstance(along, str) or along not in dims:
         raise _not_an_axis(ds, str(along), dims, role)
     return along
 
 
-def _stable_system(ds: xr.Dataset, question: str):
+def stable_system(ds: xr.Dataset, question: str):
     """The atlas's system, if it has a notion of stability."""
     system = systems.of_atlas(ds.attrs)
     if system.stable_label is None:
@@ -387,7 +387,7 @@ def _coord(sub: xr.Dataset, name: str, dim: str, values) -> tuple:
     return (dim, np.asarray(values), dict(sub[name].attrs))
 
 
-def _fixed_coords(sub: xr.Dataset, axes: dict[str, AxisSelection]) -> dict:
+def fixed_coords(sub: xr.Dataset, axes: dict[str, AxisSelection]) -> dict:
     """The grid axes a number fixed, as scalar coordinates holding the grid value used.
 
     The scene's fixed parameters (the atlas's other scalar coordinates) are left out, so that ``.to_dataframe()``
@@ -432,7 +432,7 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
     >>> b.where(b.n_complex_pairs_above == 0, drop=True)            # only the changes to stable
     """
     dims = grid_axes(ds)
-    along = _along(ds, along, dims, "boundaries along")
+    along = check_axis(ds, along, dims, "boundaries along")
     sub, axes = select(ds, sel, along=along)
     others, x, nc, inferred = _lines(sub, along)
     lab = systems.of_atlas(ds.attrs).label
@@ -446,7 +446,7 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
         return ("boundary", values, {"long_name": long_name, **attrs})
 
     coords = {d: _coord(sub, d, "boundary", sub[d].values[p]) for d, p in zip(others, position)}
-    coords.update(_fixed_coords(sub, axes))
+    coords.update(fixed_coords(sub, axes))
     out = xr.Dataset(
         {
             "boundary_lower": var(x[k], f"{along} at the grid value below the change of {lab}", units=units),
@@ -471,7 +471,7 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
         "n_lines": n_lines,
         "n_lines_with_boundary": int(np.unique(line).size),
         "along_grid_values": int(x.size),
-        "selection": _selection_text(axes),
+        "selection": selection_text(axes),
         "fixed_axes": _fixed_names(axes),
         "located_by": located.strip(),
         "comment": (
@@ -519,15 +519,15 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
     >>> s.smallest_stable.plot()                    # the smallest stable spin rate against K_1
     """
     dims = grid_axes(ds)
-    along = _along(ds, along, dims, "smallest_stable along")
+    along = check_axis(ds, along, dims, "smallest_stable along")
     sub, axes = select(ds, sel, along=along)
     others, x, nc, inferred = _lines(sub, along)
-    system = _stable_system(ds, "smallest_stable")
+    system = stable_system(ds, "smallest_stable")
     label = system.variable(system.label)
     if over is not None:
         if over == along:
             raise StabmapError(f"over={over!r} is the axis searched along; choose another axis for over, e.g. {next((d for d in dims if d != along), 'K_1')}")
-        over = _along(ds, over, dims, "over")
+        over = check_axis(ds, over, dims, "over")
         if axes[over].fixed:
             raise StabmapError(f"over={over!r} is also fixed by {over}={axes[over].requested:g}; give {over} a range (lo, hi) or leave it out")
         extra = [d for d in others if d != over]
@@ -547,7 +547,7 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
         return (others, values, {"long_name": long_name, **attrs})
 
     coords = {d: _coord(sub, d, d, sub[d].values) for d in others}
-    coords.update(_fixed_coords(sub, axes))
+    coords.update(fixed_coords(sub, axes))
     out = xr.Dataset(
         {
             "smallest_stable": var(np.where(has, x[first], np.nan), f"smallest stable {along}", units=units),
@@ -572,7 +572,7 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
         "along_units": units,
         "along_range": [float(x.min()), float(x.max())],
         "along_grid_values": int(x.size),
-        "selection": _selection_text(axes),
+        "selection": selection_text(axes),
         "fixed_axes": _fixed_names(axes),
         "comment": (
             f"smallest_stable is a grid value of {along} proved (or, where inferred is true, inferred) stable, and "

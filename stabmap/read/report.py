@@ -42,6 +42,8 @@ def render(result, fmt: str = "text", *, limit: int = 40, atlas: xr.Dataset | No
         head = {k: result.attrs[k] for k in ("stabmap_query", "along", "along_units", "selection", "comment")}
         head["fixed"] = {k: float(result[k]) for k in _fixed_axes(result)}
         head["rows"] = frame.to_dict(orient="records")
+        if "undecided_lower" in result:
+            head["undecided"] = [[float(a), float(b)] for a, b in zip(result["undecided_lower"].values, result["undecided_upper"].values)]
         return _json(head)
     return (_boundaries_text if kind == "boundaries" else _smallest_text)(result, frame, limit)
 
@@ -153,7 +155,8 @@ def _frame(result: xr.Dataset):
     """A pandas table of a boundaries/smallest_stable answer: varying axes, fixed axes, then the variables."""
     scalars = [k for k in result.coords if result[k].ndim == 0]
     fixed = _fixed_axes(result)
-    table = result.drop_vars(scalars)
+    gaps = [k for k in result.variables if "gap" in result[k].dims]  # located boundaries' undecided stretches: apart
+    table = result.drop_vars(scalars + gaps)
     if not table.sizes:  # smallest_stable of a one-axis atlas: one row
         frame = table.expand_dims("row").to_dataframe().reset_index(drop=True)
     elif result.attrs["stabmap_query"] == "boundaries":
@@ -195,7 +198,8 @@ def _boundaries_text(b: xr.Dataset, frame, limit: int) -> str:
     n, lines_total = b.sizes["boundary"], b.attrs["n_lines"]
     lines = [
         f"boundaries along {along}{u}: {n} change{'s' if n != 1 else ''} of {sym} on {b.attrs['n_lines_with_boundary']} "
-        f"of {lines_total} line{'s' if lines_total != 1 else ''}, each between two neighbouring grid values"
+        f"of {lines_total} line{'s' if lines_total != 1 else ''}, "
+        + ("each located to 1e-10 relative" if b.attrs.get("located") else "each between two neighbouring grid values")
     ]
     lines += _head(b)
     others = [c for c in frame.columns if c in b.coords and b[c].ndim == 1]
@@ -216,9 +220,24 @@ def _boundaries_text(b: xr.Dataset, frame, limit: int) -> str:
     lines += _more(len(frame), limit)
     if star:
         lines.append("* not computed: inferred from the agreeing corners of its grid cell (docs/refine.md)")
+    if b.attrs.get("located"):
+        lines += _gaps_text(b, along)
+        return "\n".join(lines)
     located = b.attrs.get("located_by", f"{CRITICAL_HINT.format(along=along)}.")
     lines.append("Each change lies between the two grid values, not at either" + (f"; {located}" if located else "."))
     return "\n".join(lines)
+
+
+def _gaps_text(b: xr.Dataset, along: str) -> list[str]:
+    """The completeness of located boundaries: the stretches no proof decided, or that there are none."""
+    n = int(b.attrs.get("n_undecided", 0))
+    head = f"{b.attrs['located_by']}; "
+    if not n:
+        return [head + f"the list is complete: every other stretch of {along} is proved to keep its label"]
+    shown = [f"{a:.10g} .. {c:.10g}" for a, c in zip(b["undecided_lower"].values[:6], b["undecided_upper"].values[:6])] if "undecided_lower" in b else []
+    more = f" and {n - len(shown)} more" if n > len(shown) else ""
+    return [head + f"complete but for {n} stretch{'es' if n != 1 else ''} not decided, where a change may hide: "
+            + "; ".join(shown) + more]
 
 
 def _smallest_text(s: xr.Dataset, frame, limit: int) -> str:
@@ -248,6 +267,15 @@ def _smallest_text(s: xr.Dataset, frame, limit: int) -> str:
     lines += _more(len(frame), limit)
     if star:
         lines.append("* not computed: inferred from the agreeing corners of its grid cell (docs/refine.md)")
+    if s.attrs.get("located"):
+        undecided = int(s["undecided_below"].sum()) if "undecided_below" in s else 0
+        lines.append(
+            f"The threshold is {s.attrs['located_by']}: stable just above it, unstable just below; '(scan start)': "
+            "stable from the start of the range. "
+            + (f"On {undecided} line{'s' if undecided != 1 else ''} a stretch below it is not decided (a smaller "
+               "stable value may lie there)." if undecided else "Below it, every stretch is proved unstable.")
+        )
+        return "\n".join(lines)
     lines.append(
         f"The threshold lies between 'unstable below' and the smallest stable grid value; "
         f"'(scan start)': stable from the first grid value searched. {CRITICAL_HINT.format(along=along)}."

@@ -21,7 +21,7 @@ from ..store.checkpoint import Checkpoint, partial_dir
 from ..store.dataset import atlas_dataset, empty_arrays
 from ..store.files import check_writable, write_streamed
 from ..systems.base import SceneBase
-from . import runner
+from . import cells, runner
 from .chunks import (
     MIN_CHUNK_POINTS,
     check_chunk_points,
@@ -293,20 +293,21 @@ class _Layout:
         self.done_before = 0  # points finished by an earlier, interrupted run
         self.batch = chunk_points is None
         order = point_order(scene)
+        tile = cells.tile_shape(scene) if prove_cells and cells.provable(scene) else None  # chunks of whole tiles
         if checkpoint is not None:
             chunks = checkpoint.chunks
-            if chunk_points is not None and chunk_shape(scene.shape, chunk_points, order) != chunks:
+            if chunk_points is not None and chunk_shape(scene.shape, chunk_points, order, tile) != chunks:
                 raise StabmapError(
                     f"chunk_points {chunk_points} gives other chunks than the interrupted run's {list(chunks)}; "
                     "leave chunk_points (--chunk-points) out to resume"
                 )
         elif chunk_points is not None:
-            chunks = chunk_shape(scene.shape, chunk_points, order)
+            chunks = chunk_shape(scene.shape, chunk_points, order, tile)
         elif self.total // (8 * run.slots()) <= MIN_CHUNK_POINTS:  # a small grid: balance decides, not time
-            chunks = chunk_shape(scene.shape, chunk_points_for(scene, 0.0, run.slots()), order)
+            chunks = chunk_shape(scene.shape, chunk_points_for(scene, 0.0, run.slots()), order, tile)
         else:
             try:
-                chunks = chunk_shape(scene.shape, chunk_points_for(scene, self._probe(), run.slots()), order)
+                chunks = chunk_shape(scene.shape, chunk_points_for(scene, self._probe(), run.slots()), order, tile)
             except BaseException:
                 self.progress.close()
                 raise

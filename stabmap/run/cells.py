@@ -4,20 +4,24 @@ A grid node's **cell** is the box between the midpoints to its neighbours along 
 and last values close the outermost cells), so the cells tile the scanned box (``stabmap.scene.grid.edges``).  Every chunk of an
 atlas is decided here (``decide_chunk``):
 
-1. The chunk's cells, taken together as one box, go to ``System.prove_boxes``.  A proved box gives its label to
-   every node inside it and ``whole_cell`` to every cell: no node of it is computed.
+1. The grid is cut into **tiles** of up to TILE_CELLS cells (``tile_shape``, fixed by the grid alone); a chunk
+   holds whole tiles (``stabmap.run.chunks.chunk_shape``), and each tile is decided on its own, so the file
+   is the same whatever the chunks, threads or workers.  Each tile's cells, taken together as one box, go to
+   ``System.prove_boxes``.  A proved box gives its label to every node inside it and ``whole_cell`` to every
+   cell: no node of it is computed.
 2. A box that does not prove is split in two along each of its long axes (those with at least half as many cells
-   as its longest), and its parts are tried in the next round, down to single cells.  The rounds run all the chunk's boxes of one size in one
-   call of the kernels.
+   as its longest), and its parts are tried in the next round, down to single cells.  The rounds run all the
+   chunk's boxes of one round in one call of the kernels.
 3. A single cell that does not prove has its node computed (``System.evaluate``), and, where a neighbouring
-   node has another label, its corners: a corner with another label proves a change of label in the cell
+   node of its tile has another label, its corners: a corner with another label proves a change of label in the cell
    (``contains_change``).  Otherwise the cell is cut at its node into sub-boxes, proved in up to SUB_ROUNDS
    rounds of halving: all proved with the node's label is ``whole_cell``, one proved with another label is
    ``contains_change``, and anything left undecided is ``node_only``: the node is proved, the rest of the cell
    is not.
 
-Box proofs stop where they do not pay (PAYS) and at a budget (BOX_BUDGET), so that a cell-by-cell atlas never
-costs much more than a node-by-node one; the cells they leave are ``node_only``, never guessed.
+Box proofs stop where they do not pay (PAYS) and at a budget (BOX_BUDGET), both counted per tile, so that a
+cell-by-cell atlas never costs much more than a node-by-node one; the cells they leave are ``node_only``, never
+guessed.
 
 No label is inferred: every node's label is a box proof that holds it, or its own computation.  A system that
 proves no boxes along some scanned axis gives ``node_only`` cells, every node computed.
@@ -43,7 +47,8 @@ PAYS, PAYS_MIN, PAYS_CELLS = 0.25, 32, 4
 # Box proofs of a chunk cost at most BOX_BUDGET node proofs a cell (``System.box_cost`` prices one box): a chunk
 # costs at most 1 + BOX_BUDGET times its nodes computed one by one (and the corners of cells beside a change of
 # label), however few of its boxes prove.  A coarse grid, whose cells are too wide to prove, stays cheap.
-BOX_BUDGET, MIN_BOXES = 2.0, 1  # and at least the chunk as one box
+BOX_BUDGET, MIN_BOXES = 2.0, 1  # and at least the tile as one box
+TILE_CELLS = 1024  # cells of a tile: 1024 along one axis, 32 x 32, 8 x 8 x 8 (a power of two along every axis)
 
 NODE_ONLY, WHOLE_CELL, CONTAINS_CHANGE = (CELL.value(m) for m in ("node_only", "whole_cell", "contains_change"))
 
@@ -53,6 +58,14 @@ def provable(scene: SceneBase) -> bool:
     system = systems.of(scene)
     moving = {a.name for a in scene.grid if len(a.values) > 1}
     return bool(moving) and moving <= set(system.box_axes(scene))
+
+
+def tile_shape(scene: SceneBase) -> tuple[int, ...]:
+    """Cells of a tile along each grid axis: the same power of two along every scanned axis (TILE_CELLS in all),
+    1 along an axis of one value."""
+    moving = [len(a.values) > 1 for a in scene.grid]
+    side = 2 ** int(math.log2(TILE_CELLS) // max(1, sum(moving)))
+    return tuple(side if m else 1 for m in moving)
 
 
 def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evaluate, order: tuple[int, ...]) -> dict[str, np.ndarray]:
@@ -71,21 +84,18 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
     known = np.zeros(shape, dtype=bool)
     failed_cell = np.zeros(shape, dtype=bool)  # single cells whose own box was tried and failed
 
-    lo = np.zeros((1, len(shape)), dtype=np.int64)
-    hi = np.array([shape], dtype=np.int64)
-    pays = chunk.provable
-    while lo.shape[0] and pays:
+    lo, hi = chunk.tiles()
+    while lo.shape[0] and chunk.provable:
         got, proved, tried = chunk.prove(lo, hi)
         for b in np.flatnonzero(proved):
             where = tuple(slice(a, z) for a, z in zip(lo[b], hi[b]))
             label[where], cell[where], known[where] = got[b], WHOLE_CELL, True
         one = np.all(hi - lo == 1, axis=1)
-        failed = one & ~proved
-        failed[tried:] = False
-        failed_cell[tuple(lo[failed].T)] = True
-        pays = tried == lo.shape[0] and (_pays(proved) or np.prod(hi - lo, axis=1).max() > PAYS_CELLS)
-        lo, hi = lo[~proved & ~one], hi[~proved & ~one]
-        lo, hi = _halves(lo, hi)
+        failed_cell[tuple(lo[one & tried & ~proved].T)] = True
+        small = np.prod(hi - lo, axis=1) <= PAYS_CELLS
+        chunk.stop(chunk.tile_of(lo), tried, proved, small)
+        go = ~proved & ~one & ~chunk.stopped[chunk.tile_of(lo)]
+        lo, hi = _halves(lo[go], hi[go])
 
     if known.any():
         for k, v in system.proved_box(label[known]).items():
@@ -100,24 +110,22 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
         for k, v in computed.items():
             out[k][where] = v
         label[where] = computed[system.label]
-        cell[where] = chunk.classify(nodes, label, failed_cell[where] if pays else np.zeros(nodes.shape[0], dtype=bool))
+        sub_boxes = failed_cell[where] & ~chunk.stopped[chunk.tile_of(nodes)]
+        cell[where] = chunk.classify(nodes, label, sub_boxes)
     out[CELL.name] = cell
     return out
 
 
-def _pays(proved: np.ndarray) -> bool:
-    """Whether a round of box proofs went well enough to split its failures and try again."""
-    return proved.size < PAYS_MIN or proved.mean() >= PAYS
-
-
-def _beside_change(label: np.ndarray, nodes: np.ndarray) -> np.ndarray:
-    """Which of ``nodes`` (rows of indices into ``label``) have a neighbour along some axis with another label."""
+def _beside_change(label: np.ndarray, nodes: np.ndarray, tile: np.ndarray) -> np.ndarray:
+    """Which of ``nodes`` (rows of indices into ``label``) have a neighbour in their own tile (``tile``: each
+    index's tile along its axis, same shape as ``label`` per axis) with another label."""
     out = np.zeros(nodes.shape[0], dtype=bool)
     for d in range(label.ndim):
         for step in (-1, 1):
             other = nodes.copy()
             other[:, d] += step
             inside = (other[:, d] >= 0) & (other[:, d] < label.shape[d])
+            inside[inside] &= tile[d][other[inside, d]] == tile[d][nodes[inside, d]]
             out[inside] |= label[tuple(other[inside].T)] != label[tuple(nodes[inside].T)]
     return out
 
@@ -150,27 +158,64 @@ class _Chunk:
         self.edges = [edges(a.array)[s : e + 1] for a, (s, e) in zip(scene.grid, location)]
         self.provable = provable(scene)
         self.cost = self.system.box_cost(scene) if self.provable else 1.0
-        self.budget = max(BOX_BUDGET * math.prod(e - s for s, e in location), MIN_BOXES * self.cost)  # in node proofs
+        # tiles: index along each axis of the chunk's cells; tiles numbered in C order of the chunk's tile grid
+        size = tile_shape(scene)
+        self.axis_tile = [(np.arange(s, e) // t) - s // t for (s, e), t in zip(location, size)]
+        self.tile_grid = tuple(int(a[-1]) + 1 for a in self.axis_tile)
+        starts = [np.flatnonzero(np.diff(a, prepend=-1)) for a in self.axis_tile]
+        stops = [np.append(st[1:], len(a)) for st, a in zip(starts, self.axis_tile)]
+        self._tiles = (np.array(list(itertools.product(*starts)), dtype=np.int64).reshape(-1, len(location)),
+                       np.array(list(itertools.product(*stops)), dtype=np.int64).reshape(-1, len(location)))
+        cells = np.prod(self._tiles[1] - self._tiles[0], axis=1)
+        self.budget = np.maximum(BOX_BUDGET * cells, MIN_BOXES * self.cost)  # per tile, in node proofs
+        self.stopped = np.zeros(cells.size, dtype=bool)
+
+    def tiles(self) -> tuple[np.ndarray, np.ndarray]:
+        """The chunk's tiles as boxes of cells [lo, hi) (chunk indices), numbered as ``tile_of`` numbers them."""
+        return self._tiles[0].copy(), self._tiles[1].copy()
+
+    def tile_of(self, index: np.ndarray) -> np.ndarray:
+        """The tile of each row of chunk indices (a box's lower corner, or a node)."""
+        if index.shape[0] == 0:
+            return np.zeros(0, dtype=np.int64)
+        return np.ravel_multi_index(tuple(self.axis_tile[d][index[:, d]] for d in range(index.shape[1])), self.tile_grid)
+
+    def stop(self, tile: np.ndarray, tried: np.ndarray, proved: np.ndarray, small: np.ndarray) -> None:
+        """Stop the tiles whose budget ran out in this round, or whose small boxes failed broadly (PAYS)."""
+        n = self.stopped.size
+        self.stopped |= np.bincount(tile[~tried], minlength=n) > 0
+        attempts = np.bincount(tile[tried & small], minlength=n)
+        wins = np.bincount(tile[tried & small & proved], minlength=n)
+        self.stopped |= (attempts >= PAYS_MIN) & (wins < PAYS * attempts)
 
     def values(self, index: np.ndarray) -> dict[str, np.ndarray]:
         """Grid-axis values of the nodes ``index`` (rows of chunk indices)."""
         return {name: v[index[:, d]] for d, (name, v) in enumerate(zip(self.names, self.nodes))}
 
-    def prove(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-        """(label, proved, tried) of the boxes of cells [lo, hi) (chunk indices per axis): the first ``tried`` of
-        them as far as the budget reaches, the others not tried (not proved)."""
+    def prove(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(label, proved, tried) of the boxes of cells [lo, hi) (chunk indices per axis), each tried while its
+        tile's budget lasts (in the given order within a tile)."""
         return self._prove({n: e[lo[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))},
-                           {n: e[hi[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))})
+                           {n: e[hi[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))}, self.tile_of(lo))
 
-    def _prove(self, lower: dict, upper: dict) -> tuple[np.ndarray, np.ndarray, int]:
-        npts = len(next(iter(lower.values())))
+    def _prove(self, lower: dict, upper: dict, tile: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        npts = tile.size
         label, proved = np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=bool)
-        tried = min(npts, int(self.budget // self.cost)) if self.provable else 0
-        if tried:
-            got, ok = self.system.prove_boxes(self.scene, {k: v[:tried] for k, v in lower.items()},
-                                              {k: v[:tried] for k, v in upper.items()})
-            label[:tried], proved[:tried] = got, ok
-            self.budget -= tried * self.cost
+        tried = np.zeros(npts, dtype=bool)
+        if not self.provable or npts == 0:
+            return label, proved, tried
+        # the k-th box of a tile (in order) is tried if the tile can still pay for k boxes
+        order = np.argsort(tile, kind="stable")
+        first = np.searchsorted(tile[order], tile[order], side="left")
+        rank = np.empty(npts, dtype=np.int64)
+        rank[order] = np.arange(npts) - first
+        tried = (rank + 1) * self.cost <= self.budget[tile]
+        self.budget -= self.cost * np.bincount(tile[tried], minlength=self.budget.size)
+        rows = np.flatnonzero(tried)
+        if rows.size:
+            got, ok = self.system.prove_boxes(self.scene, {k: v[rows] for k, v in lower.items()},
+                                              {k: v[rows] for k, v in upper.items()})
+            label[rows], proved[rows] = got, ok
         return label, proved, tried
 
     def classify(self, nodes: np.ndarray, label: np.ndarray, sub_boxes: np.ndarray) -> np.ndarray:
@@ -184,7 +229,7 @@ class _Chunk:
             return cell
         node_label = label[tuple(nodes.T)]
         d = nodes.shape[1]
-        near = np.flatnonzero(_beside_change(label, nodes))
+        near = np.flatnonzero(_beside_change(label, nodes, self.axis_tile))
         if near.size:
             # the labels at those cells' 2^d corners, each corner computed once however many cells share it
             sides = [np.array(s) for s in itertools.product((0, 1), repeat=d)]
@@ -199,18 +244,19 @@ class _Chunk:
         lower, upper, owner = self._sub_boxes(nodes[todo], todo)
         whole = np.zeros(nodes.shape[0], dtype=bool)
         whole[todo] = True
+        tile = self.tile_of(nodes)
         for _ in range(SUB_ROUNDS):
             if owner.size == 0:
                 break
-            got, proved, tried = self._prove(lower, upper)
+            got, proved, tried = self._prove(lower, upper, tile[owner])
             other = proved & (got != node_label[owner])
             cell[owner[other]] = CONTAINS_CHANGE
             failed = ~proved
-            if tried < owner.size or not _pays(proved):
-                owner = owner[failed]
-                break
-            lower, upper, owner = self._halve({k: v[failed] for k, v in lower.items()},
-                                              {k: v[failed] for k, v in upper.items()}, owner[failed])
+            self.stop(tile[owner], tried, proved, np.ones(owner.size, dtype=bool))
+            go = failed & tried & ~self.stopped[tile[owner]]
+            whole[owner[failed & ~go]] = False  # undecided, and not tried further
+            lower, upper, owner = self._halve({k: v[go] for k, v in lower.items()},
+                                              {k: v[go] for k, v in upper.items()}, owner[go])
         whole[owner] = False  # a sub-box still undecided after the last round
         cell[(cell == NODE_ONLY) & whole] = WHOLE_CELL
         return cell
@@ -248,4 +294,4 @@ class _Chunk:
                 np.concatenate(owners))
 
 
-__all__ = ["CONTAINS_CHANGE", "NODE_ONLY", "WHOLE_CELL", "decide_chunk", "provable"]
+__all__ = ["CONTAINS_CHANGE", "NODE_ONLY", "TILE_CELLS", "WHOLE_CELL", "decide_chunk", "provable", "tile_shape"]

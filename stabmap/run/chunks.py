@@ -67,18 +67,23 @@ def check_chunk_points(value, option: str = "chunk_points") -> int | None:
     return int(value)
 
 
-def chunk_shape(shape: tuple[int, ...], points: int, order: tuple[int, ...] | None = None) -> tuple[int, ...]:
+def chunk_shape(shape: tuple[int, ...], points: int, order: tuple[int, ...] | None = None,
+                tile: tuple[int, ...] | None = None) -> tuple[int, ...]:
     """Chunk sizes per axis holding about ``points`` points, the axes last in ``order`` kept whole first.
 
     ``order`` is the order the kernels visit the axes, the fastest last (``stabmap.run.tasks.point_order``;
     default: the grid's): a chunk then holds long runs along the fastest axes, the runs the kernels are quick
     on (work shared by neighbouring points, such as a cavity's liquid modes or a chain's matrices).
+    ``tile``: each size is rounded up to a multiple of it (or the whole axis), so that chunks hold whole tiles
+    (``stabmap.run.cells``).
     """
     order = tuple(range(len(shape))) if order is None else tuple(order)
     chunks = list(shape)
     budget = max(1, points)
     for d in reversed(order):
         chunks[d] = max(1, min(shape[d], budget))
+        if tile is not None:
+            chunks[d] = min(shape[d], -(-chunks[d] // tile[d]) * tile[d])
         budget = max(1, budget // chunks[d])
     return tuple(chunks)
 

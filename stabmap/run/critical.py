@@ -213,7 +213,7 @@ def critical(
 def _scan(run, scene, index: int, progress, chunk_points, counts: _Counts) -> np.ndarray:
     """The label on the whole grid, as (other axes..., along) with the along values increasing."""
     system = systems.of(scene)
-    arrays = decide_grid(run, scene, progress=progress, chunk_points=chunk_points)
+    arrays = decide_grid(run, scene, progress=progress, chunk_points=chunk_points, prove_cells=False)  # its own boxes follow
     nc = np.moveaxis(arrays[system.label], index, -1)
     if scene.grid[index].values[0] > scene.grid[index].values[-1]:
         nc = nc[..., ::-1]
