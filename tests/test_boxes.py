@@ -499,8 +499,9 @@ def _identical_chains():
 
 def test_spin_by_mass_boxes_of_identical_bodies_hold_their_label_in_exact_arithmetic():
     # The near-repeated roots of identical bodies: with the stiffness times u rounded in float (a radius of one
-    # rounding at every node) none of these was proved.  Boxes of omega x m_k from 1e-4 to 1e-2 of the ranges
-    # (about 0.4 to 40 grid cells of paper-n3-fixed), every proved one checked at its corners and inside.
+    # rounding at every node) 67 of these 96 were proved, none of the 24 omega x m_3 of the n = 3 chain with one
+    # mode; now 93.  Boxes of omega x m_k from 1e-4 to 1e-2 of the ranges (about 0.4 to 40 grid cells of
+    # paper-n3-fixed), every proved one checked at its corners and inside.
     nbox, proved_all, tried = 24, 0, 0
     for system, rng in _identical_chains():
         n = len(system["bodies"])
@@ -520,7 +521,7 @@ def test_spin_by_mass_boxes_of_identical_bodies_hold_their_label_in_exact_arithm
             assert np.all(_exact(scene, values) == nc[i]), (system, pair, i)
         proved_all += int(proved.sum())
         tried += nbox
-    assert proved_all >= 0.6 * tried, (proved_all, tried)
+    assert proved_all >= 0.85 * tried, (proved_all, tried)
 
 
 def test_paper_n3_fixed_one_cell_spin_by_mass_boxes_are_proved():
