@@ -205,7 +205,7 @@ def _box_ok(body, rb):
 
 
 @kernel
-def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, parent, at, rat, t, t_lo, t_hi, t2, t2_lo, t2_hi,
+def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, parent, at, rat, t, t_lo, t_hi, t2, t2_lo, t2_hi, spin,
                     out_nc, out_status):
     """N_c proved for every point of each of a block of boxes along whose one or two main parameters p is a polynomial.
 
@@ -214,7 +214,12 @@ def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, p
     distinct nodes in the interval of t, ``t2[p]`` N2 in that of t2; N2 = 1 (t2 = t2_lo = t2_hi = 0) is a box along
     t alone.  ``body[p, k]``, ``joint[p, k]``, ``g[p, k]``, ``at[p, k]`` (with their radii ``rbody`` ... in the same
     layout) are the kernel inputs at node k = i N2 + j, (t[p, i], t2[p, j]), layouts as for ``box_block`` with a
-    node axis after the box axis.  The coefficients are enclosed at each node as narrowly as at a point, and
+    node axis after the box axis.  ``spin``: t is u = 1 / omega^2 of the spin-scaled model (every t[p, i] > 0), and
+    the joints and g given are those of u = 1; node k takes them times t[p, i], a product exact in double-double
+    (``charpoly.matrix_box``), so its inputs are the model's at u_i with no rounding radius.  A float product
+    formed outside would carry a radius of one rounding at every node, which the near-repeated roots of identical
+    bodies do not survive (docs/certification.md, section 6).  The coefficients are enclosed at each node as
+    narrowly as at a point, and
     ``count_nodes`` counts over the whole box (docs/certification.md, section 6).  Outputs as for ``box_block``;
     more than ``LAPLACE_MAX`` bodies: UNDECIDED.  ValueError unless the node axis has N1 N2 entries.
     """
@@ -234,13 +239,16 @@ def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, p
     for p in range(npts):
         out_nc[p], out_status[p] = -1, UNDECIDED
         ok = laplace and _nodes_ok(t[p], t_lo[p], t_hi[p]) and _nodes_ok(t2[p], t2_lo[p], t2_hi[p])
+        ok = ok and (not spin or t_lo[p] > 0.0)  # the nodes lie in [t_lo, t_hi]
         for k in range(N):
             ok = ok and _box_ok(body[p, k], rbody[p, k])
         if not ok:
             continue
         grid = (N1, t[p], *_ball(t_lo[p], t_hi[p]), N2, t2[p], *_ball(t2_lo[p], t2_hi[p]))
         for k in range(N):
-            matrix_box(body[p, k], rbody[p, k], joint[p, k], rjoint[p, k], at[p, k], rat[p, k], g[p, k], rg[p, k], E[p], kappa[p], nmodes, parent, free, ws)
+            u = t[p, k // N2] if spin else 1.0
+            matrix_box(body[p, k], rbody[p, k], joint[p, k], rjoint[p, k], at[p, k], rat[p, k], g[p, k], rg[p, k], E[p], kappa[p], nmodes, parent,
+                       free, ws, u)
             block_det(ws, rowdeg, 0, n, C[k])
         out_nc[p], out_status[p] = count_nodes(C, grid, cs, Xn, F, G)
 

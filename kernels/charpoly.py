@@ -99,16 +99,40 @@ def _lever_arms(body, rb, at, ra, parent, free, J):
 
 
 @kernel
-def _stiffness_T(body, rb, joint, rj, at, ra, parent, g, rg, free, sub, K):
-    """Write K T (see module docstring) into K (n, n, 3); sub (n, 3) is scratch."""
+def _scaled(x, r, u):
+    """Enclosure of (x +- r) u for floats x, r >= 0 and u > 0.  x u is exact in double-double (``two_prod``), so a
+    point x stays a point: only r u, rounded up, is a radius (and ``ETA`` where the product is so small that its
+    rounding error may underflow).  An exact zero stays exact."""
+    if x == 0.0 and r == 0.0:
+        return 0.0, 0.0, 0.0
+    h, l = dd.two_prod(x, u)
+    rad = r * u * dd.INFL
+    if abs(h) < 2.0**-900:
+        rad += dd.ETA
+    return h, l, rad
+
+
+@kernel
+def _stiffness_T(body, rb, joint, rj, at, ra, parent, g, rg, free, sub, K, u):
+    """Write K T (see module docstring) into K (n, n, 3), the stiffness (joints and g) times the float u > 0 (the
+    spin-scaled model; u = 1: K T itself, operation for operation); sub (n, 3) is scratch."""
     n = body.shape[0]
     K[:] = 0.0
     for j in range(1, n):
-        K[j, j, 0], K[j, j, 2] = joint[j], rj[j]
-        K[parent[j], j, 0], K[parent[j], j, 2] = -joint[j], rj[j]
+        if u == 1.0:
+            K[j, j, 0], K[j, j, 2] = joint[j], rj[j]
+            K[parent[j], j, 0], K[parent[j], j, 2] = -joint[j], rj[j]
+        else:
+            _set(K[j], j, _scaled(joint[j], rj[j], u))
+            _set(K[parent[j]], j, dd.neg(*_scaled(joint[j], rj[j], u)))
     if free:
         return
-    K[0, 0, 0], K[0, 0, 2] = joint[0], rj[0]
+    if u == 1.0:
+        K[0, 0, 0], K[0, 0, 2] = joint[0], rj[0]
+        gu = (g, 0.0, rg)
+    else:
+        _set(K[0], 0, _scaled(joint[0], rj[0], u))
+        gu = _scaled(g, rg, u)
     # sub[k]: mass of the subtree of body k; children come after their parent, so go backwards.
     for k in range(n - 1, -1, -1):
         outboard = (0.0, 0.0, 0.0)  # mass of the bodies beyond body k
@@ -123,7 +147,7 @@ def _stiffness_T(body, rb, joint, rj, at, ra, parent, g, rg, free, sub, K):
             leaf = False
         if leaf:
             a = dd.add(*a, 0.0, 0.0, 0.0)  # as m_k c_k + s_k * 0: the same rounding bound as a chain's top body
-        ga = dd.mul(g, 0.0, rg, *a)
+        ga = dd.mul(*gu, *a)
         j = k
         while j >= 0:  # row k of -g diag(a) T: the bodies on the path to k
             K[k, j, 0], K[k, j, 1], K[k, j, 2] = dd.add(K[k, j, 0], K[k, j, 1], K[k, j, 2], *dd.neg(*ga))
@@ -156,7 +180,7 @@ def structure(body, joint, at, g, parent, free, sub, J, M, K):
     zero, zero1 = np.zeros_like(body), np.zeros(body.shape[0])
     _lever_arms(body, zero, at, zero1, parent, free, J)
     _inertia_T(body, zero, parent, J, M)
-    _stiffness_T(body, zero, joint, zero1, at, zero1, parent, g, 0.0, free, sub, K)
+    _stiffness_T(body, zero, joint, zero1, at, zero1, parent, g, 0.0, free, sub, K, 1.0)
 
 
 @kernel
@@ -184,20 +208,21 @@ def _liquid_polys(omega, romega, E, kappa, L, q, w):
 
 
 @kernel
-def _matrix(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, reuse):
+def _matrix(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, reuse, u=1.0):
     """Write P = diag(Q) Phi T as interval polynomials into P (n, n, 3 + Lmax, 3).
 
     Row k has degree 2 + nmodes[k]; unused trailing coefficients are exact zeros.
     ``reuse``: M T and K T in M, K are those of this point already (only omega
     or the liquid changed since the previous point).  T from ``path_matrix``.
     rb, rj, ra, rg: radii of body, joint, at and g (zeros for one point): the
-    enclosures then hold for every parameter value within them (a box).
+    enclosures then hold for every parameter value within them (a box).  u: the stiffness (joints and g) is
+    taken times u (``_stiffness_T``).
     """
     n = body.shape[0]
     if not reuse:
         _lever_arms(body, rb, at, ra, parent, free, J)
         _inertia_T(body, rb, parent, J, M)
-        _stiffness_T(body, rb, joint, rj, at, ra, parent, g, rg, free, sub, K)
+        _stiffness_T(body, rb, joint, rj, at, ra, parent, g, rg, free, sub, K, u)
     P[:] = 0.0
     for k in range(n):
         L = nmodes[k]
@@ -361,12 +386,15 @@ def matrix_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
 
 
 @kernel
-def matrix_box(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, ws):
+def matrix_box(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, ws, u=1.0):
     """Build P of a box of parameters into ws[5]: every parameter x within its radius r (x +- r) of the
     midpoint given (rb, rj, ra, rg: radii shaped as body, joint, at and g).  The intervals of P then hold
-    P at every point of the box.  E and kappa are points (they are never scanned)."""
+    P at every point of the box.  E and kappa are points (they are never scanned).
+
+    u (a float > 0): the joints and g are taken times u, the product exact in double-double.  The spin-scaled
+    model's node u_i (docs/certification.md, section 6): formed here, its inputs need no rounding radius."""
     J, M, K, q, w, P, D, T, sub, zero, zero1 = ws
-    _matrix(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, False)
+    _matrix(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, False, u)
 
 
 @kernel

@@ -32,9 +32,6 @@ import numpy as np
 from .points import PointArrays, point_arrays
 from .scene import Scene
 
-ROUNDING = 2.0**-52  # relative bound of one rounding, with a factor 2 of margin
-TINY = 2.0**-1074
-
 
 @dataclass
 class NodeBoxes:
@@ -42,7 +39,8 @@ class NodeBoxes:
 
     ``body``, ``joint``, ``g``, ``at`` and their radii have a node axis after the box axis, node i N2 + j; t (npts,
     N1) and t2 (npts, N2) hold the nodes, distinct and decreasing, inside [t_lo, t_hi] and [t2_lo, t2_hi].  A box
-    along one parameter has N2 = 1 and t2 = t2_lo = t2_hi = 0.
+    along one parameter has N2 = 1 and t2 = t2_lo = t2_hi = 0.  ``spin``: t is u = 1 / omega^2 (spin-scaled), and
+    ``joint``, ``g`` and their radii are those of u = 1, which the kernel multiplies by u_i at node (i, j) exactly.
     """
 
     body: np.ndarray
@@ -64,10 +62,11 @@ class NodeBoxes:
     t2: np.ndarray
     t2_lo: np.ndarray
     t2_hi: np.ndarray
+    spin: bool = False
 
     def kernel_args(self):
         return (self.body, self.rbody, self.joint, self.rjoint, self.g, self.rg, self.E, self.kappa, self.nmodes, self.free,
-                self.parent, self.at, self.rat, self.t, self.t_lo, self.t_hi, self.t2, self.t2_lo, self.t2_hi)
+                self.parent, self.at, self.rat, self.t, self.t_lo, self.t_hi, self.t2, self.t2_lo, self.t2_hi, self.spin)
 
 
 def chebyshev(lo: np.ndarray, hi: np.ndarray, N: int) -> np.ndarray:
@@ -75,13 +74,6 @@ def chebyshev(lo: np.ndarray, hi: np.ndarray, N: int) -> np.ndarray:
     mid = 0.5 * lo + 0.5 * hi
     t = mid[:, None] + (hi - mid)[:, None] * np.cos(np.pi * (2 * np.arange(N) + 1) / (2 * N))[None, :]
     return np.clip(t, lo[:, None], hi[:, None])
-
-
-def _times(x: np.ndarray, r: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A ball (midpoint, radius) holding (x +- r) u for floats u > 0 (broadcast); an exact zero stays exact."""
-    m = x * u
-    rad = np.abs(m) * ROUNDING + r * u * (1.0 + 2.0 * ROUNDING) + TINY
-    return m, np.where((x == 0.0) & (r == 0.0), 0.0, rad)
 
 
 def _u_interval(w1: np.ndarray, w2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -104,7 +96,8 @@ def _no_second(npts: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def spin_scaled(box, w1: np.ndarray, w2: np.ndarray) -> NodeBoxes:
     """The plain boxes ``box`` (``boxes.BoxArrays``) in the spin-scaled model: u = 1 / omega^2 at n + 1 nodes, the
-    other parameters within their radii at every node.  omega runs between the corners' w1 and w2 (one sign)."""
+    other parameters within their radii at every node.  omega runs between the corners' w1 and w2 (one sign).
+    The stiffness is handed over at u = 1: the kernel forms its products with the nodes exactly (``spin``)."""
     m = box.mid
     u_lo, u_hi = _u_interval(w1, w2)
     n = m.body.shape[1]
@@ -115,10 +108,8 @@ def spin_scaled(box, w1: np.ndarray, w2: np.ndarray) -> NodeBoxes:
 
     body, rbody = at_nodes(m.body), at_nodes(box.rbody)
     body[..., 5], rbody[..., 5] = 1.0, 0.0
-    joint, rjoint = _times(m.joint[:, None], box.rjoint[:, None], u[..., None])
-    g, rg = _times(m.g[:, None], box.rg[:, None], u)
-    return NodeBoxes(body, rbody, joint, rjoint, g, rg, at_nodes(m.at), at_nodes(box.rat), m.E, m.kappa, m.nmodes, m.free,
-                     m.parent, u, u_lo, u_hi, *_no_second(u.shape[0]))
+    return NodeBoxes(body, rbody, at_nodes(m.joint), at_nodes(box.rjoint), at_nodes(m.g), at_nodes(box.rg), at_nodes(m.at),
+                     at_nodes(box.rat), m.E, m.kappa, m.nmodes, m.free, m.parent, u, u_lo, u_hi, *_no_second(u.shape[0]), spin=True)
 
 
 def _copies(pts: PointArrays, lo: PointArrays, hi: PointArrays, sel: np.ndarray, grid: dict[str, np.ndarray],
@@ -182,7 +173,8 @@ def mechanical(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
         t, t_lo, t_hi = nodes[axes[0]][keep], ranges[axes[0]][0][keep], ranges[axes[0]][1][keep]
         arrays = [a for x in (body, joint, g, at) for a in (x, np.zeros_like(x))]
         return sel, NodeBoxes(*arrays, E, kappa, pts.nmodes, pts.free, pts.parent, t, t_lo, t_hi, *second)
-    # spin-scaled: at node (u_i, t_j) the inputs at t_j with every spin 1 and the stiffness (joints, g) times u_i
+    # spin-scaled: at node (u_i, t_j) the inputs at t_j with every spin 1 and the stiffness (joints, g) times u_i,
+    # the product formed by the kernel (``spin``)
     u_lo, u_hi = _u_interval(lo.body[sel, 0, 5], hi.body[sel, 0, 5])
     n = scene.n
     u = chebyshev(u_lo, u_hi, n + 1)
@@ -191,12 +183,9 @@ def mechanical(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
         """(sel, count, ...) at the mechanical nodes -> (sel, (n + 1) count, ...), the u axis slowest."""
         return np.repeat(x[:, None], n + 1, axis=1).reshape((sel.size, (n + 1) * count) + x.shape[2:])
 
-    body = tensor(body)
+    body, joint, g, at = tensor(body), tensor(joint), tensor(g), tensor(at)
     body[..., 5] = 1.0
-    uk = np.repeat(u, count, axis=1)  # u at each node of the tensor grid
-    joint, rjoint = _times(tensor(joint), 0.0, uk[..., None])
-    g, rg = _times(tensor(g), 0.0, uk)
-    at = tensor(at)
     (axis,) = axes
-    return sel, NodeBoxes(body, np.zeros_like(body), joint, rjoint, g, rg, at, np.zeros_like(at), E, kappa, pts.nmodes, pts.free,
-                          pts.parent, u, u_lo, u_hi, nodes[axis][keep], ranges[axis][0][keep], ranges[axis][1][keep])
+    zeros = [np.zeros_like(x) for x in (body, joint, g, at)]
+    return sel, NodeBoxes(body, zeros[0], joint, zeros[1], g, zeros[2], at, zeros[3], E, kappa, pts.nmodes, pts.free,
+                          pts.parent, u, u_lo, u_hi, nodes[axis][keep], ranges[axis][0][keep], ranges[axis][1][keep], spin=True)
