@@ -3,7 +3,7 @@
     python scripts/bench_cell_boxes.py          # every cell: 90000 boxes per example (about a minute)
     python scripts/bench_cell_boxes.py 2000     # a random sample of 2000 cells each
 
-Cells: edges midway between neighbouring grid values (``scene.grid.edges``).  paper-n3-fixed omega x m_2 (three
+Cells: edges midway between neighbouring grid values (``store.dataset.edges``).  paper-n3-fixed omega x m_2 (three
 identical bodies and cavities: spin and a mass on the tensor grid) and paper-n2-fixed omega x K_1
 (docs/certification.md, section 6, "Measured": 92.7 % and 97.7 % of every cell).
 """
@@ -16,7 +16,8 @@ import time
 import numpy as np
 
 import stabmap
-from stabmap.scene.grid import edges, resample
+from stabmap.scene.grid import resample
+from stabmap.store.dataset import edges
 from stabmap.systems.gyroscopes.decide import prove_boxes
 
 CASES = (("paper-n3-fixed", "omega", "m_2"), ("paper-n2-fixed", "omega", "K_1"))

@@ -31,6 +31,7 @@ import sys
 import tempfile
 import threading
 import time
+import tomllib
 from collections import Counter
 from pathlib import Path
 
@@ -38,11 +39,13 @@ import numpy as np
 
 import stabmap
 from stabmap.run import cells
-from stabmap.scene.grid import edges, resample
+from stabmap.scene.grid import resample
+from stabmap.store.dataset import edges
 from stabmap.store.variables import CELL
 from stabmap.systems.gyroscopes.scene import from_dict
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_critical import REGIONS  # noqa: E402  (the two-body chain of ../shared/REGIONS.md)
 from float_peer import float_atlas  # noqa: E402
 
 LADDER = [(3, 0), (2, 1), (3, 2), (4, 2), (6, 2), (6, 4), (8, 4)]  # degrees 6, 6, 12, 16, 24, 36, 48
@@ -149,23 +152,15 @@ def end_to_end(name: str, num: int, workdir: str) -> dict:
             "shares": {m: float((cell == v).mean()) for v, m in CELL.flags}, "peer_wrong": wrong}
 
 
-WINDOW = {
-    "support": "fixed", "g": 9.81, "joints": [10.0],
-    "bodies": [
-        {"m": 1.0, "A": 0.02, "C": 0.06, "c": 0.1, "s": 0.2, "fluid": {"E": [5e-4], "kappa": [-2.5]}},
-        {"m": 1.0, "A": 0.05, "C": 0.06, "c": 0.05, "fluid": {"E": [5e-4], "kappa": [4.5]}},
-    ],
-    "grid": {"omega": {"start": 0.5, "stop": 99.5, "num": 100}},
-}
-
-
 def stress(E: float, rng) -> dict:
     """False whole cells on the stress scene with liquid E (module docstring)."""
     from stabmap.run.critical import critical
     from stabmap.systems.gyroscopes import exact
     from stabmap.systems.gyroscopes.points import point_arrays
 
-    scene = from_dict(dict(WINDOW, bodies=[dict(b, fluid=dict(b["fluid"], E=[E])) for b in WINDOW["bodies"]]))
+    table = tomllib.loads(REGIONS)
+    table["bodies"] = [dict(b, fluid=dict(b["fluid"], E=[E])) for b in table["bodies"]]
+    scene = from_dict(table)
     ds = stabmap.compute_atlas(scene, progress=False)
     crit = critical(scene, "omega", rtol=1e-10, progress=False)
     keep = np.isfinite(crit["boundary_lower"].values)

@@ -72,3 +72,17 @@ def engine_enclosure(system: dict) -> list[tuple[Fraction, Fraction]]:
     out = np.zeros((1, scene.degree + 1, 3))
     kernels.charpoly_block(*pts.kernel_args(), out)
     return [(Fraction(h) + Fraction(lo), Fraction(r)) for h, lo, r in out[0]]
+
+
+# ../shared/REGIONS.md: a two-body fixed chain with small liquid modes, a stable window 0.108 rad/s wide near
+# omega = 12 between scan values 1 rad/s apart.  Exact boundaries (roots of the discriminant in omega):
+# 11.909452, 12.017778, 13.838770.
+WINDOW = {
+    "support": "fixed", "g": 9.81, "joints": [10.0],
+    "bodies": [
+        {"m": 1.0, "A": 0.02, "C": 0.06, "c": 0.1, "s": 0.2, "fluid": {"E": [5e-4], "kappa": [-2.5]}},
+        {"m": 1.0, "A": 0.05, "C": 0.06, "c": 0.05, "fluid": {"E": [5e-4], "kappa": [4.5]}},
+    ],
+    "grid": {"omega": {"start": 0.5, "stop": 99.5, "num": 100}},
+}
+EXACT_BOUNDARIES = (11.909452, 12.017778, 13.838770)

@@ -19,18 +19,8 @@ from stabmap.systems.gyroscopes.decide import kernel_args
 from stabmap.systems.gyroscopes.nodes import spin_scaled
 from stabmap.systems.gyroscopes.points import point_arrays
 from stabmap.systems.gyroscopes.scene import from_dict
+from systems import EXACT_BOUNDARIES, WINDOW
 
-# Two-body fixed chain with small liquid modes: a stable window 0.108 rad/s wide near omega = 12, between two
-# scan values 1 rad/s apart.  Exact boundaries (roots of the discriminant in omega): 11.909452, 12.017778, 13.838770.
-WINDOW = {
-    "support": "fixed", "g": 9.81, "joints": [10.0],
-    "bodies": [
-        {"m": 1.0, "A": 0.02, "C": 0.06, "c": 0.1, "s": 0.2, "fluid": {"E": [5e-4], "kappa": [-2.5]}},
-        {"m": 1.0, "A": 0.05, "C": 0.06, "c": 0.05, "fluid": {"E": [5e-4], "kappa": [4.5]}},
-    ],
-    "grid": {"omega": {"start": 0.5, "stop": 99.5, "num": 100}},
-}
-EXACT_BOUNDARIES = (11.909452, 12.017778, 13.838770)
 
 
 def _exact(scene, values: dict[str, np.ndarray]) -> np.ndarray:
@@ -527,7 +517,8 @@ def test_spin_by_mass_boxes_of_identical_bodies_hold_their_label_in_exact_arithm
 def test_paper_n3_fixed_one_cell_spin_by_mass_boxes_are_proved():
     # paper-n3-fixed regridded to 300 x 300 (omega x m_2): measured 92.7 % of all 90000 one-cell boxes proved (none
     # before the stiffness was scaled by u exactly in the kernel); 400 random cells here
-    from stabmap.scene.grid import edges, resample
+    from stabmap.scene.grid import resample
+from stabmap.store.dataset import edges
 
     scene = resample(stabmap.example("paper-n3-fixed"), omega=300, m_2=300)
     omega, m2 = (edges(a.array) for a in scene.grid)

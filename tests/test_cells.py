@@ -5,6 +5,7 @@ narrow windows and bands (the roots of the discriminant in omega, tests/test_box
 from __future__ import annotations
 
 import dataclasses
+import random
 
 import numpy as np
 import pytest
@@ -14,26 +15,17 @@ from hypothesis import strategies as st
 
 import stabmap
 from stabmap.run.critical import critical
-from stabmap.scene.grid import Axis, edges, resample
+from stabmap.scene.grid import Axis, resample
+from stabmap.store.dataset import edges
 from stabmap.store.variables import CELL
 from stabmap.systems.gyroscopes import exact
 from stabmap.systems.gyroscopes.outputs import BY_BOX
 from stabmap.systems.gyroscopes.points import point_arrays
 from stabmap.systems.gyroscopes.scene import from_dict
+from systems import EXACT_BOUNDARIES, WINDOW, random_system
 
 WHOLE, CHANGE, NODE = (CELL.value(m) for m in ("whole_cell", "contains_change", "node_only"))
 
-# The two-body chain of tests/test_boxes.py: a stable window 0.108 rad/s wide near omega = 12 between scan values
-# 1 rad/s apart; exact boundaries 11.909452, 12.017778, 13.838770.
-WINDOW = {
-    "support": "fixed", "g": 9.81, "joints": [10.0],
-    "bodies": [
-        {"m": 1.0, "A": 0.02, "C": 0.06, "c": 0.1, "s": 0.2, "fluid": {"E": [5e-4], "kappa": [-2.5]}},
-        {"m": 1.0, "A": 0.05, "C": 0.06, "c": 0.05, "fluid": {"E": [5e-4], "kappa": [4.5]}},
-    ],
-    "grid": {"omega": {"start": 0.5, "stop": 99.5, "num": 100}},
-}
-EXACT_BOUNDARIES = (11.909452, 12.017778, 13.838770)
 
 
 def _exact(scene, values: dict[str, np.ndarray]) -> np.ndarray:
@@ -117,23 +109,15 @@ def test_narrow_liquid_bands_never_hide_in_a_whole_cell(E):
 
 # --------------------------------------------------------------------------------------- random scenes (2-D)
 def _random_scene(seed: int):
-    rng = np.random.default_rng(seed)
-    n = int(rng.integers(1, 4))
-    bodies = []
-    for _ in range(n):
-        body = {"m": float(rng.uniform(0.5, 2)), "A": float(rng.uniform(0.01, 0.05)), "C": float(rng.uniform(0.01, 0.08)),
-                "c": float(rng.uniform(-0.05, 0.15)), "s": float(rng.uniform(0.1, 0.3))}
-        if rng.random() < 0.7:
-            L = int(rng.integers(1, 3))
-            body["fluid"] = {"E": [float(x) for x in rng.uniform(1e-4, 2e-3, L)],
-                             "kappa": [float(x) for x in rng.choice([-2.5, 1.3, 2.7, 4.5], L, replace=False)]}
-        bodies.append(body)
-    other = str(rng.choice(["K_1", "m_1", "c_1", "g"])) if n > 1 else str(rng.choice(["m_1", "c_1", "g"]))
-    start = {"K_1": 0.0, "m_1": 0.5, "c_1": -0.05, "g": 0.0}[other]
-    stop = {"K_1": 40.0, "m_1": 3.0, "c_1": 0.2, "g": 20.0}[other]
-    system = {"support": "fixed", "g": 9.81, "bodies": bodies, "joints": [float(x) for x in rng.uniform(0, 20, n - 1)],
-              "grid": {"omega": {"start": float(rng.uniform(1, 10)), "stop": float(rng.uniform(30, 120)), "num": int(rng.integers(5, 13))},
-                       other: {"start": start, "stop": stop, "num": int(rng.integers(4, 9))}}}
+    """A random fixed chain (tests/systems.py, every body at the common spin) over omega x another parameter."""
+    rng = random.Random(seed)
+    n = rng.randint(1, 3)
+    system = random_system(rng, n, rng.randint(0, 2), "fixed")
+    for body in system["bodies"]:
+        body.pop("omega", None)
+    other, start, stop = rng.choice([("K_1", 0.0, 40.0), ("m_1", 0.5, 3.0), ("c_1", -0.05, 0.2), ("g", 0.0, 20.0)][n == 1:])
+    system["grid"] = {"omega": {"start": rng.uniform(1, 10), "stop": rng.uniform(30, 120), "num": rng.randint(5, 12)},
+                      other: {"start": start, "stop": stop, "num": rng.randint(4, 8)}}
     return from_dict(system)
 
 

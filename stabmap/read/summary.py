@@ -6,7 +6,7 @@ import numpy as np
 import xarray as xr
 
 from .. import systems
-from ..scene.grid import edges
+from ..store.dataset import edges
 from ..store.variables import CELL
 
 
@@ -52,7 +52,7 @@ def summary(ds: xr.Dataset) -> dict:
 
 
 def cell_sizes(ds: xr.Dataset, dim: str) -> np.ndarray:
-    """The widths of the grid cells along ``dim`` (the midpoints between its values; ``stabmap.scene.grid.edges``);
+    """The widths of the grid cells along ``dim`` (the midpoints between its values; ``stabmap.store.dataset.edges``);
     an axis of one value has one cell of width 1, so that it weighs nothing."""
     e = edges(ds[dim].values)
     return np.abs(np.diff(e)) if e.size > 2 else np.ones(ds[dim].size)

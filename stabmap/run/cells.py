@@ -1,7 +1,7 @@
 """Atlases decided cell by cell: large boxes proved first, nodes computed only where no box proves.
 
 A grid node's **cell** is the box between the midpoints to its neighbours along every axis (the scan's first
-and last values close the outermost cells), so the cells tile the scanned box (``stabmap.scene.grid.edges``).  Every chunk of an
+and last values close the outermost cells), so the cells tile the scanned box (``stabmap.store.dataset.edges``).  Every chunk of an
 atlas is decided here (``decide_chunk``):
 
 1. The grid is cut into **tiles** of up to TILE_CELLS cells (``tile_shape``, fixed by the grid alone); a chunk
@@ -35,7 +35,7 @@ import math
 import numpy as np
 
 from .. import systems
-from ..scene.grid import edges
+from ..store.dataset import edges
 from ..store.variables import CELL
 from ..systems.base import SceneBase
 
@@ -44,10 +44,10 @@ SUB_ROUNDS = 2  # rounds of halving inside one cell before it is left node_only
 # PAYS_CELLS cells each, of which under PAYS prove, is the last; its boxes' nodes are then computed, and its cells
 # left node_only.  Larger boxes fail for their size alone (roots move past the separators), so they never stop it.
 PAYS, PAYS_MIN, PAYS_CELLS = 0.25, 32, 4
-# Box proofs of a chunk cost at most BOX_BUDGET node proofs a cell (``System.box_cost`` prices one box): a chunk
+# Box proofs of a tile cost at most BOX_BUDGET node proofs a cell (``System.box_cost`` prices one box): a tile
 # costs at most 1 + BOX_BUDGET times its nodes computed one by one (and the corners of cells beside a change of
 # label), however few of its boxes prove.  A coarse grid, whose cells are too wide to prove, stays cheap.
-BOX_BUDGET, MIN_BOXES = 2.0, 1  # and at least the tile as one box
+BOX_BUDGET = 1.0
 TILE_CELLS = 1024  # cells of a tile: 1024 along one axis, 32 x 32, 8 x 8 x 8 (a power of two along every axis)
 
 NODE_ONLY, WHOLE_CELL, CONTAINS_CHANGE = (CELL.value(m) for m in ("node_only", "whole_cell", "contains_change"))
@@ -167,7 +167,7 @@ class _Chunk:
         self._tiles = (np.array(list(itertools.product(*starts)), dtype=np.int64).reshape(-1, len(location)),
                        np.array(list(itertools.product(*stops)), dtype=np.int64).reshape(-1, len(location)))
         cells = np.prod(self._tiles[1] - self._tiles[0], axis=1)
-        self.budget = np.maximum(BOX_BUDGET * cells, MIN_BOXES * self.cost)  # per tile, in node proofs
+        self.budget = BOX_BUDGET * cells.astype(np.float64)  # per tile, in node proofs: no box dearer than its tile
         self.stopped = np.zeros(cells.size, dtype=bool)
 
     def tiles(self) -> tuple[np.ndarray, np.ndarray]:

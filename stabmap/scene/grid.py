@@ -57,22 +57,6 @@ class Axis:
         return {"values": list(self.values), "scale": self.scale}
 
 
-def edges(values) -> np.ndarray:
-    """The edges of an axis's grid cells (one more than its values): midpoints between neighbouring values, the
-    first and last values outside, so the cells tile the scanned interval.  One value: a cell of width 0."""
-    values = np.asarray(values, dtype=np.float64)
-    out = np.empty(values.size + 1)
-    out[0], out[-1] = values[0], values[-1]
-    out[1:-1] = 0.5 * values[:-1] + 0.5 * values[1:]
-    return out
-
-
-def bounds(values) -> np.ndarray:
-    """CF bounds of an axis, shape (len, 2): each grid cell's two edges, in the axis's order."""
-    e = edges(values)
-    return np.column_stack([e[:-1], e[1:]])
-
-
 def check_axes(axes: tuple[Axis, ...], parameter: Callable[[str], Parameter]) -> None:
     """Every axis names a parameter (``parameter`` raises for other names) and holds values it may take."""
     names = [a.name for a in axes]

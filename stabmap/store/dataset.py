@@ -8,11 +8,26 @@ import datetime as dt
 import numpy as np
 import xarray as xr
 
-from ..scene.grid import bounds
 from ..version import __version__
 
 BOUNDS_DIM = "bnds"  # the CF bounds variables' second dimension: a cell's two edges
 FORMAT_VERSION = 5  # 4: stabmap_system; every variable of the system written as declared; 5: cell and axis bounds
+
+
+def edges(values) -> np.ndarray:
+    """The edges of an axis's grid cells (one more than its values): midpoints between neighbouring values, the
+    first and last values outside, so the cells tile the scanned interval.  One value: a cell of width 0."""
+    values = np.asarray(values, dtype=np.float64)
+    out = np.empty(values.size + 1)
+    out[0], out[-1] = values[0], values[-1]
+    out[1:-1] = 0.5 * values[:-1] + 0.5 * values[1:]
+    return out
+
+
+def bounds(values) -> np.ndarray:
+    """CF bounds of an axis, shape (len, 2): each grid cell's two edges, in the axis's order."""
+    e = edges(values)
+    return np.column_stack([e[:-1], e[1:]])
 
 
 def coordinates(system, scene, skip: tuple[str, ...] = ()) -> dict:

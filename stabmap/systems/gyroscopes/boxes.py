@@ -185,9 +185,13 @@ def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarra
 
 
 def box_cost(scene: Scene) -> float:
-    """A box proof along the scene's scanned axes, in point proofs: its enclosure's nodes, each about one point's
-    coefficients (n + 1 along the spin, 2n + 1 along a mechanical axis, their product for two axes; plain: 1)."""
+    """A box proof along the scene's scanned axes, in point proofs: its enclosure's nodes (n + 1 along the spin,
+    2n + 1 along a mechanical axis, their product for two axes; plain: 1), each dearer than a point by a factor
+    that grows with n: the box kernel expands the determinant's 2^n minors in intervals at every node, where a
+    point reuses its neighbour's work or proves without coefficients.  1 + n/3 + 2^n/64, fitted to
+    scripts/bench_cells.py (a box of two bodies costs about 23 points, of six about 270, of eight about 1400)."""
     n = scene.n
     per_axis = [n + 1 if _is_spin(scene, a.name) else 2 * n + 1 if _mechanical(scene, a.name) else 1
                 for a in scene.grid if len(a.values) > 1]
-    return float(np.prod(per_axis)) if len(per_axis) <= 2 else 1.0
+    nodes = float(np.prod(per_axis)) if len(per_axis) <= 2 else 1.0
+    return nodes * (1.0 + n / 3.0 + 2.0**n / 64.0)
