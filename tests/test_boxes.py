@@ -518,7 +518,7 @@ def test_paper_n3_fixed_one_cell_spin_by_mass_boxes_are_proved():
     # paper-n3-fixed regridded to 300 x 300 (omega x m_2): measured 92.7 % of all 90000 one-cell boxes proved (none
     # before the stiffness was scaled by u exactly in the kernel); 400 random cells here
     from stabmap.scene.grid import resample
-from stabmap.store.dataset import edges
+    from stabmap.store.dataset import edges
 
     scene = resample(stabmap.example("paper-n3-fixed"), omega=300, m_2=300)
     omega, m2 = (edges(a.array) for a in scene.grid)
