@@ -83,7 +83,7 @@ def test_the_narrow_window_never_lies_in_a_whole_cell():
         for i in _cells_containing(scene, x):
             assert cell[i] != WHOLE, (x, i)
     assert [CELL.meaning(int(cell[i])) for i in _cells_containing(scene, EXACT_BOUNDARIES[2])] == ["contains_change"]
-    assert (cell == WHOLE).sum() >= 90  # all but the low-spin cells and the window's
+    assert (cell == WHOLE).sum() >= 75  # the rest mostly proved (a 100-cell tile affords 19 box proofs)
 
 
 @pytest.mark.parametrize("E", [1e-4, 1e-6, 1e-8])

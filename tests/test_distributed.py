@@ -22,6 +22,7 @@ from stabmap import cli
 from stabmap.run import atlas
 from stabmap.run import runner as cluster
 from stabmap.run.atlas import compute, compute_to_file
+from stabmap.run.cells import tile_shape
 from stabmap.run.chunks import (
     MIN_CHUNK_POINTS,
     TASK_SECONDS,
@@ -72,7 +73,7 @@ fluid = { E = [0.0005, 0.0001, 0.00005, 0.00002], kappa = [1.7, 3.3, 5.5, 7.9] }
 omega = { start = 1.0, stop = 120.0, num = 240 }
 m_2 = { start = 0.2, stop = 4.0, num = 160 }
 """
-SLOW_CHUNK = 1024  # 40 chunks of 240 x 4 points
+SLOW_CHUNK = 1024  # 40 chunks: one tile of 32 x 32 cells each (stabmap.run.cells)
 
 
 def _same_atlas(a: xr.Dataset, b: xr.Dataset) -> None:
@@ -204,6 +205,17 @@ def test_chunk_layout_covers_the_grid_once():
         assert int(np.prod(chunks)) <= points
         if order is not None:  # the axis visited fastest is kept whole first
             assert chunks[order[-1]] == min(shape[order[-1]], points)
+    # chunks of whole tiles (stabmap.run.cells): multiples of the tile or the whole axis, at least one tile
+    for shape, points, order, tile in [((240, 160), 1024, (1, 0), (32, 32)), ((240, 160), 5000, (1, 0), (32, 32)),
+                                       ((100000,), 3000, None, (1024,)), ((20, 10), 50, None, (32, 32))]:
+        chunks = chunk_shape(shape, points, order, tile)
+        assert all(c == n or c % t == 0 for c, n, t in zip(chunks, shape, tile))
+        assert int(np.prod(chunks)) <= max(points, int(np.prod([min(n, t) for n, t in zip(shape, tile)])))
+        seen = np.zeros(shape, dtype=int)
+        for loc in chunk_locations(shape, chunks):
+            seen[tuple(slice(a, b) for a, b in loc)] += 1
+        assert (seen == 1).all()
+    assert chunk_shape((240, 160), 1024, (1, 0), (32, 32)) == (32, 32)
 
 
 def test_chunks_follow_the_measured_cost(slow_scene_file):
@@ -477,7 +489,8 @@ def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(
     total = len(chunk_locations(shape, chunks))
     assert before <= len(done) < total
     if sizing == "fixed":
-        assert chunks == chunk_shape((240, 160), SLOW_CHUNK, (1, 0))  # omega, the fastest axis, whole
+        # chunks of whole tiles of cells (stabmap.run.cells), as many along omega, the fastest axis, as fit
+        assert chunks == chunk_shape((240, 160), SLOW_CHUNK, (1, 0), tile_shape(stabmap.load_scene(scene_file)))
 
     # Without --resume the finished work is not thrown away silently.
     assert cli.main(args + here) == 2
@@ -485,7 +498,7 @@ def test_interrupted_run_leaves_no_file_and_resume_computes_only_the_rest(
     # --resume computes exactly the missing chunks (counted at the task function itself), in this process.
     calls = []
     task = atlas.evaluate_blocks
-    monkeypatch.setattr(atlas, "evaluate_blocks", lambda scene, locs: calls.extend(locs) or task(scene, locs))
+    monkeypatch.setattr(atlas, "evaluate_blocks", lambda scene, locs, *rest: calls.extend(locs) or task(scene, locs, *rest))
     assert cli.main(args + here + ["--resume"]) == 0
     err = capsys.readouterr().err
     assert len(calls) == total - len(done)

@@ -78,14 +78,15 @@ def chunk_shape(shape: tuple[int, ...], points: int, order: tuple[int, ...] | No
     (``stabmap.run.cells``).
     """
     order = tuple(range(len(shape))) if order is None else tuple(order)
-    chunks = list(shape)
-    budget = max(1, points)
+    tile = (1,) * len(shape) if tile is None else tuple(tile)
+    # counted in tiles: a chunk of whole tiles, about ``points`` points (at least one tile)
+    ntiles = [-(-n // t) for n, t in zip(shape, tile)]
+    chunks = list(ntiles)
+    budget = max(1, points // math.prod(tile))
     for d in reversed(order):
-        chunks[d] = max(1, min(shape[d], budget))
-        if tile is not None:
-            chunks[d] = min(shape[d], -(-chunks[d] // tile[d]) * tile[d])
+        chunks[d] = max(1, min(ntiles[d], budget))
         budget = max(1, budget // chunks[d])
-    return tuple(chunks)
+    return tuple(min(n, c * t) for n, c, t in zip(shape, chunks, tile))
 
 
 def chunk_locations(shape: tuple[int, ...], chunks: tuple[int, ...]) -> list[tuple[tuple[int, int], ...]]:
