@@ -47,20 +47,23 @@ def test_the_window_between_two_scan_values_is_found_and_located():
     assert ds["omega_stable_whole"].values.tolist() == [1, 1]
 
 
+def _random_body(rng, liquid: float) -> dict:
+    """One body over the ranges of these tests, with one or two liquid modes at probability ``liquid``."""
+    body = {"m": float(rng.uniform(0.5, 2)), "A": float(rng.uniform(0.01, 0.05)), "C": float(rng.uniform(0.01, 0.08)),
+            "c": float(rng.uniform(-0.05, 0.15)), "s": float(rng.uniform(0.1, 0.3))}
+    if rng.random() < liquid:
+        L = int(rng.integers(1, 3))
+        body["fluid"] = {"E": [float(x) for x in rng.uniform(1e-4, 2e-3, L)],
+                         "kappa": [float(x) for x in rng.choice([-2.5, 1.3, 2.7, 4.5], L, replace=False)]}
+    return body
+
+
 def _scenes():
     rng = np.random.default_rng(7)
     for support in ("fixed", "free"):
         for _ in range(3):
             n = int(rng.integers(1, 4))
-            bodies = []
-            for k in range(n):
-                body = {"m": float(rng.uniform(0.5, 2)), "A": float(rng.uniform(0.01, 0.05)), "C": float(rng.uniform(0.01, 0.08)),
-                        "c": float(rng.uniform(-0.05, 0.15)), "s": float(rng.uniform(0.1, 0.3))}
-                if rng.random() < 0.7:
-                    L = int(rng.integers(1, 3))
-                    body["fluid"] = {"E": [float(x) for x in rng.uniform(1e-4, 2e-3, L)],
-                                     "kappa": [float(x) for x in rng.choice([-2.5, 1.3, 2.7, 4.5], L, replace=False)]}
-                bodies.append(body)
+            bodies = [_random_body(rng, 0.7) for _ in range(n)]
             scene = {"support": support, "bodies": bodies, "joints": [float(x) for x in rng.uniform(0, 20, n - 1)]}
             if support == "fixed":
                 scene["g"] = 9.81
@@ -248,15 +251,7 @@ def _fixed_chains():
     """Fixed chains n = 1..3, liquid modes in most bodies (as ``_scenes``)."""
     rng = np.random.default_rng(11)
     for n in (1, 2, 2, 3, 3):
-        bodies = []
-        for _ in range(n):
-            body = {"m": float(rng.uniform(0.5, 2)), "A": float(rng.uniform(0.01, 0.05)), "C": float(rng.uniform(0.01, 0.08)),
-                    "c": float(rng.uniform(-0.05, 0.15)), "s": float(rng.uniform(0.1, 0.3))}
-            if rng.random() < 0.8:
-                L = int(rng.integers(1, 3))
-                body["fluid"] = {"E": [float(x) for x in rng.uniform(1e-4, 2e-3, L)],
-                                 "kappa": [float(x) for x in rng.choice([-2.5, 1.3, 2.7, 4.5], L, replace=False)]}
-            bodies.append(body)
+        bodies = [_random_body(rng, 0.8) for _ in range(n)]
         yield {"support": "fixed", "g": 9.81, "omega": float(rng.uniform(5, 60)), "bodies": bodies,
                "joints": [float(x) for x in rng.uniform(0, 20, n - 1)]}, rng
 

@@ -17,7 +17,7 @@ import xarray as xr
 from .. import systems
 from ..errors import StabmapError
 from ..scene.grid import Axis
-from .query import check_axis, fixed_coords, grid_axes, select, selection_text, stable_system
+from .query import check_axis, fixed_coords, fixed_names, grid_axes, select, selection_text, stable_system
 
 RTOL = 1e-10
 
@@ -48,7 +48,7 @@ def _attrs(ds, crit, along: str, axes, kind: str, label, system) -> dict:
         "title": ds.attrs.get("title", ""), "stabmap_query": kind, "label": label.name, "label_symbol": system.label_symbol,
         "label_fill": label.fill, "along": along, "along_units": units, "along_range": [float(x.min()), float(x.max())],
         "along_grid_values": int(x.size), "selection": selection_text(axes),
-        "fixed_axes": " ".join(a.name for a in axes.values() if a.fixed), "located": 1, "n_undecided": gaps,
+        "fixed_axes": fixed_names(axes), "located": 1, "n_undecided": gaps,
         "located_by": f"located to {RTOL:g} relative by critical values of the atlas's scene (docs/critical.md)",
     }
 

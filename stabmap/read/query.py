@@ -259,7 +259,7 @@ def _contiguous(index: np.ndarray) -> np.ndarray | slice:
     return index
 
 
-def _fixed_names(axes: dict[str, AxisSelection]) -> str:
+def fixed_names(axes: dict[str, AxisSelection]) -> str:
     """The axes a number fixed, space-separated (a netCDF-safe string attribute)."""
     return " ".join(a.name for a in axes.values() if a.fixed)
 
@@ -472,7 +472,7 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
         "n_lines_with_boundary": int(np.unique(line).size),
         "along_grid_values": int(x.size),
         "selection": selection_text(axes),
-        "fixed_axes": _fixed_names(axes),
+        "fixed_axes": fixed_names(axes),
         "located_by": located.strip(),
         "comment": (
             f"Each change of {lab} lies somewhere between boundary_lower and boundary_upper, two "
@@ -573,7 +573,7 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
         "along_range": [float(x.min()), float(x.max())],
         "along_grid_values": int(x.size),
         "selection": selection_text(axes),
-        "fixed_axes": _fixed_names(axes),
+        "fixed_axes": fixed_names(axes),
         "comment": (
             f"smallest_stable is a grid value of {along} proved (or, where inferred is true, inferred) stable, and "
             f"unstable_below the grid value just below it; the threshold lies between them and is not located more "

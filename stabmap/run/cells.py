@@ -86,15 +86,16 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
 
     lo, hi = chunk.tiles()
     while lo.shape[0] and chunk.provable:
-        got, proved, tried = chunk.prove(lo, hi)
+        tile = chunk.tile_of(lo)
+        got, proved, tried = chunk.prove(lo, hi, tile)
         for b in np.flatnonzero(proved):
             where = tuple(slice(a, z) for a, z in zip(lo[b], hi[b]))
             label[where], cell[where], known[where] = got[b], WHOLE_CELL, True
         one = np.all(hi - lo == 1, axis=1)
         failed_cell[tuple(lo[one & tried & ~proved].T)] = True
         small = np.prod(hi - lo, axis=1) <= PAYS_CELLS
-        chunk.stop(chunk.tile_of(lo), tried, proved, small)
-        go = ~proved & ~one & ~chunk.stopped[chunk.tile_of(lo)]
+        chunk.stop(tile, tried, proved, small)
+        go = ~proved & ~one & ~chunk.stopped[tile]
         lo, hi = _halves(lo[go], hi[go])
 
     if known.any():
@@ -192,11 +193,11 @@ class _Chunk:
         """Grid-axis values of the nodes ``index`` (rows of chunk indices)."""
         return {name: v[index[:, d]] for d, (name, v) in enumerate(zip(self.names, self.nodes))}
 
-    def prove(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(label, proved, tried) of the boxes of cells [lo, hi) (chunk indices per axis), each tried while its
-        tile's budget lasts (in the given order within a tile)."""
+    def prove(self, lo: np.ndarray, hi: np.ndarray, tile: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(label, proved, tried) of the boxes of cells [lo, hi) (chunk indices per axis) in the tiles ``tile``
+        (``tile_of(lo)``), each tried while its tile's budget lasts (in the given order within a tile)."""
         return self._prove({n: e[lo[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))},
-                           {n: e[hi[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))}, self.tile_of(lo))
+                           {n: e[hi[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))}, tile)
 
     def _prove(self, lower: dict, upper: dict, tile: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         npts = tile.size
