@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from . import certify, dd, pencil
+from .boxcount import middle
 from .charpoly import allocate, block_det, charpoly_point, diagonal_blocks, matrix_box, matrix_point, same_structure
-from .count import allocate_count, count_box, count_nodes, count_point
+from .count import allocate_count, count_box, count_nodes, count_point, fails_at_nodes
 from .options import kernel
 from .status import DECIDED_FLOAT, DECIDED_INCLUSION, UNDECIDED, ZERO_POLYNOMIAL
 
@@ -206,7 +207,7 @@ def _box_ok(body, rb):
 
 @kernel
 def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, parent, at, rat, t, t_lo, t_hi, t2, t2_lo, t2_hi, spin,
-                    out_nc, out_status):
+                    out_nc, out_status, out_split):
     """N_c proved for every point of each of a block of boxes along whose one or two main parameters p is a polynomial.
 
     Box p moves t over [t_lo[p], t_hi[p]] and t2 over [t2_lo[p], t2_hi[p]] (its other parameters within their
@@ -219,9 +220,10 @@ def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, p
     (``charpoly.matrix_box``), so its inputs are the model's at u_i with no rounding radius.  A float product
     formed outside would carry a radius of one rounding at every node, which the near-repeated roots of identical
     bodies do not survive (docs/certification.md, section 6).  The coefficients are enclosed at each node as
-    narrowly as at a point, and
-    ``count_nodes`` counts over the whole box (docs/certification.md, section 6).  Outputs as for ``box_block``;
-    more than ``LAPLACE_MAX`` bodies: UNDECIDED.  ValueError unless the node axis has N1 N2 entries.
+    narrowly as at a point, and ``count_nodes`` counts over the whole box (docs/certification.md, section 6).
+    Outputs as for ``box_block``, and ``out_split`` (int8[npts]): for a box left UNDECIDED, 1 or 2 if it is best
+    cut across t1 or t2 alone (``count.fails_at_nodes``), else 0.  More than ``LAPLACE_MAX`` bodies: UNDECIDED.
+    ValueError unless the node axis has N1 N2 entries.
     """
     npts, N, n = body.shape[0], body.shape[1], body.shape[2]
     N1, N2 = t.shape[1], t2.shape[1]
@@ -236,8 +238,10 @@ def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, p
     Xn = np.empty((N, degree + 1, 3))
     F = np.empty((4, N, 3))
     G = np.empty((N1, 3))
+    probe = np.empty(5, np.int64)
+    done = np.empty(N, np.bool_)
     for p in range(npts):
-        out_nc[p], out_status[p] = -1, UNDECIDED
+        out_nc[p], out_status[p], out_split[p] = -1, UNDECIDED, 0
         ok = laplace and _nodes_ok(t[p], t_lo[p], t_hi[p]) and _nodes_ok(t2[p], t2_lo[p], t2_hi[p])
         ok = ok and (not spin or t_lo[p] > 0.0)  # the nodes lie in [t_lo, t_hi]
         for k in range(N):
@@ -245,12 +249,38 @@ def nodes_box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, p
         if not ok:
             continue
         grid = (N1, t[p], *_ball(t_lo[p], t_hi[p]), N2, t2[p], *_ball(t2_lo[p], t2_hi[p]))
+        # The middle and the corner nodes first: a box whose roots cross a separator, or move too far to be
+        # enclosed, is left unproved there, at a fifth of the cost of all its nodes (``fails_at_nodes``).
+        probe[0], probe[1:] = middle(grid), corners(N1, N2)
+        done[:] = False
+        for k in probe:
+            if not done[k]:
+                _node(p, k, N2, spin, t, body, rbody, joint, rjoint, at, rat, g, rg, E, kappa, nmodes, parent, free, ws, rowdeg, n, C)
+                done[k] = True
+        low, top = -1, -1
+        if not np.all(done):
+            fails, low, top, out_split[p] = fails_at_nodes(C, probe, grid, cs, Xn)
+            if fails:
+                continue
         for k in range(N):
-            u = t[p, k // N2] if spin else 1.0
-            matrix_box(body[p, k], rbody[p, k], joint[p, k], rjoint[p, k], at[p, k], rat[p, k], g[p, k], rg[p, k], E[p], kappa[p], nmodes, parent,
-                       free, ws, u)
-            block_det(ws, rowdeg, 0, n, C[k])
-        out_nc[p], out_status[p] = count_nodes(C, grid, cs, Xn, F, G)
+            if not done[k]:
+                _node(p, k, N2, spin, t, body, rbody, joint, rjoint, at, rat, g, rg, E, kappa, nmodes, parent, free, ws, rowdeg, n, C)
+        out_nc[p], out_status[p] = count_nodes(C, grid, cs, Xn, F, G, low, top)
+
+
+@kernel
+def corners(N1, N2):
+    """The nodes nearest the box's corners: the first and last along each axis (node i N2 + j)."""
+    return np.array([0, N2 - 1, (N1 - 1) * N2, N1 * N2 - 1], dtype=np.int64)
+
+
+@kernel
+def _node(p, k, N2, spin, t, body, rbody, joint, rjoint, at, rat, g, rg, E, kappa, nmodes, parent, free, ws, rowdeg, n, C):
+    """C[k]: p enclosed at node k of box p (``nodes_box_block``)."""
+    u = t[p, k // N2] if spin else 1.0
+    matrix_box(body[p, k], rbody[p, k], joint[p, k], rjoint[p, k], at[p, k], rat[p, k], g[p, k], rg[p, k], E[p], kappa[p], nmodes, parent,
+               free, ws, u)
+    block_det(ws, rowdeg, 0, n, C[k])
 
 
 @kernel

@@ -7,12 +7,15 @@ import math
 import numpy as np
 
 from . import dd
-from .boxcount import count_complex_pairs_box, middle, over_grid
+from .boxcount import count_complex_pairs_box, middle, over_grid, separators_spread
 from .inclusion import count_complex_pairs_inclusion
 from .options import kernel
 from .scaling import nonzero_span, rescale, rescale_by, root_scale
 from .status import DECIDED_INCLUSION, UNDECIDED, ZERO_POLYNOMIAL
 from .sturm import count_complex_pairs
+
+
+SPLIT = 4.0  # a box whose probed values move this many times more along one axis than the other is cut across it alone
 
 
 @kernel
@@ -84,7 +87,7 @@ def count_box(c, ws):
 
 
 @kernel
-def count_nodes(C, grid, ws, Xn, F, G):
+def count_nodes(C, grid, ws, Xn, F, G, low0=-1, top0=-1):
     """(N_c, status) of every polynomial of a box whose coefficients are polynomials of degree < N1 in t1 and < N2
     in t2, enclosed at the N = N1 N2 nodes of ``grid`` in C[:N] (``boxcount``, "Polynomial in one parameter" and
     "in two parameters").
@@ -92,7 +95,8 @@ def count_nodes(C, grid, ws, Xn, F, G):
     ws from ``allocate_count``; Xn (N, deg + 1, 3), F (4, N, 3) and G (N1, 3) are scratch.  Coefficients that are
     exact zeros at every node are zero on the whole box (a polynomial of degree < N1 in t1 and < N2 in t2 that
     vanishes on the grid: each row's interpolant is zero, then each column's), so the exact zero roots and the
-    degree are the box's.
+    degree are the box's.  (low0, top0): the span ``fails_at_nodes`` left root approximations for; reused if it is
+    the box's.
     """
     W, X, a, z, R, group, flags = ws
     N = grid[0] * grid[4]
@@ -118,4 +122,43 @@ def count_nodes(C, grid, ws, Xn, F, G):
     for k in range(N):
         if not rescale_by(Xn[k], d, shift, e):
             return -1, UNDECIDED
-    return count_complex_pairs_box(Xn, grid, d, a, z, R, group[:d], flags, F, G)
+    return count_complex_pairs_box(Xn, grid, d, a, z, R, group[:d], flags, F, G, low == low0 and top == top0)
+
+
+@kernel
+def fails_at_nodes(C, probe, grid, ws, Xn):
+    """True if ``count_nodes`` would, or would nearly always, return UNDECIDED, from the nodes ``probe`` alone (C[k]
+    computed for k in probe, the grid's middle node among them).  Would: two of them differ in proved sign at a
+    separator of the count, or one is not proved nonzero there; the enclosure over the box holds every node's
+    value, so it holds 0.  Nearly always: their values at a separator spread by more than SPREAD times the middle
+    node's (``boxcount.separators_spread``).
+
+    A screen, never a proof: True only leaves the box unproved (the caller splits it), False proves nothing.
+    Where the probed nodes disagree on the exact zero coefficients (the box's degree needs every node) it answers
+    False.  ws, Xn as for ``count_nodes``.  Returns (that answer, low, top, split): low, top the span of the
+    coefficients whose scaled middle node's root approximations it left in ws (``count_nodes``), top = -1 if
+    none; split where it answers True: 1 if the probed values moved mostly along t1 (SPLIT times more than along
+    t2), 2 if mostly along t2, else 0: the box is best cut across that axis alone.
+    """
+    W, X, a, z, R, group, flags = ws
+    mid = middle(grid)
+    low, top = nonzero_span(C[mid])
+    if top < 0:
+        return False, -1, -1, 0
+    for k in probe:
+        lk, tk = nonzero_span(C[k])
+        if lk != low or tk != top:
+            return False, -1, -1, 0
+    d = top - low
+    if d < 2:
+        return False, -1, -1, 0
+    for k in probe:
+        Xn[k, : d + 1] = C[k, low : top + 1]
+    shift = root_scale(Xn[mid], d)
+    e = math.frexp(Xn[mid, d, 0])[1] + shift * d
+    for k in probe:
+        if not rescale_by(Xn[k], d, shift, e):
+            return False, -1, -1, 0
+    fails, along1, along2 = separators_spread(Xn, probe, mid, d, a, z, R, flags)
+    split = 1 if along1 > SPLIT * along2 else 2 if along2 > SPLIT * along1 else 0
+    return fails, low, top, split

@@ -37,7 +37,7 @@ def signatures() -> list[tuple]:
     # first axis and t2, t2_lo, t2_hi of the second (one node at 0 for a box along one axis), and whether t is u
     b4, j3, g2, a3 = body[:, None], joint[:, None], g[:, None], at[:, None]
     nodes = (b4, b4.copy(), j3, j3.copy(), g2, g2.copy(), E, kappa, nmodes, False, parent, a3, a3.copy(), g2.copy(), g.copy(), g.copy(),
-             g2.copy(), g.copy(), g.copy(), False) + out
+             g2.copy(), g.copy(), g.copy(), False) + out + (np.empty(npts, np.int8),)
     return [(decide_block, tuple(numba.typeof(a) for a in args)), (box_block, tuple(numba.typeof(a) for a in box)),
             (nodes_box_block, tuple(numba.typeof(a) for a in nodes))]
 

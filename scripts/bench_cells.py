@@ -84,11 +84,12 @@ class Tally:
         tally = self
 
         def counted_prove(chunk, lower, upper, tile):
-            label, proved, tried = prove(chunk, lower, upper, tile)
+            out = prove(chunk, lower, upper, tile)
+            _, proved, tried, _ = out
             with tally.lock:
                 tally.counts["boxes"] += int(tried.sum())
                 tally.counts["proved boxes"] += int(proved.sum())
-            return label, proved, tried
+            return out
 
         def counted_classify(chunk, nodes, label, sub_boxes):
             with tally.lock:

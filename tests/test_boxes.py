@@ -16,7 +16,7 @@ from stabmap.systems.gyroscopes.decide import prove_boxes
 from stabmap.kernels import DECIDED_INCLUSION, UNDECIDED, ZERO_POLYNOMIAL, box_block, nodes_box_block
 from stabmap.systems.gyroscopes.boxes import BoxArrays, box_arrays, box_axes, boxes
 from stabmap.systems.gyroscopes.decide import kernel_args
-from stabmap.systems.gyroscopes.nodes import spin_scaled
+from stabmap.systems.gyroscopes.nodes import degree, spin_scaled
 from stabmap.systems.gyroscopes.points import point_arrays
 from stabmap.systems.gyroscopes.scene import from_dict
 from systems import EXACT_BOUNDARIES, WINDOW
@@ -175,8 +175,16 @@ def test_each_box_goes_to_its_narrowest_enclosure_and_holds_its_points():
             (kind,) = kinds
             N1, N2 = part.t.shape[1], part.t2.shape[1]
             assert part.body.shape[1] == N1 * N2
-            assert (N1, N2) == {"spin-scaled": (n + 1, 1), "one axis": (2 * n + 1, 1), "spin and axis": (n + 1, 2 * n + 1),
-                                "two axes": (2 * n + 1, 2 * n + 1)}[kind]
+            # t and t2 are the axes the boxes move, each at its degree bound's nodes (nodes.degree)
+            for j, i in enumerate(rows):
+                named = {part.axis1[j]} | ({part.axis2[j]} if part.axis2 is not None else set())
+                assert named == {k for k in axes if lower[k][i] != upper[k][i]} or kind == "spin-scaled"
+            def nodes(names):
+                return degree(scene, names[0]) + 1
+
+            assert (N1, N2) == {"spin-scaled": lambda: (n + 1, 1), "one axis": lambda: (nodes(part.axis1), 1),
+                                "spin and axis": lambda: (n + 1, nodes(part.axis2)),
+                                "two axes": lambda: (nodes(part.axis1), nodes(part.axis2))}[kind]()
             for t, lo, hi in ((part.t, part.t_lo, part.t_hi), (part.t2, part.t2_lo, part.t2_hi)):
                 assert np.all(np.diff(t, axis=1) < 0) and np.all((lo[:, None] <= t) & (t <= hi[:, None]))
             if N2 == 1:
@@ -293,7 +301,7 @@ def test_two_axis_boxes_proved_on_the_tensor_grid_hold_their_label_in_exact_arit
             (kind,) = kinds
             # every box goes to the tensor grid
             parts = boxes(scene, lower, upper)
-            assert len(parts) == 1 and parts[0][1].t2.shape[1] == 2 * n + 1, pair
+            assert len(parts) == 1 and parts[0][1].t2.shape[1] == degree(scene, pair[-1]) + 1, pair
             nc, proved = prove_boxes(scene, lower, upper)
             t = rng.random((6, 2))
             t[:4] = [(0, 0), (0, 1), (1, 0), (1, 1)]  # the four corners, then interior points
@@ -325,7 +333,7 @@ def test_the_tensor_grid_proves_boxes_that_the_plain_and_spin_scaled_enclosures_
     # today's spin-scaled enclosure with K_1 as a radius at every node
     radius = spin_scaled(box_arrays(scene, lower, upper), lower["omega"], upper["omega"])
     rnc, rst = np.empty(40, np.int16), np.empty(40, np.int8)
-    nodes_box_block(*kernel_args(radius), rnc, rst)
+    nodes_box_block(*kernel_args(radius), rnc, rst, np.empty_like(rst))
     assert proved.mean() >= 0.75 and not plain.any() and np.all((rst == UNDECIDED) | (rst == ZERO_POLYNOMIAL)), (proved.mean(), plain.mean())
     for b in np.flatnonzero(proved)[:10]:
         corners = {"omega": np.array([omega[i[b]], omega[i[b] + 1]] * 2), "K_1": np.repeat([K[j[b]], K[j[b] + 1]], 2)}
@@ -362,17 +370,21 @@ def test_a_two_axis_box_across_a_boundary_is_never_proved():
             assert not proved.any(), (E, other, np.flatnonzero(proved))
 
 
-@pytest.mark.parametrize("symbol", ["u", "m_1", "m_2", "A_2", "C_1", "c_1", "c_2", "s_1", "K_1", "g", "c", "m"])
-def test_p_has_degree_at_most_2n_in_each_mechanical_parameter_and_n_in_u(symbol):
-    # The premise of the node counts (nodes.py): checked exactly on a fixed chain of three bodies with liquid, the
-    # other parameters at dyadic values so that every input (u K included) is exact.  D + 2 equally spaced samples of
-    # a polynomial of degree <= D have a zero (D + 1)-th difference.
-    system = {"support": "fixed", "g": 9.75, "joints": [20.0, 12.5], "bodies": [
+@pytest.mark.parametrize("support, symbol", [("fixed", s) for s in ("u", "m_1", "m_2", "A_2", "C_1", "c_1", "c_2", "s_1", "K_0", "K_1", "g", "c", "m", "A", "K")]
+                         + [("free", s) for s in ("u", "A_2", "C_1", "K_1", "c_1")])
+def test_p_has_at_most_the_degree_its_nodes_assume_in_each_mechanical_parameter_and_n_in_u(support, symbol):
+    # The premise of the node counts (nodes.py, ``degree``): checked exactly on a chain of three bodies with liquid,
+    # the other parameters at dyadic values so that every input (u K included) is exact.  D + 2 equally spaced
+    # samples of a polynomial of degree <= D have a zero (D + 1)-th difference.
+    system = {"support": support, "g": 9.75, "joints": [20.0, 12.5], "bodies": [
         {"m": 1.0, "A": 0.03125, "C": 0.0625, "c": 0.125, "s": 0.25, "fluid": {"E": [1 / 512], "kappa": [1.25]}},
         {"m": 0.75, "A": 0.015625, "C": 0.046875, "c": 0.0625, "s": 0.1875, "fluid": {"E": [1 / 1024, 1 / 2048], "kappa": [2.5, -2.5]}},
         {"m": 0.5, "A": 0.0234375, "C": 0.03125, "c": 0.09375}]}
+    if support == "fixed":
+        system["K_0"] = 40.0
     n = 3
-    D = n if symbol == "u" else 2 * n
+    D = n if symbol == "u" else degree(from_dict(dict(system, omega=3.0)), symbol)
+    assert D == {"u": n, "c_1": 2 * n, "c_2": 2 * n, "s_1": 2 * n, "c": 2 * n, "A_2": 1, "C_1": 1, "K_0": 1, "K_1": 1}.get(symbol, n)
     x = 0.5 + np.arange(D + 2) / 16.0
     if symbol == "u":
         scene = from_dict(dict(system, omega=1.0))
@@ -382,7 +394,7 @@ def test_p_has_degree_at_most_2n_in_each_mechanical_parameter_and_n_in_u(symbol)
     else:
         scene = from_dict(dict(system, omega=3.0, grid={symbol: {"values": [x[0]]}}))
         pts = point_arrays(scene, {symbol: x})
-    polys = [exact.char_poly(pts.body[i], pts.joint[i], pts.g[i], pts.E[i], pts.kappa[i], pts.nmodes, False, pts.parent, pts.at[i])
+    polys = [exact.char_poly(pts.body[i], pts.joint[i], pts.g[i], pts.E[i], pts.kappa[i], pts.nmodes, pts.free, pts.parent, pts.at[i])
              for i in range(x.size)]
     width = max(p.degree() for p in polys) + 1
     coeffs = [[p.coeffs()[k] if k <= p.degree() else 0 for k in range(width)] for p in polys]
@@ -419,21 +431,21 @@ def test_the_kernel_refuses_a_node_axis_that_is_not_the_grid_and_nodes_out_of_or
     (rows, part), = boxes(scene, lower, upper)
     args = list(kernel_args(part))
     nc, st = np.empty(2, np.int16), np.empty(2, np.int8)
-    nodes_box_block(*args, nc, st)
+    nodes_box_block(*args, nc, st, np.empty_like(st))
     assert (st == DECIDED_INCLUSION).all()
     short = np.ascontiguousarray(args[16][:, 1:])  # t2 one node short of the node axis
     with pytest.raises(ValueError, match="t.shape"):
-        nodes_box_block(*args[:16], short, *args[17:], nc, st)
+        nodes_box_block(*args[:16], short, *args[17:], nc, st, np.empty_like(st))
     # a repeated node of the second axis (its divided differences would divide by zero): undecided, not a proof
     bad = args[16].copy()
     bad[0, 1] = bad[0, 0]
-    nodes_box_block(*args[:16], bad, *args[17:], nc, st)
+    nodes_box_block(*args[:16], bad, *args[17:], nc, st, np.empty_like(st))
     assert st.tolist() == [UNDECIDED, DECIDED_INCLUSION]
     # spin-scaled nodes (the stiffness times each u_i) are refused unless the interval of u is positive
     assert args[19] is True
     t_lo = args[14].copy()
     t_lo[1] = 0.0
-    nodes_box_block(*args[:14], t_lo, *args[15:], nc, st)
+    nodes_box_block(*args[:14], t_lo, *args[15:], nc, st, np.empty_like(st))
     assert st.tolist() == [DECIDED_INCLUSION, UNDECIDED]
 
 

@@ -208,3 +208,36 @@ def test_located_boundaries_and_smallest_stable_find_the_window_the_grid_misses(
     assert "3 changes of N_c on 1 of 1 line, each located to 1e-10 relative" in out and "the list is complete" in out
     assert main(["query", str(path), "omega=12", "--locate"]) == 2
     assert "--locate applies to --boundaries and --smallest-stable" in capsys.readouterr().err
+
+
+def test_a_box_is_halved_across_the_axis_its_proof_names_alone():
+    from stabmap.run.cells import _halves
+
+    lo, hi = np.array([[0, 0], [0, 0], [0, 0]]), np.array([[4, 4], [4, 4], [1, 4]])
+    along = np.array([[True, False], [False, False], [True, False]])  # omega alone; none; an axis one cell wide
+    got = sorted(map(tuple, np.hstack(_halves(lo, hi, along))))
+    assert got == sorted([(0, 0, 2, 4), (2, 0, 4, 4),  # across the first axis alone
+                          (0, 0, 2, 2), (0, 2, 2, 4), (2, 0, 4, 2), (2, 2, 4, 4),  # no axis named: both
+                          (0, 0, 1, 2), (0, 2, 1, 4)])  # the named axis cannot be cut: the other
+
+
+def test_low_spin_boxes_of_identical_cavities_fail_and_are_cut_across_the_spin_then_prove():
+    # paper-n3-fixed below omega = 3 on a 4000 x 4000 grid: u = 1/omega^2 moves the clustered liquid roots fast and
+    # m_2 barely, so 16 x 16-cell boxes fail and their corners say so; boxes one cell wide in omega then prove, and
+    # their labels hold in exact arithmetic.
+    scene = stabmap.example("paper-n3-fixed")
+    system = stabmap.systems.of(scene)
+    rng = np.random.default_rng(11)
+    w, m = rng.uniform(1.0, 3.0, 24), np.exp(rng.uniform(np.log(0.1), np.log(10.0), 24))
+    dw, dm = 199.0 / 4000, np.log(100.0) / 4000
+    label, proved, cut = system.prove_and_cut_boxes(scene, {"omega": w, "m_2": m}, {"omega": w + 16 * dw, "m_2": m * np.exp(16 * dm)})
+    assert not proved.any()
+    across = cut["omega"] & ~cut["m_2"]
+    assert across.mean() >= 0.75, across
+    thin = {"omega": w + dw / 2, "m_2": m * np.exp(16 * dm)}
+    label, proved, _ = system.prove_and_cut_boxes(scene, {"omega": w, "m_2": m}, thin)
+    assert proved.mean() >= 0.75, proved
+    for i in np.flatnonzero(proved)[:6]:
+        t = rng.random(2)
+        pts = point_arrays(scene, {"omega": np.array([w[i] + t[0] * dw / 2]), "m_2": np.array([m[i] * np.exp(t[1] * 16 * dm)])})
+        assert exact.decide_points(*pts.kernel_args(), np.arange(1))[0] == label[i]

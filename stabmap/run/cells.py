@@ -10,7 +10,9 @@ atlas is decided here (``decide_chunk``):
    ``System.prove_boxes``.  A proved box gives its label to every node inside it and ``whole_cell`` to every
    cell: no node of it is computed.
 2. A box that does not prove is split in two along each of its long axes (those with at least half as many cells
-   as its longest), and its parts are tried in the next round, down to single cells.  The rounds run all the
+   as its longest), or along the one axis the system names (``System.prove_and_cut_boxes``: for gyroscopes, the
+   axis along which its corners' polynomials moved most), and its parts are tried in the next round, down to
+   single cells.  The rounds run all the
    chunk's boxes of one round in one call of the kernels.
 3. A single cell that does not prove has its node computed (``System.evaluate``), and, where a neighbouring
    node of its tile has another label, its corners: a corner with another label proves a change of label in the cell
@@ -87,7 +89,7 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
     lo, hi = chunk.tiles()
     while lo.shape[0] and chunk.provable:
         tile = chunk.tile_of(lo)
-        got, proved, tried = chunk.prove(lo, hi, tile)
+        got, proved, tried, along = chunk.prove(lo, hi, tile)
         for b in np.flatnonzero(proved):
             where = tuple(slice(a, z) for a, z in zip(lo[b], hi[b]))
             label[where], cell[where], known[where] = got[b], WHOLE_CELL, True
@@ -96,7 +98,7 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
         small = np.prod(hi - lo, axis=1) <= PAYS_CELLS
         chunk.stop(tile, tried, proved, small)
         go = ~proved & ~one & ~chunk.stopped[tile]
-        lo, hi = _halves(lo[go], hi[go])
+        lo, hi = _halves(lo[go], hi[go], along[go])
 
     if known.any():
         for k, v in system.proved_box(label[known]).items():
@@ -131,15 +133,21 @@ def _beside_change(label: np.ndarray, nodes: np.ndarray, tile: np.ndarray) -> np
     return out
 
 
-def _halves(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Boxes (rows of index ranges [lo, hi)) cut in two along their long axes: those holding at least half as many
-    cells as the longest (a chunk's long, thin boxes become square before they are cut across)."""
+def _halves(lo: np.ndarray, hi: np.ndarray, along: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Boxes (rows of index ranges [lo, hi)) cut in two along their long axes among those ``along`` allows (rows
+    of bools; all if None, or if it allows none of more than one cell): those holding at least half as many cells
+    as the longest (a chunk's long, thin boxes become square before they are cut across)."""
     if lo.shape[0] == 0:
         return lo, hi
     d = lo.shape[1]
     mid = (lo + hi) // 2
     size = hi - lo
-    split = (size > 1) & (2 * size >= size.max(axis=1, keepdims=True))
+    if along is None:
+        along = np.ones(size.shape, dtype=bool)
+    along = along & (size > 1)
+    along[~along.any(axis=1)] = True
+    size_along = np.where(along, size, 0)
+    split = along & (size > 1) & (2 * size >= size_along.max(axis=1, keepdims=True))
     out_lo, out_hi = [], []
     for side in itertools.product((0, 1), repeat=d):
         side = np.array(side, dtype=bool)
@@ -193,18 +201,20 @@ class _Chunk:
         """Grid-axis values of the nodes ``index`` (rows of chunk indices)."""
         return {name: v[index[:, d]] for d, (name, v) in enumerate(zip(self.names, self.nodes))}
 
-    def prove(self, lo: np.ndarray, hi: np.ndarray, tile: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(label, proved, tried) of the boxes of cells [lo, hi) (chunk indices per axis) in the tiles ``tile``
-        (``tile_of(lo)``), each tried while its tile's budget lasts (in the given order within a tile)."""
+    def prove(self, lo: np.ndarray, hi: np.ndarray, tile: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(label, proved, tried, along) of the boxes of cells [lo, hi) (chunk indices per axis) in the tiles ``tile``
+        (``tile_of(lo)``), each tried while its tile's budget lasts (in the given order within a tile); along (boxes,
+        axes): the axes a box not proved is worth cutting along (``System.prove_and_cut_boxes``)."""
         return self._prove({n: e[lo[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))},
                            {n: e[hi[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))}, tile)
 
-    def _prove(self, lower: dict, upper: dict, tile: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _prove(self, lower: dict, upper: dict, tile: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         npts = tile.size
         label, proved = np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=bool)
         tried = np.zeros(npts, dtype=bool)
+        along = np.ones((npts, len(self.names)), dtype=bool)
         if not self.provable or npts == 0:
-            return label, proved, tried
+            return label, proved, tried, along
         # the k-th box of a tile (in order) is tried if the tile can still pay for k boxes
         order = np.argsort(tile, kind="stable")
         first = np.searchsorted(tile[order], tile[order], side="left")
@@ -214,10 +224,12 @@ class _Chunk:
         self.budget -= self.cost * np.bincount(tile[tried], minlength=self.budget.size)
         rows = np.flatnonzero(tried)
         if rows.size:
-            got, ok = self.system.prove_boxes(self.scene, {k: v[rows] for k, v in lower.items()},
-                                              {k: v[rows] for k, v in upper.items()})
+            got, ok, cut = self.system.prove_and_cut_boxes(self.scene, {k: v[rows] for k, v in lower.items()},
+                                                           {k: v[rows] for k, v in upper.items()})
             label[rows], proved[rows] = got, ok
-        return label, proved, tried
+            for d, name in enumerate(self.names):
+                along[rows, d] = cut[name]
+        return label, proved, tried, along
 
     def classify(self, nodes: np.ndarray, label: np.ndarray, sub_boxes: np.ndarray) -> np.ndarray:
         """The ``cell`` flag of the cells of ``nodes`` (computed; ``label`` holds the chunk's labels), none proved whole.
@@ -249,7 +261,7 @@ class _Chunk:
         for _ in range(SUB_ROUNDS):
             if owner.size == 0:
                 break
-            got, proved, tried = self._prove(lower, upper, tile[owner])
+            got, proved, tried, _ = self._prove(lower, upper, tile[owner])
             other = proved & (got != node_label[owner])
             cell[owner[other]] = CONTAINS_CHANGE
             failed = ~proved

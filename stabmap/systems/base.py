@@ -182,6 +182,12 @@ class System:
         """
         return None
 
+    def prove_and_cut_boxes(self, scene: SceneBase, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+        """``prove_boxes``, and for each box not proved the grid axes worth cutting it along: (label, proved, cut),
+        ``cut[name][i]`` for each axis named (``stabmap.run.cells`` halves box i along those).  Default: every axis."""
+        label, proved = self.prove_boxes(scene, lower, upper)
+        return label, proved, {k: np.ones(np.shape(label), dtype=bool) for k in lower}
+
     def box_cost(self, scene: SceneBase) -> float:
         """What one box proof of a box along this scene's grid axes costs, in proofs of one point (default 1):
         the budget of box proofs in an atlas (``stabmap.run.cells``)."""

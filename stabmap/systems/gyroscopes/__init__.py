@@ -118,6 +118,11 @@ class Gyroscopes(System):
 
         return prove_boxes(scene, lower, upper)
 
+    def prove_and_cut_boxes(self, scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+        from .decide import prove_boxes
+
+        return prove_boxes(scene, lower, upper, cut=True)
+
     def proved_box(self, label: np.ndarray) -> dict[str, np.ndarray]:
         return {"stability": stability_from_pairs(label), "decided_by": np.full(np.shape(label), BY_BOX, dtype=np.int8)}
 

@@ -7,11 +7,11 @@ the narrowest first (docs/certification.md, section 6; the degree bounds in ``no
   grid axis, which the box moves, not through 0, and the box moves one more axis whose kernel inputs are copies
   of its value (a mass, inertia, length, stiffness or g).  With lambda = omega mu, p(omega mu; omega) =
   omega^D p_1(mu; u), u = 1 / omega^2, p_1 the polynomial at unit spin with the stiffness (joints and gravity)
-  times u: the same real roots.  p_1 has degree <= n in u and <= 2n in the axis: the tensor grid of (n + 1) x
-  (2n + 1) nodes.
-- **two mechanical axes**: (2n + 1) x (2n + 1) nodes.
+  times u: the same real roots.  p_1 has degree <= n in u and at most ``nodes.degree`` in the axis (2n in a
+  length, n in a mass or g, 1 in one body's A or C or one joint's K): the tensor grid of their nodes.
+- **two mechanical axes**: the tensor grid of both axes' nodes.
 - **spin-scaled**: the spin as above, other moving axes within their radii: n + 1 nodes in u.
-- **one mechanical axis**: 2n + 1 nodes.  Not a mass of a free system (it divides by the total mass).
+- **one mechanical axis**: its degree + 1 nodes.  Not a mass of a free system (it divides by the total mass).
 - **plain** (``kernels.box_block``): the hull of the corners' inputs, as intervals.
 """
 
@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .nodes import NodeBoxes, mechanical, spin_scaled
+from .nodes import NodeBoxes, degree, mechanical, spin_scaled
 from .parameters import parse_name
 from .points import PointArrays, point_arrays
 from .scene import Scene
@@ -159,10 +159,15 @@ def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarra
     plain = _plain(lo, hi)
     out = []
 
+    spin_names = np.full(npts, None, dtype=object)  # the spin axis a box moves
+    for k in lower:
+        if _is_spin(scene, k):
+            spin_names[moves[k]] = k
+
     def route(rows: np.ndarray, axes: tuple[str, ...], spin: bool) -> np.ndarray:
         """Hand the boxes among ``rows`` that move exactly ``axes`` (besides the spin) to the node path; the rest."""
         sel = rows[np.all([moves[a][rows] for a in axes], axis=0) & (others[rows] == len(axes))]
-        kept, nodes = mechanical(scene, lower, upper, lo, hi, sel, axes, spin)
+        kept, nodes = mechanical(scene, lower, upper, lo, hi, sel, axes, spin, spin_names[sel])
         if nodes is not None:
             out.append((kept, nodes))
         return np.setdiff1d(rows, kept)
@@ -172,7 +177,7 @@ def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarra
     for axis in mech:
         rest = route(rest, (axis,), True)
     if rest.size:
-        out.append((rest, spin_scaled(plain.take(rest), lo.body[rest, 0, 5], hi.body[rest, 0, 5])))
+        out.append((rest, spin_scaled(plain.take(rest), lo.body[rest, 0, 5], hi.body[rest, 0, 5], spin_names[rest])))
     rest = np.setdiff1d(np.arange(npts), spin)
     for axis in mech:
         rest = route(rest, (axis,), False)
@@ -186,12 +191,12 @@ def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarra
 
 def box_cost(scene: Scene) -> float:
     """A box proof along the scene's scanned axes, in point proofs: its enclosure's nodes (n + 1 along the spin,
-    2n + 1 along a mechanical axis, their product for two axes; plain: 1), each dearer than a point by a factor
+    ``nodes.degree`` + 1 along a mechanical axis, their product for two axes; plain: 1), each dearer than a point by a factor
     that grows with n: the box kernel expands the determinant's 2^n minors in intervals at every node, where a
     point reuses its neighbour's work or proves without coefficients.  1 + n/3 + 2^n/64, fitted to
     scripts/bench_cells.py (a box of two bodies costs about 23 points, of six about 270, of eight about 1400)."""
     n = scene.n
-    per_axis = [n + 1 if _is_spin(scene, a.name) else 2 * n + 1 if _mechanical(scene, a.name) else 1
+    per_axis = [n + 1 if _is_spin(scene, a.name) else degree(scene, a.name) + 1 if _mechanical(scene, a.name) else 1
                 for a in scene.grid if len(a.values) > 1]
     nodes = float(np.prod(per_axis)) if len(per_axis) <= 2 else 1.0
     return nodes * (1.0 + n / 3.0 + 2.0**n / 64.0)

@@ -43,11 +43,14 @@ def decide(points: PointArrays) -> tuple[np.ndarray, np.ndarray]:
     return nc, decided_by_from_status(status)
 
 
-def prove_boxes(scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+def prove_boxes(scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray], cut: bool = False):
     """(N_c int16, proved bool) of each box: N_c at every point of box i where proved[i] (``System.prove_boxes``).
+    ``cut``: also the axes each box not proved is best cut along, ``cut[name][i]`` (``System.prove_and_cut_boxes``).
 
     Each box goes to the kernel of its narrowest enclosure (``boxes.boxes``).  Boxes that span an axis outside
-    ``box_axes`` are not proved, and not tried.
+    ``box_axes`` are not proved, and not tried.  A box on the tensor grid whose probed corners moved mostly along
+    one of its two axes is cut across that one alone (``kernels.count.fails_at_nodes``); every other box along
+    every axis.
     """
     npts = len(next(iter(lower.values()))) if lower else 1
     spans = np.zeros(npts, dtype=bool)
@@ -55,15 +58,30 @@ def prove_boxes(scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray
         spans |= outside
     nc = np.full(npts, -1, dtype=np.int16)
     proved = np.zeros(npts, dtype=bool)
+    along = {k: np.ones(npts, dtype=bool) for k in lower}
     todo = np.flatnonzero(~spans)
     if todo.size == 0:
-        return nc, proved
+        return (nc, proved, along) if cut else (nc, proved)
     for rows, part in boxes(scene, {k: np.asarray(v)[todo] for k, v in lower.items()}, {k: np.asarray(v)[todo] for k, v in upper.items()}):
         count = np.empty(rows.size, dtype=np.int16)
         status = np.empty(rows.size, dtype=np.int8)
-        kernel = nodes_box_block if isinstance(part, NodeBoxes) else box_block
-        kernel(*kernel_args(part), count, status)
+        if isinstance(part, NodeBoxes):
+            split = np.empty(rows.size, dtype=np.int8)
+            nodes_box_block(*kernel_args(part), count, status, split)
+            _cut_along(along, todo[rows], split, part)
+        else:
+            box_block(*kernel_args(part), count, status)
         ok = (status != UNDECIDED) & (status != ZERO_POLYNOMIAL)
         nc[todo[rows[ok]]] = count[ok]
         proved[todo[rows[ok]]] = True
-    return nc, proved
+    return (nc, proved, along) if cut else (nc, proved)
+
+
+def _cut_along(cut: dict[str, np.ndarray], rows: np.ndarray, split: np.ndarray, part: NodeBoxes) -> None:
+    """Boxes ``rows`` whose kernel said 1 (along t) or 2 (along t2) in ``split`` are cut along that axis alone."""
+    for code, names in ((1, part.axis1), (2, part.axis2)):
+        if names is None:
+            continue
+        at = np.flatnonzero(split == code)
+        for k in cut:
+            cut[k][rows[at]] = names[at] == k

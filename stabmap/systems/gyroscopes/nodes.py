@@ -7,15 +7,20 @@ minus g (m c + at times the mass beyond) on the diagonal.  So each entry is a po
 (not a free system's: it divides by the total mass), an inertia, a stiffness or g, and <= 2 in a length; a product
 such as m g c has degree 1 in each of its factors.  The bound is per variable: an axis that sets one column of
 every body (``c``) still gives degree <= 2 per entry.  Every term of det P takes one entry from each of the n rows,
-so p has degree <= 2n in each such parameter, whatever the others are.  In the spin-scaled model (every body at
-one rate omega, u = 1 / omega^2) u multiplies K alone, so each entry is affine in u: degree <= n in u.
+so p has degree <= n in a parameter of degree <= 1 per entry, and <= 2n in a length, whatever the others are.
+A parameter that moves one row of P alone (A_k and C_k: row k of P = diag(Q) Phi T) or one rank-one term of it (a
+joint's K_a: K = S diag(K_a) S^T, so P moves by t (Q o s_a)(s_a^T T)) gives degree <= 1: det(P_0 + t e f^T) =
+det P_0 + t f^T adj(P_0) e.  In the spin-scaled model (every body at one rate omega, u = 1 / omega^2) u multiplies
+K alone, so each entry is affine in u: degree <= n in u.  ``degree`` gives the bound of each axis;
+tests/test_boxes.py checks each in exact arithmetic.
 
 Hence the node counts:
 
 - **spin-scaled**: u at n + 1 nodes, the other parameters within their radii at every node;
-- **one mechanical axis**: 2n + 1 nodes, the inputs exact at each;
-- **spin and one mechanical axis**: the tensor grid of (n + 1) nodes in u times (2n + 1) in the axis;
-- **two mechanical axes**: (2n + 1) x (2n + 1).
+- **one mechanical axis**: degree + 1 nodes (2n + 1 in a length, n + 1 in a mass or g, 2 in one body's A or C or
+  one joint's K), the inputs exact at each;
+- **spin and one mechanical axis**: the tensor grid of (n + 1) nodes in u times those of the axis;
+- **two mechanical axes**: the tensor grid of both axes' nodes.
 
 p is then of degree < N1 in the first parameter and < N2 in the second, so its tensor interpolant through the
 grid is p itself, and ``boxcount.over_grid`` encloses every value the count needs over the whole box.  A node is
@@ -29,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .parameters import parse_name
 from .points import PointArrays, point_arrays
 from .scene import Scene
 
@@ -63,6 +69,8 @@ class NodeBoxes:
     t2_lo: np.ndarray
     t2_hi: np.ndarray
     spin: bool = False
+    axis1: np.ndarray | None = None  # the grid axis of t (per box: the spin axis that moves it, for ``spin``)
+    axis2: np.ndarray | None = None  # the grid axis of t2 (None: a box along one parameter)
 
     def kernel_args(self):
         return (self.body, self.rbody, self.joint, self.rjoint, self.g, self.rg, self.E, self.kappa, self.nmodes, self.free,
@@ -94,7 +102,7 @@ def _no_second(npts: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.zeros((npts, 1)), np.zeros(npts), np.zeros(npts)
 
 
-def spin_scaled(box, w1: np.ndarray, w2: np.ndarray) -> NodeBoxes:
+def spin_scaled(box, w1: np.ndarray, w2: np.ndarray, names: np.ndarray | None = None) -> NodeBoxes:
     """The plain boxes ``box`` (``boxes.BoxArrays``) in the spin-scaled model: u = 1 / omega^2 at n + 1 nodes, the
     other parameters within their radii at every node.  omega runs between the corners' w1 and w2 (one sign).
     The stiffness is handed over at u = 1: the kernel forms its products with the nodes exactly (``spin``)."""
@@ -109,7 +117,23 @@ def spin_scaled(box, w1: np.ndarray, w2: np.ndarray) -> NodeBoxes:
     body, rbody = at_nodes(m.body), at_nodes(box.rbody)
     body[..., 5], rbody[..., 5] = 1.0, 0.0
     return NodeBoxes(body, rbody, at_nodes(m.joint), at_nodes(box.rjoint), at_nodes(m.g), at_nodes(box.rg), at_nodes(m.at),
-                     at_nodes(box.rat), m.E, m.kappa, m.nmodes, m.free, m.parent, u, u_lo, u_hi, *_no_second(u.shape[0]), spin=True)
+                     at_nodes(box.rat), m.E, m.kappa, m.nmodes, m.free, m.parent, u, u_lo, u_hi, *_no_second(u.shape[0]), spin=True,
+                     axis1=names)
+
+
+LENGTHS = {"c", "s", "at"}  # entries of P quadratic in them (M = J^T diag(m) J, J linear in the lengths)
+RANK_ONE = {"A", "C", "K"}  # one body's (one joint's): they move one row of P, or one rank-one term of it
+
+
+def degree(scene: Scene, key: str) -> int:
+    """A bound on the degree of p in the mechanical parameter ``key`` (module docstring): 2n in a length, 1 in one
+    body's A or C or one joint's K, n in the others (a mass, g, or a column or joint set for all at once)."""
+    name = parse_name(key, scene.n, scene.support)
+    if name.symbol in LENGTHS:
+        return 2 * scene.n
+    if name.kind in ("body", "joint") and name.symbol in RANK_ONE:
+        return 1
+    return scene.n
 
 
 def _copies(pts: PointArrays, lo: PointArrays, hi: PointArrays, sel: np.ndarray, grid: dict[str, np.ndarray],
@@ -136,24 +160,25 @@ def _copies(pts: PointArrays, lo: PointArrays, hi: PointArrays, sel: np.ndarray,
 
 
 def mechanical(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray], lo: PointArrays, hi: PointArrays,
-               sel: np.ndarray, axes: tuple[str, ...], spin: bool = False) -> tuple[np.ndarray, NodeBoxes | None]:
+               sel: np.ndarray, axes: tuple[str, ...], spin: bool = False, spin_names: np.ndarray | None = None
+               ) -> tuple[np.ndarray, NodeBoxes | None]:
     """Node boxes of the boxes ``sel`` that move the mechanical ``axes`` (one or two) and nothing else but, with
     ``spin``, the one spin rate of every body: those among them whose moving inputs are copies (``_copies``).
 
-    2n + 1 nodes per mechanical axis; with ``spin`` the first grid axis is u = 1 / omega^2 at n + 1 nodes (module
-    docstring).  Returns the rows kept and their boxes (None if none is kept).
+    ``degree(axis) + 1`` nodes per mechanical axis; with ``spin`` the first grid axis is u = 1 / omega^2 at n + 1
+    nodes (module docstring); ``spin_names``: the spin axis each box of ``sel`` moves.  Returns the rows kept and
+    their boxes (None if none is kept).
     """
     if sel.size == 0:
         return sel, None
-    N = 2 * scene.n + 1
     ranges = {a: (np.minimum(lower[a][sel], upper[a][sel]), np.maximum(lower[a][sel], upper[a][sel])) for a in axes}
-    nodes = {a: chebyshev(*ranges[a], N) for a in axes}
-    # the mechanical grid, the first axis slowest: node i N + j at (nodes[a][i], nodes[b][j])
+    nodes = {a: chebyshev(*ranges[a], degree(scene, a) + 1) for a in axes}
+    # the mechanical grid, the first axis slowest: node i N_b + j at (nodes[a][i], nodes[b][j])
     if len(axes) == 1:
         grid = nodes
     else:
         a, b = axes
-        grid = {a: np.repeat(nodes[a], N, axis=1), b: np.tile(nodes[b], (1, N))}
+        grid = {a: np.repeat(nodes[a], nodes[b].shape[1], axis=1), b: np.tile(nodes[b], (1, nodes[a].shape[1]))}
     count = grid[axes[0]].shape[1]
     values = {k: np.repeat(lower[k][sel], count) for k in lower}
     values.update({k: v.ravel() for k, v in grid.items()})
@@ -172,7 +197,9 @@ def mechanical(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
         second = (nodes[axes[1]][keep], ranges[axes[1]][0][keep], ranges[axes[1]][1][keep]) if len(axes) == 2 else _no_second(sel.size)
         t, t_lo, t_hi = nodes[axes[0]][keep], ranges[axes[0]][0][keep], ranges[axes[0]][1][keep]
         arrays = [a for x in (body, joint, g, at) for a in (x, np.zeros_like(x))]
-        return sel, NodeBoxes(*arrays, E, kappa, pts.nmodes, pts.free, pts.parent, t, t_lo, t_hi, *second)
+        names = [np.full(sel.size, a, dtype=object) for a in axes]
+        return sel, NodeBoxes(*arrays, E, kappa, pts.nmodes, pts.free, pts.parent, t, t_lo, t_hi, *second, axis1=names[0],
+                              axis2=names[1] if len(axes) == 2 else None)
     # spin-scaled: at node (u_i, t_j) the inputs at t_j with every spin 1 and the stiffness (joints, g) times u_i,
     # the product formed by the kernel (``spin``)
     u_lo, u_hi = _u_interval(lo.body[sel, 0, 5], hi.body[sel, 0, 5])
@@ -188,4 +215,5 @@ def mechanical(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
     (axis,) = axes
     zeros = [np.zeros_like(x) for x in (body, joint, g, at)]
     return sel, NodeBoxes(body, zeros[0], joint, zeros[1], g, zeros[2], at, zeros[3], E, kappa, pts.nmodes, pts.free,
-                          pts.parent, u, u_lo, u_hi, nodes[axis][keep], ranges[axis][0][keep], ranges[axis][1][keep], spin=True)
+                          pts.parent, u, u_lo, u_hi, nodes[axis][keep], ranges[axis][0][keep], ranges[axis][1][keep], spin=True,
+                          axis1=None if spin_names is None else spin_names[keep], axis2=np.full(sel.size, axis, dtype=object))
