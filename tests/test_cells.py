@@ -241,3 +241,21 @@ def test_low_spin_boxes_of_identical_cavities_fail_and_are_cut_across_the_spin_t
         t = rng.random(2)
         pts = point_arrays(scene, {"omega": np.array([w[i] + t[0] * dw / 2]), "m_2": np.array([m[i] * np.exp(t[1] * 16 * dm)])})
         assert exact.decide_points(*pts.kernel_args(), np.arange(1))[0] == label[i]
+
+
+def test_the_probe_of_an_atlas_decided_cell_by_cell_times_whole_tiles():
+    # Chunks are sized by the probe's pace: a point-by-point probe would price a cell-decided atlas at what its
+    # nodes cost, and cut it into chunks too small (each a checkpoint write).  The probe times whole tiles instead.
+    from stabmap.run.cells import tile_shape
+    from stabmap.run.chunks import PROBE_RUNS, tile_locations
+    from stabmap.run.tasks import probe_tiles
+
+    scene = resample(stabmap.example("paper-n2-fixed"), omega=70, K_1=45)
+    tile = tile_shape(scene)
+    where = tile_locations(scene.shape, tile)
+    assert where == tile_locations(scene.shape, tile) and len(where) == PROBE_RUNS
+    for location in where:
+        for (a, b), t, n in zip(location, tile, scene.shape):
+            assert a % t == 0 and b == min(n, a + t)
+    points, seconds = probe_tiles(scene, where)
+    assert points > 0 and seconds > 0

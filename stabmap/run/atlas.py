@@ -29,9 +29,10 @@ from .chunks import (
     chunk_points_for,
     chunk_shape,
     probe_points,
+    tile_locations,
 )
 from .progress import ProgressLine, Rate, wanted
-from .tasks import evaluate_blocks, evaluate_points, point_order, probe, prove_boxes
+from .tasks import evaluate_blocks, evaluate_points, point_order, probe, probe_tiles, prove_boxes
 
 
 def compute(
@@ -307,7 +308,7 @@ class _Layout:
             chunks = chunk_shape(scene.shape, chunk_points_for(scene, 0.0, run.slots()), order, tile)
         else:
             try:
-                chunks = chunk_shape(scene.shape, chunk_points_for(scene, self._probe(), run.slots()), order, tile)
+                chunks = chunk_shape(scene.shape, chunk_points_for(scene, self._probe(tile), run.slots()), order, tile)
             except BaseException:
                 self.progress.close()
                 raise
@@ -329,11 +330,15 @@ class _Layout:
             text = f"{rate.text()} | {self.progress.elapsed:.0f} s"
         self.progress.show(f"[atlas] {text}{where}")
 
-    def _probe(self) -> float:
-        """Seconds per point, timed on the probe's points (on the runner: a worker, or a thread here)."""
+    def _probe(self, tile: tuple[int, ...] | None) -> float:
+        """Seconds per point, timed on the probe's points (on the runner: a worker, or a thread here); on whole tiles
+        where ``tile`` is given (an atlas decided cell by cell)."""
         measured = []
-        values = probe_points(self.scene, point_order(self.scene))
-        self.runner.run(probe, self.scene, _Once(values), lambda _, r: measured.append(r), self._show)
+        if tile is None:
+            task, job = probe, probe_points(self.scene, point_order(self.scene))
+        else:
+            task, job = probe_tiles, tile_locations(self.scene.shape, tile)
+        self.runner.run(task, self.scene, _Once(job), lambda _, r: measured.append(r), self._show)
         points, seconds = measured[0]
         cost = seconds / max(1, points)
         self.runner.pace = runner.Pace(cost)

@@ -59,6 +59,15 @@ def probe_points(scene: SceneBase, order: tuple[int, ...], seed: int = 0) -> dic
     return values
 
 
+def tile_locations(shape: tuple[int, ...], tile: tuple[int, ...], seed: int = 0) -> list[tuple[tuple[int, int], ...]]:
+    """Locations ((start, stop) per axis) of PROBE_RUNS whole tiles at random places of the grid (seeded: repeatable),
+    for an atlas decided cell by cell: its points cost what their tile's proofs cost, not what a point's does."""
+    rng = np.random.default_rng(seed)
+    counts = [-(-n // t) for n, t in zip(shape, tile)]
+    picks = [rng.integers(0, c, PROBE_RUNS) for c in counts]
+    return [tuple((int(i) * t, min(n, (int(i) + 1) * t)) for i, t, n in zip(at, tile, shape)) for at in zip(*picks)]
+
+
 def check_chunk_points(value, option: str = "chunk_points") -> int | None:
     if value is None:
         return None

@@ -12,6 +12,7 @@ run time, from which the runner sizes the next tasks (``stabmap.run.runner``).
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 
@@ -112,6 +113,21 @@ def probe(scene: SceneBase, values: dict[str, np.ndarray]) -> tuple[int, float]:
             spent += time.perf_counter() - t0
             done, n = end, 4 * n
         stop = max(done, 1)
+    return done, spent
+
+
+def probe_tiles(scene: SceneBase, locations: list) -> tuple[int, float]:
+    """Time whole tiles decided cell by cell (``evaluate_block``; ``stabmap.run.chunks.tile_locations``) for up to
+    PROBE_SECONDS, after one untimed tile that loads what the kernels load lazily.  Returns (points, seconds)."""
+    evaluate_block(scene, locations[0])
+    done, spent = 0, 0.0
+    for location in locations[1:]:
+        if spent >= PROBE_SECONDS:
+            break
+        t0 = time.perf_counter()
+        evaluate_block(scene, location)
+        spent += time.perf_counter() - t0
+        done += math.prod(b - a for a, b in location)
     return done, spent
 
 
