@@ -121,20 +121,22 @@ def test_an_unrelated_top_level_kernels_package_breaks_neither(tmp_path):
 
 def _installed_wheel_files() -> list[str] | None:
     """The files a regular ``pip install .`` of this very checkout put in place (its RECORD), or None: not installed,
-    installed editable, or from other sources (a kernel file whose hash differs from the checkout's)."""
-    try:
-        dist = importlib.metadata.distribution("stabmap")
-    except importlib.metadata.PackageNotFoundError:
-        return None
-    files = {str(f): f for f in dist.files or ()}
-    for source in sorted((ROOT / "kernels").glob("*.py")):
-        record = files.get(f"stabmap/kernels/{source.name}")
-        if record is None or record.hash is None:
-            return None
-        digest = base64.urlsafe_b64encode(hashlib.new(record.hash.mode, source.read_bytes()).digest()).rstrip(b"=").decode()
-        if digest != record.hash.value:
-            return None
-    return list(files)
+    installed editable, or from other sources (a kernel file whose hash differs from the checkout's).  Every
+    distribution named stabmap on the path is looked at: the checkout's own ``stabmap.egg-info``, which the build
+    leaves beside the sources, comes first when the tests run from there, and has no RECORD."""
+    for dist in importlib.metadata.distributions(name="stabmap"):
+        files = {str(f): f for f in dist.files or ()}
+        if all(_same(files.get(f"stabmap/kernels/{source.name}"), source) for source in (ROOT / "kernels").glob("*.py")):
+            return list(files)
+    return None
+
+
+def _same(record, source: Path) -> bool:
+    """Whether the RECORD entry ``record`` (or None) is the file ``source``, by its hash."""
+    if record is None or record.hash is None:
+        return False
+    digest = base64.urlsafe_b64encode(hashlib.new(record.hash.mode, source.read_bytes()).digest()).rstrip(b"=").decode()
+    return digest == record.hash.value
 
 
 @pytest.mark.slow  # where it builds the wheel
