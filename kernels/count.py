@@ -156,7 +156,10 @@ def fails_at_nodes(C, probe, grid, ws, Xn):
         Xn[k, : d + 1] = C[k, low : top + 1]
     shift = root_scale(Xn[mid], d)
     e = math.frexp(Xn[mid, d, 0])[1] + shift * d
-    for k in probe:
+    for i in range(probe.size):
+        k = probe[i]
+        if k in probe[:i]:
+            continue  # a node probed twice (a box along one parameter): scaled once
         if not rescale_by(Xn[k], d, shift, e):
             return False, -1, -1, 0
     fails, along1, along2 = separators_spread(Xn, probe, mid, d, a, z, R, flags)

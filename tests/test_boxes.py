@@ -537,3 +537,20 @@ def test_paper_n3_fixed_one_cell_spin_by_mass_boxes_are_proved():
     for b in np.flatnonzero(proved)[:12]:
         corners = {"omega": np.array([omega[i[b]], omega[i[b] + 1]] * 2), "m_2": np.repeat([m2[j[b]], m2[j[b] + 1]], 2)}
         assert np.all(_exact(scene, corners) == nc[b])
+
+
+def test_boxes_along_one_parameter_prove_with_their_nodes_probed_once():
+    # A box along one parameter has one node per corner pair (N2 = 1), and on two nodes its middle is a corner:
+    # the probe meets such a node twice and must scale it once.  Scaled twice, its values at the separators were
+    # off by the scale, the screen rejected every such box, and critical values found no box proof at all.
+    scene = stabmap.example("paper-n3-fixed")
+    w = np.linspace(40.0, 190.0, 40)
+    nc, proved = prove_boxes(scene, {"omega": w}, {"omega": w + 0.5})
+    assert proved.mean() >= 0.9, proved.mean()
+    m = np.exp(np.linspace(np.log(0.2), np.log(5.0), 40))
+    nc, proved = prove_boxes(scene, {"m_2": m}, {"m_2": m * 1.001})
+    assert proved.mean() >= 0.9, proved.mean()
+    two = from_dict(dict(WINDOW, omega=20.0, grid={"K_1": {"values": [5.0]}}))  # one joint's K alone: 2 nodes, the middle a corner
+    k = np.linspace(5.0, 15.0, 20)
+    nc, proved = prove_boxes(two, {"K_1": k}, {"K_1": k + 0.01})
+    assert proved.mean() >= 0.9, proved.mean()
