@@ -40,6 +40,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from . import dd
 from .inclusion import approximate, horner_dd
 from .options import kernel
@@ -175,6 +177,7 @@ def separators_spread(X, probe, mid, d, a, z, R, flags):
     r = _separators(X[mid], d, a, z, R, flags, False)
     if r < 0:
         return True, 0.0, 0.0
+    v = np.empty(probe.size)  # the probed nodes' values at one separator (midpoints)
     for j in range(r - 1):
         x = 0.5 * R[j] + 0.5 * R[j + 1]
         h, l, rad = _real_value(X[mid], d, x)
@@ -182,15 +185,14 @@ def separators_spread(X, probe, mid, d, a, z, R, flags):
         if s == 0:
             return True, 0.0, 0.0
         fails = False
-        for k in probe:
-            hk, lk, rk = _real_value(X[k], d, x)
+        for i in range(probe.size):
+            hk, lk, rk = _real_value(X[probe[i]], d, x)
+            v[i] = hk
             fails = fails or _sign(hk, lk, rk) != s or abs(hk - h) > SPREAD * abs(h)
         if fails:
-            # corners (i, j) = (0, 0), (0, N2 - 1), (N1 - 1, 0), (N1 - 1, N2 - 1): i indexes t1, j t2
-            v0, v1 = _real_value(X[probe[1]], d, x)[0], _real_value(X[probe[2]], d, x)[0]
-            v2, v3 = _real_value(X[probe[3]], d, x)[0], _real_value(X[probe[4]], d, x)[0]
-            along1 = (abs(v0 - v2) + abs(v1 - v3)) / abs(h)
-            along2 = (abs(v0 - v1) + abs(v2 - v3)) / abs(h)
+            # corners v[1:] at (i, j) = (0, 0), (0, N2 - 1), (N1 - 1, 0), (N1 - 1, N2 - 1): i indexes t1, j t2
+            along1 = (abs(v[1] - v[3]) + abs(v[2] - v[4])) / abs(h)
+            along2 = (abs(v[1] - v[2]) + abs(v[3] - v[4])) / abs(h)
             return True, along1, along2
     return False, 0.0, 0.0
 
