@@ -3,6 +3,7 @@ and bad input (one line, exit status 2, no file)."""
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import re
@@ -18,7 +19,13 @@ from stabmap.cli import main
 from stabmap.errors import StabmapError
 from stabmap.systems.closed import SYSTEM
 
+# The paper's planar model (the chain confined to its plane): these tests check the planar results;
+# tests/test_closed_space.py checks stability in space.
+planar_solve = functools.partial(closed.solve, model="planar")
+planar_search = functools.partial(closed.search, model="planar")
+
 HINGE = """system = "closed"
+model = "planar"
 title = "hinge against its length ratio"
 family = "hinge"
 c1sq = 2.0
@@ -26,6 +33,7 @@ c1sq = 2.0
 ratio = { start = 0.5, stop = 2.5, num = 41 }
 """
 RINGS = """system = "closed"
+model = "planar"
 family = "ring"
 [grid]
 n = { values = [5, 6, 7, 8] }
@@ -58,7 +66,7 @@ def test_atlas_file_holds_every_variable_with_cf_metadata_and_the_scene(hinge_at
         assert float(ds["c1sq"]) == 2.0
         # every point equals the Python API's answer at that ratio
         for r in ds["ratio"].values[::7]:
-            eq = closed.solve("hinge", [1, 1, r, 1, 1, r], c1sq=2.0)
+            eq = planar_solve("hinge", [1, 1, r, 1, 1, r], c1sq=2.0)
             p = ds.sel(ratio=r)
             assert bool(p["exists"]) == eq.exists and int(p["stability"]) == {"stable": 0, "unstable": 1, "degenerate": -1, "absent": -2}[eq.stability]
             assert SYSTEM.variable("decided_by").meaning(int(p["decided_by"])) == eq.decided_by
@@ -199,7 +207,7 @@ def test_refinement_is_declined_with_one_line_and_no_file(tmp_path, capsys):
 def test_a_family_without_equilibrium_is_data_not_an_error(tmp_path):
     scene = tmp_path / "none.toml"
     # one point: a one-value axis (a scene without [grid] is an error, not a one-point atlas)
-    scene.write_text('system = "closed"\nfamily = "figure-eight-4"\n[grid]\nratio = { values = [1.5] }\n')
+    scene.write_text('system = "closed"\nmodel = "planar"\nfamily = "figure-eight-4"\n[grid]\nratio = { values = [1.5] }\n')
     out = tmp_path / "none.nc"
     assert main(["atlas", str(scene), "-o", str(out), "-q"]) == 0
     with xr.open_dataset(out) as ds:

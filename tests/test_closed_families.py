@@ -7,6 +7,7 @@ and the energy probe on the closed configurations for every index and nullity; t
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 
@@ -21,6 +22,11 @@ from hypothesis import strategies as st
 import stabmap
 from stabmap import closed
 from stabmap.errors import StabmapError
+
+# The paper's planar model (the chain confined to its plane): these tests check the planar results;
+# tests/test_closed_space.py checks stability in space.
+planar_solve = functools.partial(closed.solve, model="planar")
+planar_search = functools.partial(closed.search, model="planar")
 
 FAMILY_N = {"figure-eight-4": 4, "figure-eight-6": 6, "hinge": 6, "hinge-straight": 6}
 # Ratios h2/h1 at which each family exists, spread over its range (both sides of the stability boundaries).
@@ -102,7 +108,7 @@ def test_exact_closed_forms_with_sympy():
 def test_solve_matches_the_closed_forms_and_satisfies_the_equations_to_1e_12(family):
     for r in INSIDE[family]:
         L = [float(x) for x in ref.lengths_of(family, r)]
-        eq = closed.solve(family, L, c1sq=3.0, h=0.8)
+        eq = planar_solve(family, L, c1sq=3.0, h=0.8)
         theta, forces = ref.closed_form(family, L, c1sq=3, h=mp.mpf("0.8"))
         assert eq.exists and eq.theta.shape == (len(L),)
         np.testing.assert_allclose(eq.theta, [float(x) for x in theta], rtol=0, atol=1e-12)
@@ -115,7 +121,7 @@ def test_solve_matches_the_closed_forms_and_satisfies_the_equations_to_1e_12(fam
 @given(family=st.sampled_from(list(INSIDE)), r=st.floats(0.01, 30.0), h1=st.floats(0.01, 100.0), c1sq=st.floats(1e-3, 1e3))
 def test_every_reported_equilibrium_satisfies_the_general_equations(family, r, h1, c1sq):
     L = [float(x) for x in ref.lengths_of(family, r, h1=h1)]
-    eq = closed.solve(family, L, c1sq=c1sq)
+    eq = planar_solve(family, L, c1sq=c1sq)
     # CLOSED.md's ranges are open; at the closing end the family folds onto a line and is reported (degenerate).
     end = {"figure-eight-4": L[1] == L[0], "hinge": L[2] == 2 * L[0], "hinge-straight": L[2] == 2 * L[0]}.get(family, False)
     assert eq.exists == (ref.closed_form(family, L) is not None or end)
@@ -132,7 +138,7 @@ def test_newton_on_the_general_equations_from_perturbed_starts_returns_to_the_cl
     loops = ref.loops_of(family, len(L))
     theta, forces = ref.closed_form(family, L)
     rng = np.random.default_rng(7)
-    eq = closed.solve(family, [float(x) for x in L])
+    eq = planar_solve(family, [float(x) for x in L])
     for _ in range(3):
         start = [x + mp.mpf(float(d)) for x, d in zip(theta, rng.normal(0, 0.02, len(theta)))]
         kick = [(f[0] * mp.mpf(1.05), f[1] + mp.mpf(0.02)) for f in forces]
@@ -149,7 +155,7 @@ def test_newton_on_the_general_equations_from_perturbed_starts_returns_to_the_cl
 @pytest.mark.parametrize("family", list(INSIDE))
 def test_index_and_nullity_match_the_energy_probe_on_the_closed_shapes(family):
     for r in INSIDE[family]:
-        eq = closed.solve(family, [float(x) for x in ref.lengths_of(family, r)], h=1.0)
+        eq = planar_solve(family, [float(x) for x in ref.lengths_of(family, r)], h=1.0)
         assert (eq.index, eq.nullity) == probe_inertia(family, r), (family, r)
         assert eq.stability == ("stable" if eq.index == 0 else "unstable")
         # Both reduce on orthonormal bases of the same space (tangent to the closures, orthogonal to the
@@ -162,7 +168,7 @@ def test_index_and_nullity_match_the_energy_probe_on_the_closed_shapes(family):
 @pytest.mark.parametrize("n,j,r", [(5, 1, 1), (5, 2, 1), (6, 1, 0.4), (6, 2, 2.5), (7, 1, 1), (7, 3, 1), (8, 1, 0.5), (8, 3, 1.7), (9, 2, 1), (10, 3, 1.3)])
 def test_rings_match_the_probe_and_the_rule_cos_2_pi_j_over_n(n, j, r):
     L = [float(x) for x in ref.lengths_of("ring", r, n)]
-    eq = closed.solve("ring", L, j=j)
+    eq = planar_solve("ring", L, j=j)
     assert eq.exists and eq.rotation_index == j and np.allclose(eq.forces, 0)
     assert (eq.index, eq.nullity) == probe_inertia("ring", r, n, j)
     assert eq.stable == (math.cos(2 * math.pi * j / n) > 0)
@@ -171,23 +177,23 @@ def test_rings_match_the_probe_and_the_rule_cos_2_pi_j_over_n(n, j, r):
 
 def test_degenerate_rings_n_4_and_n_8_j_2_are_families_of_equal_energy():
     for n, j, r, null in ((4, 1, 1.0, 1), (4, 1, 0.3, 1), (8, 2, 1.0, 5), (8, 2, 2.0, 5)):
-        eq = closed.solve("ring", [float(x) for x in ref.lengths_of("ring", r, n)], j=j)
+        eq = planar_solve("ring", [float(x) for x in ref.lengths_of("ring", r, n)], j=j)
         assert (eq.index, eq.nullity, eq.stability) == (0, null, "degenerate")
         assert probe_inertia("ring", r, n, j) == (0, null)  # U is constant along the rhombi (and their like)
-    tri = closed.solve("ring", [2.0, 2.0, 2.0])  # three bodies: rigid, nothing to move
+    tri = planar_solve("ring", [2.0, 2.0, 2.0])  # three bodies: rigid, nothing to move
     assert (tri.index, tri.nullity, tri.stability, tri.eigenvalues.size) == (0, 0, "stable", 0)
 
 
 @pytest.mark.parametrize("family,r", [("figure-eight-4", 1.0), ("hinge", 2.0), ("hinge-straight", 2.0)])
 def test_folded_end_points_exist_and_are_degenerate(family, r):
     """At the end of its range a family folds onto a line: an equilibrium, but the closures lose rank there."""
-    eq = closed.solve(family, [float(x) for x in ref.lengths_of(family, r)])
+    eq = planar_solve(family, [float(x) for x in ref.lengths_of(family, r)])
     assert eq.exists and eq.stability == "degenerate" and eq.nullity >= 1 and eq.rotation_index is None
     assert eq.residual <= 1e-12 and scaled_residual(eq) <= 1e-12
     axes = np.stack([-np.sin(eq.theta), np.cos(eq.theta)], axis=-1)
     assert np.abs(axes[:, 0] * axes[0, 1] - axes[:, 1] * axes[0, 0]).max() < 1e-12  # every axis on one line
     # ... which is the limit of the family from inside its range:
-    inside = closed.solve(family, [float(x) for x in ref.lengths_of(family, r * (1 - 1e-12))])
+    inside = planar_solve(family, [float(x) for x in ref.lengths_of(family, r * (1 - 1e-12))])
     assert np.abs(np.angle(np.exp(1j * (joint_angles(inside.theta) - joint_angles(eq.theta))))).max() < 1e-5
 
 
@@ -220,7 +226,7 @@ def test_points_1e_7_either_side_of_every_boundary(name):
     b = where()
     for side, expected in ((-1, below), (1, above)):
         r = b * (1 + side * mp.mpf("1e-7"))
-        eq = closed.solve(family, [float(x) for x in ref.lengths_of(family, r)])
+        eq = planar_solve(family, [float(x) for x in ref.lengths_of(family, r)])
         assert eq.stability == expected, (name, side)
         if eq.exists:
             assert (eq.index, eq.nullity) == probe_inertia(family, r)
@@ -238,7 +244,7 @@ def test_the_boundaries_docs_closed_md_quotes_are_the_references():
 
 def test_odd_rings_with_unequal_lengths_do_not_close():
     for r, exists in ((1 - 1e-7, False), (1.0, True), (1 + 1e-7, False)):
-        eq = closed.solve("ring", [1.0, r, 1.0, r, 1.0])
+        eq = planar_solve("ring", [1.0, r, 1.0, r, 1.0])
         assert eq.exists == exists and eq.stability == ("stable" if exists else "absent")
 
 
@@ -248,7 +254,7 @@ def test_odd_rings_with_unequal_lengths_do_not_close():
 ])
 def test_critical_locates_existence_and_stability_boundaries_to_1e_10(name, family, guess, lo, hi):
     scene = stabmap.loads_scene(
-        f'system = "closed"\nfamily = "{family}"\n[grid]\nratio = {{ start = {lo}, stop = {hi}, num = 25 }}\n'
+        f'system = "closed"\nmodel = "planar"\nfamily = "{family}"\n[grid]\nratio = {{ start = {lo}, stop = {hi}, num = 25 }}\n'
     )
     ds = stabmap.critical(scene, "ratio", threads=1, progress=False)
     lower, upper = ds["boundary_lower"].values, ds["boundary_upper"].values
@@ -284,4 +290,4 @@ def test_critical_locates_existence_and_stability_boundaries_to_1e_10(name, fami
 ])
 def test_bad_input_is_one_clear_error(args, kw, message):
     with pytest.raises(StabmapError, match=message):
-        closed.solve(*args, **kw)
+        planar_solve(*args, **kw)

@@ -11,6 +11,7 @@ where the old floating-point decision was wrong the proof must give the referenc
 
 from __future__ import annotations
 
+import functools
 import math
 
 import closed_reference as ref
@@ -26,6 +27,11 @@ from stabmap import closed
 from stabmap.cli import main
 from stabmap.systems.closed import SYSTEM, equations, proofs
 from stabmap.systems.closed.families import FAMILIES
+
+# The paper's planar model (the chain confined to its plane): these tests check the planar results;
+# tests/test_closed_space.py checks stability in space.
+planar_solve = functools.partial(closed.solve, model="planar")
+planar_search = functools.partial(closed.search, model="planar")
 
 DIGITS = 60
 ZERO = 1e-40  # the reference's zero for an eigenvalue, at DIGITS digits
@@ -117,7 +123,7 @@ def test_labels_near_every_boundary_equal_the_reference_and_are_proved(name):
     family, where = BOUNDARIES[name]
     b = where()
     for r in near(b):
-        eq = closed.solve(family, lengths(family, r))
+        eq = planar_solve(family, lengths(family, r))
         expected, index, nullity = reference(family, r)
         assert eq.stability == expected, (name, r, eq, expected)
         assert eq.proved and eq.decided_by in ("ball_arithmetic", "exact_rational_arithmetic"), (name, r, eq)
@@ -130,9 +136,9 @@ def test_labels_near_every_boundary_equal_the_reference_and_are_proved(name):
 def test_labels_at_random_ratios_equal_the_reference(family, u, h1):
     lo, hi = RANGE[family]
     r = lo * (hi / lo) ** u  # log-uniform over the family's range
-    eq = closed.solve(family, [h1 * x for x in lengths(family, r)]) if h1 == 1.0 else None
+    eq = planar_solve(family, [h1 * x for x in lengths(family, r)]) if h1 == 1.0 else None
     # with h1 != 1 the lengths h1 * r are rounded: take the atlas's point (h1, ratio), whose ratio is r exactly
-    scene = stabmap.loads_scene(f'system = "closed"\nfamily = "{family}"\nh1 = {h1!r}\nratio = {r!r}\n')
+    scene = stabmap.loads_scene(f'system = "closed"\nmodel = "planar"\nfamily = "{family}"\nh1 = {h1!r}\nratio = {r!r}\n')
     point = SYSTEM.evaluate(scene, {})
     expected, index, nullity = reference(family, r)
     label = SYSTEM.variable("stability").meaning(int(point["stability"]))
@@ -145,7 +151,7 @@ def test_labels_at_random_ratios_equal_the_reference(family, u, h1):
 @pytest.mark.parametrize("n,j", [(3, 1), (4, 1), (5, 1), (5, 2), (6, 1), (6, 2), (7, 3), (8, 2), (9, 2), (12, 3), (12, 5)])
 def test_rings_exact_structure_against_the_reference(n, j):
     for r in (1.0, math.nextafter(1.0, 2.0), 0.5, 1.7):
-        eq = closed.solve("ring", lengths("ring", r, n), j=j)
+        eq = planar_solve("ring", lengths("ring", r, n), j=j)
         expected, index, nullity = reference("ring", r, n, j)
         assert eq.stability == expected, (n, j, r)
         assert eq.decided_by == ("exact_structure" if expected != "absent" else "exact_rational_arithmetic")
@@ -155,16 +161,16 @@ def test_rings_exact_structure_against_the_reference(n, j):
 
 def test_a_ring_closes_with_lengths_of_period_three_and_not_one_ulp_off():
     # sum h_k w^k with w^3 = -1 (n = 6, j = 1) and h of period 3 is (h1 w + h2 w^2 + h3 w^3)(1 + w^3) = 0.
-    closes = closed.solve("ring", [1.0, 2.0, 3.0, 1.0, 2.0, 3.0])
+    closes = planar_solve("ring", [1.0, 2.0, 3.0, 1.0, 2.0, 3.0])
     assert closes.exists and closes.stability == "stable" and closes.decided_by == "exact_structure"
     assert closes.residual <= 1e-12
-    off = closed.solve("ring", [1.0, 2.0, 3.0, 1.0, 2.0, math.nextafter(3.0, 4.0)])
+    off = planar_solve("ring", [1.0, 2.0, 3.0, 1.0, 2.0, math.nextafter(3.0, 4.0)])
     assert off.exists is False and off.stability == "absent"
 
 
 @pytest.mark.parametrize("family,r", [("figure-eight-4", 1.0), ("hinge", 2.0), ("hinge-straight", 2.0)])
 def test_folded_ends_are_proved_exactly(family, r):
-    eq = closed.solve(family, lengths(family, r))
+    eq = planar_solve(family, lengths(family, r))
     assert eq.stability == "degenerate" and eq.decided_by == "exact_rational_arithmetic"
     float_inertia = equations.inertia(eq.theta[None], np.asarray(eq.lengths)[None], eq.forces[None], FAMILIES[family].loop_of(),
                                       eq.c1sq, eq.h)
@@ -197,7 +203,7 @@ def _float_label(family, r):
 def test_where_floating_point_was_wrong_the_proof_is_right(family, r, truth):
     assert reference(family, r)[0] == truth
     assert _float_label(family, r) != truth  # the old decision: this test fails if the proof is skipped
-    eq = closed.solve(family, lengths(family, r))
+    eq = planar_solve(family, lengths(family, r))
     assert eq.stability == truth and eq.proved
 
 
@@ -209,7 +215,7 @@ def test_at_one_precision_points_within_reach_of_a_boundary_are_flagged_never_wr
     b = where()
     flagged = []
     for r in near(b):
-        eq = closed.solve(family, lengths(family, r))
+        eq = planar_solve(family, lengths(family, r))
         expected = reference(family, r)[0]
         if eq.stability == "undecided":
             assert eq.decided_by == "undecided" and eq.exists is True and eq.index == eq.nullity == -1
@@ -220,13 +226,13 @@ def test_at_one_precision_points_within_reach_of_a_boundary_are_flagged_never_wr
     # flagged, points 1e-13 away are already proved.
     assert flagged and max(flagged) < 1e-13, flagged
     for s in (-1, 1):
-        assert closed.solve(family, lengths(family, float(b * (1 + s * mp.mpf("1e-13"))))).proved
+        assert planar_solve(family, lengths(family, float(b * (1 + s * mp.mpf("1e-13"))))).proved
 
 
 def test_the_precision_ladder_decides_the_doubles_next_to_sqrt_2():
     below, above = math.nextafter(math.sqrt(2), 0), math.nextafter(math.sqrt(2), 2)
     for r in (math.sqrt(2), below, above):
-        eq = closed.solve("hinge", lengths("hinge", r))
+        eq = planar_solve("hinge", lengths("hinge", r))
         assert eq.proved and eq.stability == reference("hinge", r)[0]
         assert eq.stability == ("unstable" if mp.mpf(r) > mp.sqrt(2) else "stable")
     # math.sqrt(2) = 1.41421356237309514547... lies 1e-16 above sqrt 2 (which is stable below): unstable
@@ -238,7 +244,7 @@ def test_undecided_points_are_a_class_of_their_own_in_files_info_query_and_plot(
     b = float(mp.sqrt(2))
     ratios = [b * (1 - 1e-7), math.nextafter(b, 0), b, math.nextafter(b, 2), b * (1 + 1e-7)]
     scene = tmp_path / "s.toml"
-    scene.write_text('system = "closed"\nfamily = "hinge"\n[grid]\nratio = { values = [' + ", ".join(repr(r) for r in ratios) + "] }\n")
+    scene.write_text('system = "closed"\nmodel = "planar"\nfamily = "hinge"\n[grid]\nratio = { values = [' + ", ".join(repr(r) for r in ratios) + "] }\n")
     out = tmp_path / "s.nc"
     assert main(["atlas", str(scene), "-o", str(out), "-q"]) == 0
     with xr.open_dataset(out) as ds:
@@ -271,7 +277,7 @@ def test_undecided_points_are_a_class_of_their_own_in_files_info_query_and_plot(
 # ------------------------------------------------------------------------------------ no closed form: Krawczyk
 def test_lengths_off_the_pattern_by_rounding_are_proved_by_krawczyk():
     L = [1.0, 0.5, 1.0, math.nextafter(0.5, 1.0)]  # figure-eight-4's pattern, one length one ulp off
-    eq = closed.solve("figure-eight-4", L)
+    eq = planar_solve("figure-eight-4", L)
     assert eq.decided_by == "interval_newton" and eq.exists and eq.stability == "unstable"
     with mp.workdps(40):
         loops = [[0, 1, 2, 3]]
@@ -279,14 +285,14 @@ def test_lengths_off_the_pattern_by_rounding_are_proved_by_krawczyk():
         assert ref.residual(theta, L, forces, loops) < mp.mpf(10) ** -30
         assert ref.hessian_inertia(theta, L, forces, loops, 1e-25)[:2] == (eq.index, eq.nullity)
     # ... and absent when every pattern within the lengths is absent; flagged next to the fold
-    assert closed.solve("figure-eight-4", [1.0, 1.5, 1.0, math.nextafter(1.5, 2.0)]).stability == "absent"
-    folded = closed.solve("figure-eight-4", [1.0, 1.0, 1.0, math.nextafter(1.0, 2.0)])
+    assert planar_solve("figure-eight-4", [1.0, 1.5, 1.0, math.nextafter(1.5, 2.0)]).stability == "absent"
+    folded = planar_solve("figure-eight-4", [1.0, 1.0, 1.0, math.nextafter(1.0, 2.0)])
     assert folded.stability == "undecided" and folded.exists is None and not folded.proved
 
 
 def test_every_search_result_is_proved_by_krawczyk():
     for L in ([1.0, 2.0, 1.5, 1.2, 0.7], [1.0, 6.0, 1.0, 1.0, 6.0, 1.0]):
-        eqs = closed.search(L, starts=120)
+        eqs = planar_search(L, starts=120)
         assert eqs and all(e.decided_by == "interval_newton" and e.proved for e in eqs)
         for e in eqs:
             with mp.workdps(40):
@@ -297,7 +303,7 @@ def test_every_search_result_is_proved_by_krawczyk():
 
 def test_krawczyk_encloses_the_reference_equilibrium():
     L = [1.0, 2.0, 1.5, 1.2, 0.7]
-    e = closed.search(L, starts=60)[0]
+    e = planar_search(L, starts=60)[0]
     rho = e.forces * (e.h / e.c1sq)
     with proofs.precision(64):
         theta_b, rho_b = proofs.krawczyk(e.theta, rho, L, [0] * 5, 64)
@@ -342,7 +348,7 @@ def test_the_ball_closed_forms_solve_the_general_equations_and_match_the_referen
 
 
 def test_critical_says_proved_and_brackets_sqrt_2():
-    scene = stabmap.loads_scene('system = "closed"\nfamily = "hinge"\n[grid]\nratio = { start = 1.2, stop = 1.6, num = 5 }\n')
+    scene = stabmap.loads_scene('system = "closed"\nmodel = "planar"\nfamily = "hinge"\n[grid]\nratio = { start = 1.2, stop = 1.6, num = 5 }\n')
     ds = stabmap.critical(scene, "ratio", threads=1, progress=False)
     assert "proved" in ds.attrs["comment"] and "proved" in ds["ratio_stable_upper"].attrs["comment"]
     assert "undecided: 0" in ds.attrs["critical_decided_by"]

@@ -7,6 +7,7 @@ distinct from the others modulo rotation, relabelling and reflection; the closed
 
 from __future__ import annotations
 
+import functools
 import math
 
 import closed_reference as ref
@@ -17,6 +18,11 @@ from test_closed_families import joint_angles, scaled_residual
 
 from stabmap import closed
 from stabmap.errors import StabmapError
+
+# The paper's planar model (the chain confined to its plane): these tests check the planar results;
+# tests/test_closed_space.py checks stability in space.
+planar_solve = functools.partial(closed.solve, model="planar")
+planar_search = functools.partial(closed.search, model="planar")
 
 
 def same_shape(a, b) -> bool:
@@ -36,7 +42,7 @@ def same_shape(a, b) -> bool:
 @pytest.fixture(scope="module", params=[[1.0] * 5, [1.0, 2.0, 1.5, 1.2, 0.7], [1.0, 6.0, 1.0, 1.0, 6.0, 1.0], [1.0, 1.0, 1.5, 1.0, 1.0, 1.5]],
                 ids=["equal-5", "uneven-5", "figure-eight-6", "hinge-lengths"])
 def found(request):
-    return request.param, closed.search(request.param, starts=240)
+    return request.param, planar_search(request.param, starts=240)
 
 
 def test_every_found_equilibrium_satisfies_the_general_equations_and_is_distinct(found):
@@ -74,31 +80,31 @@ def test_the_closed_form_families_are_found(found):
         (1.0,) * 5: [("ring", 1), ("ring", 2)],
     }.get(tuple(lengths), [])
     for shape, j in expected:
-        eq = closed.solve(shape, lengths, j=j)
+        eq = planar_solve(shape, lengths, j=j)
         assert any(same_shape(eq, other) and other.energy == pytest.approx(eq.energy, rel=1e-12) for other in eqs), shape
 
 
 def test_equal_pentagon_has_the_rings_and_one_figure_eight():
-    eqs = closed.search([1.0] * 5)
+    eqs = planar_search([1.0] * 5)
     by_turns = sorted((abs(e.rotation_index), e.index, e.stability) for e in eqs)
     assert by_turns == [(0, 1, "unstable"), (1, 0, "stable"), (2, 2, "unstable")]
 
 
 def test_search_is_repeatable_and_checks_its_input():
-    a = closed.search([1.0, 0.5, 1.0, 0.5], seed=4)
-    b = closed.search([1.0, 0.5, 1.0, 0.5], seed=4)
+    a = planar_search([1.0, 0.5, 1.0, 0.5], seed=4)
+    b = planar_search([1.0, 0.5, 1.0, 0.5], seed=4)
     assert [(e.energy, tuple(e.theta)) for e in a] == [(e.energy, tuple(e.theta)) for e in b]
-    assert closed.search([1.0] * 4) == []  # four equal bodies: rhombi and folds only, nothing isolated
+    assert planar_search([1.0] * 4) == []  # four equal bodies: rhombi and folds only, nothing isolated
     with pytest.raises(StabmapError, match="cannot close"):
-        closed.search([1.0, 1.0, 3.0])
+        planar_search([1.0, 1.0, 3.0])
     with pytest.raises(StabmapError, match=r"lengths\[2\] must be > 0"):
-        closed.search([1.0, 0.0, 1.0])
+        planar_search([1.0, 0.0, 1.0])
 
 
 @pytest.mark.slow
 def test_more_starts_find_no_fewer_shapes_and_the_same_ones():
     lengths = [1.0, 1.3, 0.8, 1.1, 0.9, 1.2, 1.0]
-    few, many = closed.search(lengths, starts=150), closed.search(lengths, starts=1500, seed=1)
+    few, many = planar_search(lengths, starts=150), planar_search(lengths, starts=1500, seed=1)
     assert len(many) >= len(few)
     for eq in few:
         assert any(same_shape(eq, other) for other in many)

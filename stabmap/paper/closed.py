@@ -1,16 +1,23 @@
 """The closed-chain paper's families checked against their closed forms (``stabmap paper closed``).
 
-The bundled scenes ``closed-hinge`` and ``closed-figure-eight-6`` scan the length ratio h2/h1. Along it,
-``stabmap.critical`` locates every change of class to 1e-10 relative; each must be one that docs/closed.md's table
-(docs/closed.md, section 2) gives in closed form, with the same classes on either side:
+The paper's model is planar (its section 3 puts every axis in one plane), so its results are checked in the
+planar model (scene ``model = "planar"``).  The bundled scenes ``closed-hinge`` and ``closed-figure-eight-6``
+scan the length ratio h2/h1. Along it, ``stabmap.critical`` locates every change of class to 1e-10 relative;
+each must be one that docs/closed.md's table (docs/closed.md, section 2) gives in closed form, with the same
+classes on either side:
 
 - hinge: stable below h2/h1 = sqrt 2, unstable (index 1) above, absent beyond h2/h1 = 2 (the hinge is then a
   folded loop, degenerate, at exactly 2);
 - six-body figure-eight: absent below 2/(sqrt 2 - 1), unstable (index 1) until 5.98605461610344, stable above.
+
+Then it says in words which of the paper's shapes are stable in space at c2 = c1 (the one value where the
+paper's law (11) has an energy): the two families' classes in space along h2/h1 (``stabmap.critical`` in the
+spatial model), the plane ring (27) and the twisted ring (26) for n = 4 .. 16 (``closed.solve``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from pathlib import Path
@@ -38,7 +45,7 @@ def check_case(name: str, expected, out: Path | None = None) -> dict:
     from ..examples import example
     from ..run.critical import critical
 
-    scene = example(name)
+    scene = dataclasses.replace(example(name), model="planar")
     ds = critical(scene, "ratio", progress=False)
     meaning = _meanings(ds)
     lo, hi = ds["boundary_lower"].values, ds["boundary_upper"].values
@@ -77,5 +84,41 @@ def run(*, out: Path | None = None) -> dict:
         lines.append(f"| {r['case']} | {r['boundaries']} | {r['expected']} | {r['worst_rel']:.1e} | {len(r['problems'])} |")
     problems = [m for r in results for m in r["problems"]]
     lines += [f"DISAGREES: {m}" for m in problems]
+    lines += ["", "# in space, at c2 = c1 (the paper's model is planar; docs/closed.md, section 1b)", ""] + in_space()
     lines.append(f"# total {time.perf_counter() - t0:.0f} s")
     return {"results": results, "problems": problems, "text": "\n".join(lines)}
+
+
+def in_space() -> list[str]:
+    """Which of the paper's shapes are stable in space at c2 = c1, in words: the families' stretches along h2/h1
+    from ``critical`` in the spatial model, and the paper's rings (27) and (26) from ``closed.solve``."""
+    from .. import closed
+    from ..examples import example
+    from ..run.critical import critical
+
+    lines = []
+    for name, family in (("closed-hinge", "hinge"), ("closed-figure-eight-6", "six-body figure-eight")):
+        ds = critical(example(name), "ratio", progress=False)
+        meaning = _meanings(ds)
+        scan = ds["ratio"].values if "ratio" in ds else None
+        lo, hi = ds["boundary_lower"].values, ds["boundary_upper"].values
+        ends = [(a + b) / 2 for a, b in zip(lo, hi) if np.isfinite(a)]
+        classes = [meaning.get(int(ds["stability_at_scan_start"]), "?")]
+        classes += [meaning.get(int(t), str(t)) for t, a in zip(ds["stability_above"].values, lo) if np.isfinite(a)]
+        start = float(scan[0]) if scan is not None else float(ds.attrs.get("critical_scan_start", np.nan))
+        stops = ends + [float(scan[-1]) if scan is not None else np.nan]
+        stretches = []
+        left = start
+        for cls, right in zip(classes, stops):
+            stretches.append(f"{cls} for h2/h1 in [{left:.10g}, {right:.10g}]" if right != left else f"{cls} at {right:.10g}")
+            left = right
+        lines.append(f"- {family}: " + "; ".join(stretches) + ".")
+    for twist, what in ((0, "plane ring (27), j = 1"), (1, "twisted ring (26), one turn of twist (m = 1)")):
+        classes = {n: closed.solve("ring", [1.0] * n, twist=twist).stability for n in range(4 if not twist else 3, 17)}
+        stable = [n for n, c in classes.items() if c == "stable"]
+        other = {n: c for n, c in classes.items() if c != "stable"}
+        text = f"stable in space for n = {', '.join(map(str, stable))}" if stable else "stable in space for no n"
+        if other:
+            text += "; " + ", ".join(f"{c} for n = {n}" for n, c in other.items())
+        lines.append(f"- {what}, equal bodies: {text}.")
+    return lines

@@ -17,11 +17,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..base import Cost, System
-from . import proofs
+from . import proofs, space_proofs
 from . import scene as _scene
 from .decide import ABSENT, DEGENERATE, STABLE, UNDECIDED, decide
 from .equations import joint_angles
-from .families import FAMILIES
+from .families import FAMILIES, twist_form
 from .outputs import STABILITY, VARIABLES
 from .scene import Scene
 
@@ -33,7 +33,7 @@ REFERENCES = (
 
 class Closed(System):
     name = "closed"
-    title = "planar equilibria of a closed chain of elastic joints, with their forces and stability"
+    title = "planar and twisted equilibria of a closed chain of elastic joints, with their forces and stability in space"
     references = REFERENCES
     variables = VARIABLES
     label = STABILITY.name
@@ -44,17 +44,19 @@ class Closed(System):
     undecided_label = UNDECIDED
     proves_labels = True  # every class is proved or flagged undecided (proofs.py, docs/closed.md)
     provenance = "decided_by"
-    symbols = {"ratio": "h_2/h_1", "n": "n", "j": "j", "h": "h", "h1": "h_1", "c1sq": "c_1^2"}
+    symbols = {"ratio": "h_2/h_1", "n": "n", "j": "j", "twist": "m", "h": "h", "h1": "h_1", "c1sq": "c_1^2", "c2sq": "c_2^2"}
     scene_module = _scene
 
     def attrs(self, scene: Scene) -> dict:
         fam = scene.fam
-        out = {"closed_family": fam.name, "closed_family_title": fam.title, "closed_exists_where": fam.ratio_range}
+        out = {"closed_family": fam.name, "closed_family_title": fam.title, "closed_exists_where": fam.ratio_range,
+               "closed_model": scene.model}
         if scene.lengths:
             out["closed_lengths"] = np.array(scene.lengths)
         if fam.loops:
             out["closed_loops"] = "; ".join(" ".join(f"S{k}" for k in loop) for loop in fam.loops)
         out["closed_h"] = "min of the lengths at each point" if scene.h is None else f"{scene.h:g} m"
+        out["closed_c2sq"] = "c1sq at each point" if scene.c2sq is None else f"{scene.c2sq:g} N m2"
         return out
 
     def describe(self, attrs: dict) -> list[str]:
@@ -63,7 +65,10 @@ class Closed(System):
             lines.append(f"two loops, each with its own force: {attrs['closed_loops']}")
         if "closed_lengths" in attrs:
             lines.append(f"lengths {[float(v) for v in np.atleast_1d(attrs['closed_lengths'])]} m")
-        lines.append(f"h: {attrs.get('closed_h')}")
+        lines.append(f"h: {attrs.get('closed_h')}; c2sq: {attrs.get('closed_c2sq', 'c1sq at each point')}")
+        model = attrs.get("closed_model", "planar (written before stabmap decided stability in space)")
+        lines.append(f"model: {model}" + (" (stability against every motion, out of the plane and twist included)" if model == "spatial"
+                                          else " (the chain confined to its plane)"))
         return lines
 
     def dims(self, scene: Scene) -> dict[str, int]:
@@ -83,36 +88,41 @@ class Closed(System):
         size = int(np.prod(shape, dtype=np.int64))
         dims = self.dims(scene)
         out = {v.name: np.empty((size,) + tuple(dims[d] for d in v.dims), dtype=v.dtype) for v in VARIABLES}
-        for name in ("theta", "joint_angle", "force_y", "force_z"):
+        for name in ("theta", "twist_angle", "joint_angle", "force_x", "force_y", "force_z"):
             out[name][:] = np.nan
         fam = scene.fam
         n_of = p["n"].astype(np.int64) if "n" in p else np.full(size, scene.n_max)
         j_of = p["j"].astype(np.int64) if "j" in p else np.ones(size, dtype=np.int64)
-        for (n, j), pts in _scene.combinations(n_of, j_of):
+        m_of = p["twist"].astype(np.int64) if "twist" in p else np.zeros(size, dtype=np.int64)
+        gamma = _gammas(p["c1sq"], p["c2sq"]) if scene.spatial else None
+        for (n, j, m), pts in _scene.combinations(n_of, j_of, m_of):
+            n, j, m = int(n), int(j), int(m)
             if scene.lengths:
                 lengths = np.broadcast_to(np.asarray(scene.lengths), (pts.size, n))
             else:
                 lengths = fam.lengths(p["h1"][pts], p["ratio"][pts], n)
-            c1sq = p["c1sq"][pts]
+            c1sq, c2sq = p["c1sq"][pts], p["c2sq"][pts]
             h = p["h"][pts] if "h" in p else lengths.min(-1)
             loop_of = fam.loop_of(n)
-            if scene.lengths:  # one proof for the scene's lengths (c1^2 and h leave the labels alone)
+            g = None if gamma is None else [gamma[i] for i in pts]
+            if scene.lengths:  # the scene's lengths: one proof per gamma (c1^2 and h leave the labels alone)
                 guess = _guess(fam, lengths[:1], c1sq[:1], h[:1], j)
-                verdicts = proofs.Verdicts.of([proofs.prove_lengths(fam, j, scene.lengths, guess)] * pts.size)
-            else:  # the labels depend on the exact ratio h2/h1 only: one proof per ratio
-                verdicts = proofs.prove_ratios(fam, n, j, p["ratio"][pts])
+                done = {}
+                verdicts = proofs.Verdicts.of([
+                    done[x] if x in done else done.setdefault(x, space_proofs.prove_lengths(fam, j, m, scene.lengths, x, guess))
+                    for x in (g or [None] * pts.size)])
+            else:  # the labels depend on the exact ratio h2/h1 and gamma only: one proof per pair
+                verdicts = space_proofs.prove_ratios(fam, n, j, m, p["ratio"][pts], g)
             theta, forces, _ = fam.closed_form(lengths, c1sq, h, j, exists=verdicts.exists != 0)
-            d = decide(theta, forces, verdicts, lengths, loop_of, c1sq, h)
-            out["stability"][pts] = d.stability
-            out["decided_by"][pts] = d.decided_by
-            out["exists"][pts] = d.exists
-            out["index"][pts] = d.index
-            out["nullity"][pts] = d.nullity
-            out["rotation_index"][pts] = d.rotation_index
-            out["energy"][pts] = d.energy
-            out["residual"][pts] = d.residual
+            phi, force_x = twist_form(lengths, c1sq, c2sq, h, j, m)
+            d = decide(theta, forces, verdicts, lengths, loop_of, c1sq, h, c2sq=c2sq, phi=phi, force_x=force_x)
+            for name in ("stability", "decided_by", "exists", "index", "nullity", "planar_stability", "planar_index",
+                         "planar_nullity", "rotation_index", "energy", "residual"):
+                out[name][pts] = getattr(d, name)
             out["theta"][pts, :n] = d.theta
+            out["twist_angle"][pts, :n] = d.phi
             out["joint_angle"][pts, :n] = joint_angles(d.theta)
+            out["force_x"][pts] = d.force_x
             out["force_y"][pts] = d.forces[..., 0]
             out["force_z"][pts] = d.forces[..., 1]
         return {k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}
@@ -120,6 +130,12 @@ class Closed(System):
     def class_name(self, value: int) -> str:
         names = {ABSENT: "absent (no equilibrium)", DEGENERATE: "degenerate (nullity > 0)", UNDECIDED: "undecided (not proved)"}
         return names.get(value) or STABILITY.meaning(value)
+
+
+def _gammas(c1sq: np.ndarray, c2sq: np.ndarray) -> list:
+    """gamma = c2^2/c1^2 exactly at every point (one fmpq per distinct pair of doubles)."""
+    pairs = {}
+    return [pairs.setdefault((a, b), space_proofs.gamma_of(a, b)) for a, b in zip(c1sq.tolist(), c2sq.tolist())]
 
 
 def _guess(fam, lengths, c1sq, h, j):

@@ -67,6 +67,15 @@ def winding(j, n: int, where: str = "j") -> int:
     return j
 
 
+def twist(m, n: int, where: str = "twist") -> int:
+    """The ring's twist: 0 <= m < n/2 (less than half a turn per joint)."""
+    m = whole(where, m, 0)
+    if m and not 2 * m < n:
+        raise StabmapError(f"{where} = {m} is out of range for a ring of n = {n} bodies: each joint twists by 2 pi m/n, which must "
+                           f"stay below pi, so twist <= {(n - 1) // 2}; lower the twist or add bodies")
+    return m
+
+
 def pattern_text(fam: Family) -> str:
     return "(" + ", ".join(f"h{p}" for p in fam.pattern) + ")" if fam.pattern else "(h1, h2, h1, ...)"
 

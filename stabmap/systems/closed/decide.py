@@ -37,7 +37,12 @@ class Decided:
     stability: np.ndarray  # (P,) int8: STABLE, UNSTABLE, DEGENERATE, ABSENT, UNDECIDED
     rotation_index: np.ndarray  # (P,) int8
     decided_by: np.ndarray  # (P,) int8: proofs.BY_*
-    eigenvalues: np.ndarray  # (P, d): reduced Hessian in units of c1^2/h (floating point), NaN pads
+    eigenvalues: np.ndarray  # (P, d): planar reduced Hessian in units of c1^2/h (floating point), NaN pads
+    planar_index: np.ndarray  # (P,) int16: the in-plane block's counts
+    planar_nullity: np.ndarray
+    planar_stability: np.ndarray  # (P,) int8: the class in the plane
+    phi: np.ndarray  # (P, n) [rad]: each body's turn about its own axis (twisted rings)
+    force_x: np.ndarray  # (P, L) [N]: the closing force normal to the plane (twisted rings)
 
 
 def stability_class(exists: np.ndarray, index: np.ndarray, nullity: np.ndarray, decided_by: np.ndarray) -> np.ndarray:
@@ -48,11 +53,14 @@ def stability_class(exists: np.ndarray, index: np.ndarray, nullity: np.ndarray, 
     return np.where(decided_by == BY_NONE, UNDECIDED, out).astype(np.int8)
 
 
-def decide(theta, forces, verdicts: Verdicts, lengths, loop_of, c1sq, h, eigenvalues: bool = False) -> Decided:
+def decide(theta, forces, verdicts: Verdicts, lengths, loop_of, c1sq, h, eigenvalues: bool = False, c2sq=None, phi=None,
+           force_x=None) -> Decided:
     """The outputs at configurations ``theta`` (P, n) with loop ``forces`` (P, L, 2) and their ``verdicts``.
 
     The floating-point values are kept wherever an equilibrium exists or its existence is undecided; with
     ``eigenvalues`` the reduced Hessian's eigenvalues are computed too (floating point, for information).
+    A twisted ring also has ``phi`` (P, n), its bodies' turns about their axes, and ``force_x`` (P,), its normal
+    force, with the torsional stiffness ``c2sq`` (default c1sq).
     """
     theta = np.asarray(theta, dtype=float)
     lengths = np.asarray(lengths, dtype=float)
@@ -67,10 +75,19 @@ def decide(theta, forces, verdicts: Verdicts, lengths, loop_of, c1sq, h, eigenva
     at = np.flatnonzero(exists != 0)
     theta = np.where((exists != 0)[:, None], theta, np.nan)
     forces = np.where((exists != 0)[:, None, None], forces, np.nan)
+    c2sq = c1sq if c2sq is None else np.broadcast_to(np.asarray(c2sq, dtype=float), (P,))
+    twisted = phi is not None and np.any(phi != 0)
+    phi = np.zeros((P, n)) if phi is None else np.where((exists != 0)[:, None], phi, np.nan)
+    L = forces.shape[1]
+    force_x = np.zeros((P, L)) if force_x is None else np.broadcast_to(np.asarray(force_x, dtype=float).reshape(P, -1), (P, L))
+    force_x = np.where((exists != 0)[:, None], force_x, np.nan)
     if at.size:
         args = (theta[at], lengths[at], forces[at], loop_of, c1sq[at], h[at])
-        energy[at] = equations.energy(theta[at], c1sq[at], h[at])
+        energy[at] = equations.energy(theta[at], c1sq[at], h[at], c2sq[at], phi[at] if twisted else None)
         residual[at] = equations.residuals(*args)
+        if twisted:
+            residual[at] = np.maximum(residual[at], equations.twist_residual(theta[at], phi[at], lengths[at], force_x[at, 0],
+                                                                              c1sq[at], c2sq[at], h[at]))
         turns[at] = equations.rotation_index(theta[at])
         if eigenvalues:
             ev = equations.inertia(*args).eigenvalues
@@ -78,5 +95,9 @@ def decide(theta, forces, verdicts: Verdicts, lengths, loop_of, c1sq, h, eigenva
     index = np.where(exists == 1, verdicts.index, NO_COUNT).astype(np.int16)
     nullity = np.where(exists == 1, verdicts.nullity, NO_COUNT).astype(np.int16)
     stability = stability_class(exists, index, nullity, verdicts.decided_by)
+    planar_index = np.where(exists == 1, verdicts.planar_index, NO_COUNT).astype(np.int16)
+    planar_nullity = np.where(exists == 1, verdicts.planar_nullity, NO_COUNT).astype(np.int16)
+    planar_by = np.where(planar_index < 0, BY_NONE, 0)  # the planar counts are proved wherever they are known
+    planar = np.where(exists == 1, stability_class(exists, planar_index, planar_nullity, planar_by), stability).astype(np.int8)
     return Decided(exists, theta, forces, energy, residual, index, nullity, stability, turns,
-                   np.asarray(verdicts.decided_by, dtype=np.int8), eig)
+                   np.asarray(verdicts.decided_by, dtype=np.int8), eig, planar_index, planar_nullity, planar, phi, force_x)

@@ -21,6 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import space
+
 # The tolerances of ``inertia``, a floating-point estimate that labels nothing: the labels are proved in
 # ``proofs``; ``inertia`` gives the eigenvalues that ``solve`` reports for information.
 # Relative size below which a singular value of the (normalised) closure Jacobian counts as zero: the
@@ -41,10 +43,30 @@ def joint_angles(theta: np.ndarray) -> np.ndarray:
     return wrap(theta - np.roll(theta, 1, axis=-1))
 
 
-def energy(theta: np.ndarray, c1sq, h) -> np.ndarray:
-    """U = (c1^2/h) sum (1 - cos(theta_k - theta_{k-1})) [J] of each configuration."""
+def energy(theta: np.ndarray, c1sq, h, c2sq=None, phi=None) -> np.ndarray:
+    """U [J] of each configuration: (c1^2/h) sum (1 - cos(theta_k - theta_{k-1})) without twist; with the bodies
+    turned by phi_k about their axes (Q_k = Rx(theta_k) Rz(phi_k)), each joint adds
+    (c2^2/2h)(1 + cos(theta_k - theta_(k-1)))(1 - cos(phi_k - phi_(k-1))) (docs/closed.md, section 1b)."""
     d = theta - np.roll(theta, 1, axis=-1)
-    return np.asarray(c1sq) / np.asarray(h) * np.sum(1.0 - np.cos(d), axis=-1)
+    out = np.asarray(c1sq) / np.asarray(h) * np.sum(1.0 - np.cos(d), axis=-1)
+    if phi is not None:
+        f = phi - np.roll(phi, 1, axis=-1)
+        out = out + np.asarray(c2sq) / (2 * np.asarray(h)) * np.sum((1.0 + np.cos(d)) * (1.0 - np.cos(f)), axis=-1)
+    return out
+
+
+def twist_residual(theta, phi, lengths, force_x, c1sq, c2sq, h) -> np.ndarray:
+    """The scaled residual of the spatial equilibrium equations of configurations Q_k = Rx(theta_k) Rz(phi_k)
+    with one loop and a closing force R_x normal to the plane (the twisted rings): every component of the
+    gradient of U - R . closure (``space.spatial``, units of c1^2/h) divided by 2 + h_k |R| h / c1^2."""
+    out = np.empty(len(theta))
+    for p, (th, ph, hk, fx, c1, c2, hh) in enumerate(zip(theta, phi, lengths, force_x, np.broadcast_to(c1sq, len(theta)),
+                                                          np.broadcast_to(c2sq, len(theta)), np.broadcast_to(h, len(theta)))):
+        quats = [space.qmul((np.cos(a / 2), np.sin(a / 2), 0.0, 0.0), (np.cos(b / 2), 0.0, 0.0, np.sin(b / 2))) for a, b in zip(th, ph)]
+        rho = (fx * hh / c1, 0.0, 0.0)
+        _, g, _, _ = space.spatial(quats, list(hk), rho, c2 / c1, hessian=False)
+        out[p] = np.max(np.abs(g).reshape(-1, 3).max(-1) / (2.0 + hk * abs(rho[0])))
+    return out
 
 
 def body_forces(forces: np.ndarray, loop_of: np.ndarray) -> np.ndarray:

@@ -68,6 +68,16 @@ class Family:
         return theta, forces, exists
 
 
+def twist_form(lengths, c1sq, c2sq, h, j, m) -> tuple[np.ndarray, np.ndarray]:
+    """phi (P, n) [rad] and the normal force R_x (P,) [N] of the ring of winding j and twist m (docs/closed.md,
+    section 1b): phi_k = 2 pi m k/n, R_x = (c2^2/(h h_1)) sin(2 pi j/n) sin(2 pi m/n); zero without twist."""
+    lengths = np.atleast_2d(np.asarray(lengths, dtype=float))
+    P, n = lengths.shape
+    phi = np.broadcast_to(2.0 * np.pi * float(m) * np.arange(1, n + 1) / n, (P, n)).copy()
+    force = np.asarray(c2sq, dtype=float) / (np.asarray(h, dtype=float) * lengths[:, 0]) * np.sin(2 * np.pi * j / n) * np.sin(2 * np.pi * m / n)
+    return phi, np.broadcast_to(force, (P,)).copy()
+
+
 def _ring(lengths, c1sq, h, j):
     """(27): theta_k = 2 pi j k / n, R = 0; closes iff sum h_k exp(2 pi i j k / n) = 0."""
     P, n = lengths.shape

@@ -40,6 +40,7 @@ working precision is global, so every proof holds ``_LOCK`` while it sets it.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 import threading
@@ -49,6 +50,8 @@ from dataclasses import dataclass
 import flint
 import numpy as np
 from flint import arb, arb_mat, fmpq, fmpq_mat, fmpq_poly, fmpz_poly
+
+from . import space
 
 # Values of the provenance flag ``decided_by`` (outputs.DECIDED_BY gives their meanings).
 BY_BALLS = 0  # existence exactly, index and nullity in ball arithmetic from the closed form
@@ -65,12 +68,18 @@ _LOCK = threading.RLock()
 
 @dataclass(frozen=True)
 class Verdict:
-    """What is proved about one point: existence (1, 0, or -1 undecided), index and nullity (-1: not known)."""
+    """What is proved about one point: existence (1, 0, or -1 undecided), index and nullity (-1: not known).
+
+    The functions of this module prove the planar block (index and nullity in the plane); ``space_proofs`` adds
+    the out-of-plane block and keeps the planar counts in ``planar_index`` and ``planar_nullity``.
+    """
 
     exists: int
     index: int
     nullity: int
     decided_by: int
+    planar_index: int = -1
+    planar_nullity: int = -1
 
     @property
     def proved(self) -> bool:
@@ -78,6 +87,7 @@ class Verdict:
 
 
 ABSENT_VERDICT = Verdict(0, -1, -1, BY_EXACT)
+UNDECIDED_VERDICT = Verdict(-1, -1, -1, UNDECIDED)
 
 
 @contextmanager
@@ -199,18 +209,29 @@ def hessian_and_rows(c, s, rho, lengths, loop_of):
 def ball_inertia(H, rows) -> tuple[int, int] | None:
     """Index and nullity (0) of H on null(rows) with the rotation taken out, proved in balls; None: not decided.
 
-    ``H`` and ``rows`` hold arbs at the current precision.  The bordered matrix K = [[H, A^T], [A, 0]] with A the
-    closure rows (each loop's divided by its length scale) and the rotation row is brought by the congruence
-    M = V^T K V (V: eigenvectors of K's midpoint, largest |eigenvalue| first) to nearly diagonal form; the
-    pivots of M's LDL^T in balls give K's inertia when none holds 0 (module docstring).
+    ``H`` and ``rows`` (the closures) hold arbs at the current precision; each closure row is scaled by a double
+    near 1 / its size (any nonzero scale keeps null(A) and conditions K) and the rotation row is added.
     """
     n = len(H)
-    inv_sqrt_n = 1.0 / math.sqrt(n)
     A = []
-    for row in rows:  # any nonzero scale keeps null(A): doubles near 1 / (the row's size) condition K
+    for row in rows:
         size = max(abs(float(x)) for x in row) or 1.0
         A.append([x * (1.0 / size) for x in row])
-    A.append([arb(inv_sqrt_n)] * n)
+    A.append([arb(1.0 / math.sqrt(n))] * n)
+    return bordered_inertia(H, A)
+
+
+def bordered_inertia(H, A) -> tuple[int, int] | None:
+    """Index and nullity (0) of H on null(A), proved in balls from the bordered matrix K = [[H, A^T], [A, 0]];
+    None: not decided (module docstring).
+
+    K is brought by the congruence M = V^T K V (V: eigenvectors of K's midpoint, largest |eigenvalue| first) to
+    nearly diagonal form.  When every Gershgorin interval of M excludes 0, the intervals left and right of 0 are
+    disjoint and each holds as many eigenvalues as it has centres (shrink M's off-diagonal part to 0: no
+    eigenvalue crosses 0), so K has as many negative eigenvalues as M has negative diagonal entries.  Otherwise
+    the pivots of M's LDL^T in balls decide when none holds 0 (Sylvester's law of inertia).
+    """
+    n = len(H)
     m = len(A)
     N = n + m
     zero = arb(0)
@@ -228,8 +249,39 @@ def ball_inertia(H, rows) -> tuple[int, int] | None:
     V = V[:, np.argsort(-np.abs(lam), kind="stable")]
     Vb = arb_mat(V.tolist())
     a = (Vb.transpose() * arb_mat(K) * Vb).tolist()
+    negative = _gershgorin_negatives(a)
+    if negative is None:
+        negative = _ldl_negatives(a)
+    if negative is None:
+        return None
+    index = negative - m
+    if index < 0 or N - negative - m < 0:  # Haynsworth: K has at least m eigenvalues of each sign
+        raise ArithmeticError(f"inertia of the bordered matrix ({N - negative}, {negative}) has fewer than m = {m} of one sign")
+    return index, 0
+
+
+def _gershgorin_negatives(a) -> int | None:
+    """The number of negative eigenvalues of the symmetric ball matrix ``a`` when its Gershgorin intervals all
+    exclude 0; None otherwise."""
     negative = 0
-    for k in range(N):  # LDL^T without pivoting, lower triangle; a[i][k] keeps L_ik d_k
+    N = len(a)
+    for i in range(N):
+        radius = sum((abs(a[i][j]) for j in range(N) if j != i), arb(0))
+        if a[i][i] - radius > 0:
+            continue
+        if a[i][i] + radius < 0:
+            negative += 1
+            continue
+        return None
+    return negative
+
+
+def _ldl_negatives(a) -> int | None:
+    """The negative pivots of the LDL^T of the ball matrix ``a`` (no pivoting, lower triangle, in place); None when
+    a pivot ball holds 0."""
+    N = len(a)
+    negative = 0
+    for k in range(N):  # a[i][k] keeps L_ik d_k
         d = a[k][k]
         if d < 0:
             negative += 1
@@ -241,25 +293,23 @@ def ball_inertia(H, rows) -> tuple[int, int] | None:
                 return None
             for j in range(k + 1, i + 1):
                 a[i][j] = a[i][j] - f * a[j][k]
-    index = negative - m
-    if index < 0 or N - negative - m < 0:  # Haynsworth: K has at least m eigenvalues of each sign
-        raise ArithmeticError(f"inertia of the bordered matrix ({N - negative}, {negative}) has fewer than m = {m} of one sign")
-    return index, 0
+    return negative
 
 
-def exact_inertia(H, rows) -> tuple[int, int]:
-    """Index and nullity, in exact rational arithmetic, of H on null(rows) with the rotation taken out; the rows
-    lost to dependence (a folded loop) are added to the nullity."""
+def exact_inertia(H, rows, symmetries=None) -> tuple[int, int]:
+    """Index and nullity, in exact rational arithmetic, of H on null(rows) with the symmetries taken out (default:
+    the plane's rotation, a row of ones); the closure rows lost to dependence (a folded loop) are added to the
+    nullity."""
     n = len(H)
-    A = fmpq_mat([list(r) for r in rows] + [[fmpq(1)] * n])
-    m = A.nrows()
-    rank = A.rank()
+    symmetries = [[fmpq(1)] * n] if symmetries is None else [list(r) for r in symmetries]
+    A = fmpq_mat([list(r) for r in rows] + symmetries)
+    lost = len(rows) - fmpq_mat([list(r) for r in rows]).rank()  # symmetries lie in null(rows): ranks add
     numer, _ = A.numer_denom()
     X, dim = numer.nullspace()
-    if dim != n - rank:
+    if dim != n - A.rank():
         raise ArithmeticError("null space of the closure rows has the wrong dimension")
     if dim == 0:
-        return 0, m - rank
+        return 0, lost
     Z = fmpq_mat([[X[i, k] for k in range(dim)] for i in range(n)])
     R = Z.transpose() * fmpq_mat(H) * Z
     coeffs = [fmpq(x) for x in R.charpoly().coeffs()]  # ascending; the roots are R's eigenvalues, all real
@@ -268,7 +318,7 @@ def exact_inertia(H, rows) -> tuple[int, int]:
     positive = _sign_changes(coeffs)
     if zeros + negative + positive != dim:
         raise ArithmeticError("Descartes' count does not add up: the characteristic polynomial is not real-rooted")
-    return negative, zeros + (m - rank)
+    return negative, zeros + lost
 
 
 def _sign_changes(coeffs) -> int:
@@ -401,9 +451,10 @@ def krawczyk(theta, rho, lengths, loop_of, bits: int):
     return theta_b, rho_b
 
 
-def prove_equilibrium(theta, rho, lengths, loop_of) -> Verdict:
+def prove_equilibrium(theta, rho, lengths, loop_of, gamma=None) -> Verdict:
     """The verdict of an equilibrium known only approximately: ``theta`` (n,) [rad] and ``rho`` (L, 2) = R h / c1^2
-    [1/m] at exact ``lengths`` (doubles); existence by Krawczyk, inertia in balls; undecided if either fails."""
+    [1/m] at exact ``lengths`` (doubles); existence by Krawczyk, inertia in balls; undecided if either fails.
+    With ``gamma`` (c2^2/c1^2, exact) the out-of-plane block is proved over the same box (``in_space``)."""
     found = False
     for bits in PRECISIONS:
         with precision(bits):
@@ -414,10 +465,43 @@ def prove_equilibrium(theta, rho, lengths, loop_of) -> Verdict:
             th, rh = box
             c = [t.cos() for t in th]
             s = [t.sin() for t in th]
-            inertia = ball_inertia(*hessian_and_rows(c, s, rh, [arb(float(v)) for v in lengths], loop_of))
-        if inertia is not None:
-            return Verdict(1, inertia[0], inertia[1], BY_INTERVAL_NEWTON)
+            hk = [arb(float(v)) for v in lengths]
+            inertia = ball_inertia(*hessian_and_rows(c, s, rh, hk, loop_of))
+            out = None if inertia is None or gamma is None else out_of_plane_inertia(c, s, rh, hk, loop_of, arb(gamma))
+        if inertia is not None and (gamma is None or out is not None):
+            planar = Verdict(1, inertia[0], inertia[1], BY_INTERVAL_NEWTON)
+            return planar if gamma is None else in_space(planar, out)
     return Verdict(1 if found else -1, -1, -1, UNDECIDED)
+
+
+# ------------------------------------------------------------------------------------------------------ in space
+def scaled_rows(rows):
+    """Each row times a double near 1 / its size: the same null space, a better conditioned bordered matrix."""
+    return [[x * (1.0 / (max(abs(float(v)) for v in row) or 1.0)) for x in row] for row in rows]
+
+
+def out_of_plane_inertia(c, s, rho, lengths, loop_of, gamma) -> tuple[int, int] | None:
+    """Index and nullity (0) of the out-of-plane block (``space.out_of_plane``) on its closures with the two
+    rotations and the spin taken out, proved in balls; None: not decided."""
+    H, closures, symmetries = space.out_of_plane(c, s, rho, lengths, loop_of, gamma)
+    return bordered_inertia(H, scaled_rows(closures + symmetries))
+
+
+def planar_only(planar: Verdict) -> Verdict:
+    """The planar model's verdict: the planar counts are the label's (the chain confined to its plane)."""
+    return Verdict(planar.exists, planar.index, planar.nullity, planar.decided_by, planar.index, planar.nullity)
+
+
+def in_space(planar: Verdict, out: tuple[int, int] | None, exact: bool = False) -> Verdict:
+    """The verdict in space from the planar one and the out-of-plane (index, nullity): the counts add up (the
+    reflection through the plane splits the Hessian).  ``out`` None: undecided.  A ring's planar proof by
+    structure becomes a proof in balls (the out-of-plane block was proved in balls) unless ``exact``."""
+    if planar.exists != 1 or planar.decided_by == UNDECIDED:
+        return planar_only(planar)
+    if out is None:
+        return Verdict(1, -1, -1, UNDECIDED, planar.index, planar.nullity)
+    by = BY_BALLS if planar.decided_by == BY_STRUCTURE and not exact else planar.decided_by
+    return Verdict(1, planar.index + out[0], planar.nullity + out[1], by, planar.index, planar.nullity)
 
 
 # ---------------------------------------------------------------------------------------------------------- batches
@@ -430,50 +514,16 @@ class Verdicts:
     index: np.ndarray
     nullity: np.ndarray
     decided_by: np.ndarray
+    planar_index: np.ndarray
+    planar_nullity: np.ndarray
 
     @staticmethod
     def of(verdicts: list[Verdict]) -> Verdicts:
-        return Verdicts(
-            np.array([v.exists for v in verdicts], dtype=np.int8).reshape(-1),
-            np.array([v.index for v in verdicts], dtype=np.int16).reshape(-1),
-            np.array([v.nullity for v in verdicts], dtype=np.int16).reshape(-1),
-            np.array([v.decided_by for v in verdicts], dtype=np.int8).reshape(-1),
-        )
+        def field(name, dtype):
+            return np.array([getattr(v, name) for v in verdicts], dtype=dtype).reshape(-1)
 
+        return Verdicts(field("exists", np.int8), field("index", np.int16), field("nullity", np.int16),
+                        field("decided_by", np.int8), field("planar_index", np.int16), field("planar_nullity", np.int16))
 
-def prove_lengths(fam, j: int, lengths, guess=None) -> Verdict:
-    """The verdict of family ``fam`` (a ``families.Family``) at explicit ``lengths`` (doubles, exact).
-
-    ``guess()`` gives (theta, rho) of the floating-point closed form, for lengths that follow the family's pattern
-    only to rounding (then no closed form holds exactly and the Krawczyk operator proves the equilibrium).
-    """
-    q = [exact(v) for v in lengths]
-    n = len(q)
-    if fam.pattern is None:
-        return prove_ring(q, j)
-    loop_of = [int(v) for v in fam.loop_of(n)]
-    r = pattern_ratio(q, fam.pattern)
-    if r is not None:
-        return prove_pattern(fam.name, r, fam.pattern, loop_of)
-    if ratio_hull_absent(fam.name, q, fam.pattern):
-        return ABSENT_VERDICT
-    theta, rho = guess() if guess is not None else (None, None)
-    if theta is None or not (np.isfinite(theta).all() and np.isfinite(rho).all()):
-        return Verdict(-1, -1, -1, UNDECIDED)
-    return prove_equilibrium(theta, rho, lengths, loop_of)
-
-
-def prove_ratios(fam, n: int, j: int, ratio: np.ndarray) -> Verdicts:
-    """The verdicts of family ``fam`` at the ratios h2/h1 (doubles, exact) of its pattern: one proof per value."""
-    ratio = np.asarray(ratio, dtype=float).reshape(-1)
-    values, inverse = np.unique(ratio, return_inverse=True)
-    loop_of = [int(v) for v in fam.loop_of(n)]
-    out = []
-    for r in values.tolist():
-        q = exact(r)
-        if fam.pattern is None:
-            out.append(prove_ring([fmpq(1) if k % 2 == 0 else q for k in range(n)], j))
-        else:
-            out.append(prove_pattern(fam.name, q, fam.pattern, loop_of))
-    v = Verdicts.of(out)
-    return Verdicts(v.exists[inverse], v.index[inverse], v.nullity[inverse], v.decided_by[inverse])
+    def take(self, at) -> Verdicts:
+        return Verdicts(*(getattr(self, f.name)[at] for f in dataclasses.fields(self)))

@@ -27,10 +27,13 @@ PARAMETERS = {
     "n": Parameter("n", "1", "number of bodies of the ring", 3.0, False),
     "j": Parameter("j", "1", "winding number of the ring", 1.0, False),
     "c1sq": Parameter("c_1^2", "N m2", "bending stiffness c1^2 of the joints", 0.0, True),
+    "c2sq": Parameter("c_2^2", "N m2", "torsional stiffness c2^2 of the joints (default c1^2)", 0.0, True),
+    "twist": Parameter("m", "1", "twist of the ring: turns m of the bodies' frames about their axes around the ring", 0.0, False),
     "h": Parameter("h", "m", "step h of the discrete curvature", 0.0, True),
 }
-_KEYS = {"title", "family", "lengths", "ratio", "h1", "n", "j", "c1sq", "h", "grid"}
-_RING_ONLY = ("n", "j")
+_KEYS = {"title", "family", "model", "lengths", "ratio", "h1", "n", "j", "twist", "c1sq", "c2sq", "h", "grid"}
+_RING_ONLY = ("n", "j", "twist")
+MODELS = ("spatial", "planar")
 _PATTERN_ONLY = ("ratio", "h1", "n")  # names that build the lengths: not with explicit lengths
 
 
@@ -41,18 +44,25 @@ class Scene(SceneBase):
     Lengths are either ``lengths`` (h_1..h_n [m], in the family's pattern) or built from ``h1`` [m] (default 1)
     and ``ratio`` = h2/h1 (default 1 for the ring, whose pattern alternates h1, h2).  ``n`` (ring only) is the
     number of bodies; ``j`` (ring only, default 1) its winding; ``c1sq`` (default 1) the bending stiffness c1^2 [N m^2];
-    ``h`` (default min h_k at each point) the step of the discrete curvature.
+    ``h`` (default min h_k at each point) the step of the discrete curvature; ``c2sq`` (default c1^2 at each
+    point) the torsional stiffness c2^2 [N m^2]; ``twist`` (ring only, default 0) the ring's twist m, whole turns
+    of the bodies' frames about their axes around the ring (equal lengths only).  ``model`` is "spatial" (the
+    default: stability against every motion, out of the plane and twist included) or "planar" (the chain
+    confined to its plane, the paper's section 3).
     """
 
     system: ClassVar[str] = "closed"
 
     family: str = "ring"
+    model: str = "spatial"
     lengths: tuple[float, ...] = ()
     ratio: float | None = None
     h1: float | None = None
     n: int | None = None
     j: int | None = None
+    twist: int | None = None
     c1sq: float | None = None
+    c2sq: float | None = None
     h: float | None = None
     title: str = ""
     grid: tuple[Axis, ...] = field(default=())
@@ -67,6 +77,10 @@ class Scene(SceneBase):
     @property
     def ring(self) -> bool:
         return self.family == "ring"
+
+    @property
+    def spatial(self) -> bool:
+        return self.model == "spatial"
 
     def axis(self, name: str) -> np.ndarray | None:
         for a in self.grid:
@@ -95,9 +109,11 @@ class Scene(SceneBase):
 
     def to_dict(self) -> dict:
         out = {"title": self.title, "family": self.family}
+        if self.model != "spatial":
+            out["model"] = self.model
         if self.lengths:
             out["lengths"] = list(self.lengths)
-        for key in ("ratio", "h1", "n", "j", "c1sq", "h"):
+        for key in ("ratio", "h1", "n", "j", "twist", "c1sq", "c2sq", "h"):
             if getattr(self, key) is not None:
                 out[key] = getattr(self, key)
         if self.grid:
@@ -110,7 +126,8 @@ def _parameter(name: str, family: str, explicit: bool) -> Parameter:
         raise StabmapError(f"unknown parameter name {name!r}; a closed chain scans {', '.join(PARAMETERS)}")
     if name in _RING_ONLY and family != "ring":
         n = FAMILIES[family].n
-        raise StabmapError(f"grid axis {name!r} applies to family = \"ring\" only; family {family!r} has n = {n} bodies and no winding")
+        what = "no twisted equilibrium (twist applies to rings)" if name == "twist" else "no winding"
+        raise StabmapError(f"grid axis {name!r} applies to family = \"ring\" only; family {family!r} has n = {n} bodies and {what}")
     if name in _PATTERN_ONLY and explicit:
         raise StabmapError(f"grid axis {name!r} builds the lengths from the family's pattern; remove lengths = [...] to scan it")
     return PARAMETERS[name]
@@ -125,7 +142,7 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
     if not isinstance(lengths, list):
         raise StabmapError(f"lengths must be a list of lengths h_1..h_n [m], e.g. lengths = [1.0, 0.5, 1.0, 0.5]; got {lengths!r}")
     grid = parse_axes(data.get("grid", {}), lambda name: _parameter(name, family, bool(lengths)))
-    scalars = {k: data[k] for k in ("title", "ratio", "h1", "n", "j", "c1sq", "h") if k in data}
+    scalars = {k: data[k] for k in ("title", "model", "ratio", "h1", "n", "j", "twist", "c1sq", "c2sq", "h") if k in data}
     return Scene(family=family, lengths=tuple(lengths), grid=grid, **scalars)
 
 
@@ -139,7 +156,10 @@ def fixed_values(scene: Scene, all_names: bool = False) -> dict[str, float]:
         if scene.n is not None or scene.lengths:
             out["n"] = float(len(scene.lengths) if scene.lengths else scene.n)
         out["j"] = float(1 if scene.j is None else scene.j)
+        out["twist"] = float(0 if scene.twist is None else scene.twist)
     out["c1sq"] = 1.0 if scene.c1sq is None else scene.c1sq
+    if scene.c2sq is not None:
+        out["c2sq"] = scene.c2sq
     if scene.h is not None:
         out["h"] = scene.h
     if all_names:
@@ -156,6 +176,9 @@ def _validate(scene: Scene) -> None:
         object.__setattr__(scene, name, value)
 
     fam = checks.family(scene.family)
+    if scene.model not in MODELS:
+        raise StabmapError(f"model = {scene.model!r}: choose \"spatial\" (stability against every motion, the default) or \"planar\" "
+                           "(the chain confined to its plane)")
     if not isinstance(scene.title, str):
         raise StabmapError(f"title must be a string, got {scene.title!r}")
     put("grid", tuple(scene.grid))
@@ -165,7 +188,7 @@ def _validate(scene: Scene) -> None:
             if getattr(scene, key) is not None:
                 raise StabmapError(f"{key}: give either lengths = [...] or h1, ratio (and the ring's n), not both; remove {key}")
         put("lengths", tuple(checks.lengths(fam, scene.lengths).tolist()))
-    for key in ("ratio", "h1", "c1sq", "h"):
+    for key in ("ratio", "h1", "c1sq", "c2sq", "h"):
         if getattr(scene, key) is not None:
             put(key, check_value(key, getattr(scene, key), PARAMETERS[key]))
     for key in _RING_ONLY:
@@ -177,12 +200,14 @@ def _validate(scene: Scene) -> None:
         put("n", checks.whole("n", scene.n, 3))
     if scene.j is not None:
         put("j", checks.whole("j", scene.j, 1))
+    if scene.twist is not None:
+        put("twist", checks.whole("twist", scene.twist, 0))
     check_axes(scene.grid, scene.parameter)
     names = {a.name for a in scene.grid}
     for key in _RING_ONLY:
         if key in names:
             for i, v in enumerate(scene.axis(key)):
-                checks.whole(f"grid.{key}.values[{i + 1}]", v, 3 if key == "n" else 1)
+                checks.whole(f"grid.{key}.values[{i + 1}]", v, {"n": 3, "j": 1, "twist": 0}[key])
     if scene.ring and not explicit and scene.n is None and "n" not in names:
         raise StabmapError("n is missing: a ring needs its number of bodies; set n = 6 (say), scan n in [grid], or give lengths = [...]")
     if scene.ratio is None and not explicit and not scene.ring and "ratio" not in names:
@@ -190,14 +215,18 @@ def _validate(scene: Scene) -> None:
             f"ratio is missing: family {fam.name!r} has lengths {checks.pattern_text(fam)}; set ratio = h2/h1, scan it in [grid], "
             "or give lengths = [...]"
         )
-    for key in ("n", "j"):
+    for key in ("n", "j", "twist"):
         if key in names and getattr(scene, key) is not None:
             raise StabmapError(f"{key} is both fixed and a grid axis; remove one of them")
-    for key in ("ratio", "h1", "c1sq", "h"):
+    for key in ("ratio", "h1", "c1sq", "c2sq", "h"):
         if key in names and getattr(scene, key) is not None:
             raise StabmapError(f"{key} is both fixed and a grid axis; remove one of them")
     if scene.ring:
         _check_windings(scene)
+        _check_twist(scene)
+    if not scene.spatial and "c2sq" in names:
+        raise StabmapError("grid axis 'c2sq' with model = \"planar\": the torsional stiffness acts out of the plane only; "
+                           "remove the axis or use model = \"spatial\"")
     _check_closing(scene)
 
 
@@ -208,6 +237,24 @@ def _check_windings(scene: Scene) -> None:
     if scene.axis("n") is not None:
         where += f" (with the grid's smallest n = {n_min})"
     checks.winding(int(j.max()), n_min, where)
+
+
+def _check_twist(scene: Scene) -> None:
+    """A twisted ring needs equal lengths (its closing force is normal to the plane and balances only equal
+    bodies), space, and a twist of less than half a turn per joint."""
+    twist = scene.values_of("twist")
+    if not twist.max():
+        return
+    where = "grid.twist" if scene.axis("twist") is not None else "twist"
+    if not scene.spatial:
+        raise StabmapError(f"{where} = {int(twist.max())} with model = \"planar\": a twisted ring is an equilibrium in space only; "
+                           "remove twist or use model = \"spatial\"")
+    lengths = np.asarray(scene.lengths) if scene.lengths else None
+    ratios = scene.values_of("ratio") if lengths is None else None
+    if (lengths is not None and (lengths != lengths[0]).any()) or (ratios is not None and (ratios != 1.0).any()):
+        raise StabmapError(f"{where} = {int(twist.max())}: a twisted ring needs equal lengths (ratio = 1, or equal lengths = [...]); "
+                           "unequal bodies do not balance its normal force. Set ratio = 1 or remove twist")
+    checks.twist(int(twist.max()), int(scene.n_values.min()), where)
 
 
 def _check_closing(scene: Scene) -> None:
@@ -237,6 +284,8 @@ def point_values(scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.nd
             out[name] = np.broadcast_to(np.asarray(values[name], dtype=float), shape).ravel()
         elif name in fixed:
             out[name] = np.full(int(np.prod(shape, dtype=np.int64)), float(fixed[name]))
+    if "c2sq" not in out:  # the default torsional stiffness: c1^2 at each point, where the paper's law has an energy
+        out["c2sq"] = out["c1sq"]
     return out
 
 

@@ -20,11 +20,15 @@ The method (docs/closed.md, "search"):
    angles equal to 1e-7).
 5. **Proof.** Each shape kept is proved (``proofs.prove_equilibrium``): the Krawczyk operator on the general
    equations in ball arithmetic shows a unique equilibrium in a small box around it, and the inertia of the
-   constrained Hessian over that box is proved in balls (``decided_by = "interval_newton"``).  A shape for which
+   constrained Hessian over that box is proved in balls (``decided_by = "interval_newton"``): in the plane and,
+   with the default ``model = "spatial"``, out of it (the planar shape is an equilibrium in space too: the
+   reflection through its plane maps it onto itself), so each shape carries its class in space and in the plane.  A shape for which
    either fails is still listed, flagged: ``decided_by = "undecided"``, stability ``"undecided"`` (and
    ``exists = None`` when the Krawczyk test failed).
 
 Nothing guarantees that every equilibrium is found: more ``starts`` find more of those with small basins.
+Only planar equilibria are searched for: non-planar ones (which may branch off where a planar one loses
+stability out of its plane) are not.
 """
 
 from __future__ import annotations
@@ -34,9 +38,9 @@ import math
 import numpy as np
 from scipy.optimize import root
 
-from . import equations, proofs
+from . import equations, proofs, space_proofs
 from .checks import can_close, positive
-from .solve import Equilibrium, equilibrium
+from .solve import Equilibrium, _scalars, equilibrium, model_of
 
 RESIDUAL = 1e-12
 REGULAR = 1e-10
@@ -123,15 +127,17 @@ def _same(a: Equilibrium, b: Equilibrium) -> bool:
     return False
 
 
-def search(lengths, *, c1sq: float = 1.0, h: float | None = None, starts: int | None = None, seed: int = 0) -> list[Equilibrium]:
-    """Every isolated planar equilibrium of the plain closed chain with ``lengths`` that the multi-start finds.
+def search(lengths, *, c1sq: float = 1.0, c2sq: float | None = None, h: float | None = None, starts: int | None = None, seed: int = 0,
+           model: str = "spatial") -> list[Equilibrium]:
+    """Every isolated planar equilibrium of the plain closed chain with ``lengths`` that the multi-start finds,
+    with its stability in space (``model = "spatial"``, the default; ``c2sq`` defaults to c1sq) and in the plane.
 
     Parameters
     ----------
     lengths : sequence of float
         h_1..h_n [m], n >= 4 (three bodies are rigid: only their triangle), positive and closable.
-    c1sq, h : float
-        As for ``solve`` (they scale forces and energy only).
+    c1sq, c2sq, h, model
+        As for ``solve``.
     starts : int, optional
         Number of starts (default 60 n).
     seed : int
@@ -150,8 +156,8 @@ def search(lengths, *, c1sq: float = 1.0, h: float | None = None, starts: int | 
 
         raise StabmapError(f"lengths: a closed chain needs at least 3 bodies, got {h_k.size}")
     can_close(h_k)
-    c1sq = positive("c1sq", c1sq)
-    h = float(h_k.min()) if h is None else positive("h", h)
+    c1sq, h, c2sq = _scalars(h_k, c1sq, h, c2sq)
+    gamma = space_proofs.gamma_of(c1sq, c2sq) if model_of(model) else None
     n = h_k.size
     starts = 60 * n if starts is None else int(starts)
     rho_scale = 1.0 / h_k.mean()  # forces in units of c1^2 / (h mean h_k): unknowns of order one
@@ -181,6 +187,7 @@ def search(lengths, *, c1sq: float = 1.0, h: float | None = None, starts: int | 
         found.append(eq)
     proved = []
     for eq in found:  # each kept shape proved: Krawczyk on the general equations, then its inertia in balls
-        verdict = proofs.prove_equilibrium(eq.theta, eq.forces * (h / c1sq), h_k, loop_of)
-        proved.append(equilibrium("found", h_k, eq.theta, eq.forces, verdict, loop_of, c1sq, h))
+        verdict = proofs.prove_equilibrium(eq.theta, eq.forces * (h / c1sq), h_k, loop_of, gamma)
+        verdict = proofs.planar_only(verdict) if gamma is None else verdict
+        proved.append(equilibrium("found", h_k, eq.theta, eq.forces, verdict, loop_of, c1sq, h, c2sq=c2sq, model=model))
     return sorted(proved, key=lambda e: (e.energy, e.index))
