@@ -1,11 +1,14 @@
-"""Closed chains of elastic joints (docs/closed.md): the planar equilibria of a closed rod of n bodies, their
-forces and their stability, from Bolgrabskaya, Savchenko and Shchepin (2006), as restated and corrected in docs/closed.md.
+"""Closed chains of elastic joints (docs/closed.md): the planar and twisted equilibria of a closed rod of n bodies,
+their forces and their stability in space (and in their plane), from Bolgrabskaya, Savchenko and Shchepin (2006), as
+restated, corrected and extended in docs/closed.md.
 
 The pipeline's part of this system is the ``System`` below; the physics is in the modules beside it:
 
 - ``families``: the named families (ring, figure-eights, hinges) and their closed forms;
 - ``equations``: the general equilibrium equations, energy, constrained Hessian, rotation index;
-- ``proofs``: the proof of every label (exact rational and ball arithmetic, python-flint), or the flag undecided;
+- ``space``: the joint energy in space, the out-of-plane block and the spatial Hessian (twisted rings);
+- ``proofs``: the proof of the planar labels (exact rational and ball arithmetic, python-flint) and of the
+  inertia of any bordered Hessian, or the flag undecided; ``space_proofs``: the labels in space, per point batch;
 - ``decide``: a batch of configurations and their proofs -> every output (shared by atlases and ``solve``);
 - ``solve`` and ``search``: the Python API (``stabmap.closed``);
 - ``checks``, ``scene``: what an input must satisfy, and the scene files;
