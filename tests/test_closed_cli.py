@@ -179,6 +179,16 @@ BAD = [
     ('family = "hinge"\n[grid]\nn = { values = [6] }', "grid axis 'n' applies to family = \"ring\" only"),
     ('family = "ring"\nlengths = [1.0, 1.0, 1.0, 1.0]\n[grid]\nratio = { values = [1, 2] }', "remove lengths"),
     ('family = "ring"\nn = 6\nwinding = 2', "unknown key 'winding'"),
+    # in space (docs/closed.md, section 1b)
+    ('family = "figure-eight-6"\nratio = 7\nc2sq = -1', "c2sq must be > 0"),
+    ('family = "hinge"\nratio = 1.2\ntwist = 1', 'twist applies to family = "ring" only'),
+    ('family = "hinge"\nratio = 1.2\n[grid]\ntwist = { values = [0, 1] }', "grid axis 'twist' applies to family = \"ring\" only"),
+    ('family = "ring"\nn = 8\nratio = 2\ntwist = 1', "a twisted ring needs equal lengths"),
+    ('family = "ring"\nn = 8\ntwist = 4', "twist = 4 is out of range"),
+    ('family = "ring"\nn = 8\ntwist = 1\nmodel = "planar"', "equilibrium in space only"),
+    ('family = "ring"\nn = 8\nmodel = "flat"', "model = 'flat'"),
+    ('family = "ring"\nn = 8\nmodel = "planar"\n[grid]\nc2sq = { values = [1, 2] }', "acts out of the plane only"),
+    ('family = "ring"\nn = 8\n[grid]\nc2sq = { values = [0, 2] }', r"grid.c2sq"),
 ]
 
 

@@ -211,32 +211,6 @@ def test_the_planar_model_is_the_papers():
 
 
 # ------------------------------------------------------------------------------------------------- bad input
-BAD = [
-    ('family = "figure-eight-6"\nratio = 7\nc2sq = -1', "c2sq must be > 0"),
-    ('family = "hinge"\nratio = 1.2\ntwist = 1', 'twist applies to family = "ring" only'),
-    ('family = "hinge"\nratio = 1.2\n[grid]\ntwist = { values = [0, 1] }', "grid axis 'twist' applies to family = \"ring\" only"),
-    ('family = "ring"\nn = 8\nratio = 2\ntwist = 1', "a twisted ring needs equal lengths"),
-    ('family = "ring"\nn = 8\ntwist = 4', "twist = 4 is out of range"),
-    ('family = "ring"\nn = 8\ntwist = 1\nmodel = "planar"', "equilibrium in space only"),
-    ('family = "ring"\nn = 8\nmodel = "flat"', "model = 'flat'"),
-    ('family = "ring"\nn = 8\nmodel = "planar"\n[grid]\nc2sq = { values = [1, 2] }', "acts out of the plane only"),
-    ('family = "ring"\nn = 8\n[grid]\nc2sq = { values = [0, 2] }', r"grid.c2sq"),
-]
-
-
-@pytest.mark.parametrize("body, message", BAD)
-def test_bad_spatial_input_is_one_line_exit_2_and_no_file(tmp_path, capsys, body, message):
-    import re
-
-    scene = tmp_path / "bad.toml"
-    scene.write_text('system = "closed"\n' + body + "\n")
-    out = tmp_path / "a.nc"
-    assert main(["atlas", str(scene), "-o", str(out), "-q"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert re.search(message, err) and len(err.splitlines()) == 1, err
-    assert not out.exists() and not list(tmp_path.glob("a.nc*"))
-
-
 @pytest.mark.parametrize("kw, message", [
     ({"c2sq": -1.0}, "c2sq must be > 0"), ({"twist": 1}, "leave twist out"), ({"model": "flat"}, "model = 'flat'"),
 ])
