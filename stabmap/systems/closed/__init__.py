@@ -78,12 +78,18 @@ class Closed(System):
         return {"body": scene.n_max, "loop": len(scene.fam.loops) or 1}
 
     def cost(self, scene: Scene) -> Cost:
-        # Measured on one core (scripts/bench_closed.py): a two-length family costs 0.1-0.15 ms a ratio, almost
-        # all of it the proof in ball arithmetic (proofs.py; points of one ratio share it); a ring 9 us a point
-        # for six bodies, 25 us for fifty (numpy on batches, an exact cyclotomic test per ratio).
+        # Measured on one core (scripts/bench_closed.py, BENCHMARKS.md): in the plane a two-length family costs
+        # 0.1-0.2 ms a ratio, almost all of it the proof in ball arithmetic (points of one ratio share it), a ring
+        # 10-25 us a point (exact, no balls); in space the out-of-plane block adds 3-4x for the families and 0.4 ms
+        # for a ring, and a twisted ring's whole spatial Hessian costs about 0.2 ms n^2.
         n = scene.n_max
-        seconds = 6e-6 + 4e-7 * n if scene.ring else 1.6e-4
-        return Cost(seconds=seconds, bytes=8 * (6 + 2 * n))
+        if not scene.spatial:
+            seconds = 6e-6 + 4e-7 * n if scene.ring else 1.6e-4
+        elif scene.ring:
+            seconds = 2e-4 * n * n if scene.values_of("twist").max() else 4e-4 + 1e-5 * n
+        else:
+            seconds = 5e-4
+        return Cost(seconds=seconds, bytes=8 * (10 + 4 * n))
 
     def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         shape = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()

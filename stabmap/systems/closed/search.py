@@ -40,7 +40,7 @@ from scipy.optimize import root
 
 from . import equations, proofs, space_proofs
 from .checks import can_close, positive
-from .solve import Equilibrium, _scalars, equilibrium, model_of
+from .solve import Equilibrium, scalars, equilibrium, model_of
 
 RESIDUAL = 1e-12
 REGULAR = 1e-10
@@ -156,7 +156,7 @@ def search(lengths, *, c1sq: float = 1.0, c2sq: float | None = None, h: float | 
 
         raise StabmapError(f"lengths: a closed chain needs at least 3 bodies, got {h_k.size}")
     can_close(h_k)
-    c1sq, h, c2sq = _scalars(h_k, c1sq, h, c2sq)
+    c1sq, h, c2sq = scalars(h_k, c1sq, h, c2sq)
     gamma = space_proofs.gamma_of(c1sq, c2sq) if model_of(model) else None
     n = h_k.size
     starts = 60 * n if starts is None else int(starts)

@@ -139,7 +139,7 @@ class Equilibrium:
         )
 
 
-def _scalars(lengths: np.ndarray, c1sq, h, c2sq=None) -> tuple[float, float, float]:
+def scalars(lengths: np.ndarray, c1sq, h, c2sq=None) -> tuple[float, float, float]:
     c1sq = checks.positive("c1sq", c1sq)
     h = float(lengths.min()) if h is None else checks.positive("h", h)
     c2sq = c1sq if c2sq is None else checks.positive("c2sq", c2sq)
@@ -217,7 +217,7 @@ def solve(shape: str, lengths, *, c1sq: float = 1.0, c2sq: float | None = None, 
     """
     fam = checks.family(shape)
     h_k = checks.lengths(fam, lengths)
-    c1sq, h, c2sq = _scalars(h_k, c1sq, h, c2sq)
+    c1sq, h, c2sq = scalars(h_k, c1sq, h, c2sq)
     spatial = model_of(model)
     n = h_k.size
     if fam.name == "ring":

@@ -23,7 +23,7 @@ import numpy as np
 from flint import arb, fmpq
 
 from . import proofs, space
-from .proofs import (ABSENT_VERDICT, BY_BALLS, BY_EXACT, PRECISIONS, UNDECIDED, UNDECIDED_VERDICT, Verdict, Verdicts,
+from .proofs import (ABSENT_VERDICT, BY_BALLS, PRECISIONS, UNDECIDED, UNDECIDED_VERDICT, Verdict, Verdicts,
                      bordered_inertia, exact, exact_inertia, in_space, out_of_plane_inertia, planar_only, precision,
                      scaled_rows)
 
@@ -158,4 +158,4 @@ def prove_lengths(fam, j: int, m: int, lengths, gamma: fmpq | None, guess=None) 
     return planar_only(planar) if gamma is None else planar
 
 
-__all__ = ["BY_EXACT", "gamma_of", "prove_lengths", "prove_ratios"]
+__all__ = ["gamma_of", "prove_lengths", "prove_ratios"]
