@@ -88,7 +88,9 @@ def prove_twisted_ring(n: int, j: int, m: int, gamma: fmpq) -> Verdict:
         with precision(bits):
             quats, rho, _ = space.twisted_ring(n, j, m, arb(gamma), lambda x: x.cos_pi(), lambda x: x.sin_pi(),
                                                lambda a, b: arb(fmpq(a, b)))
-            H, _, closures, symmetries = space.spatial(quats, [arb(1)] * n, rho, arb(gamma))
+            H, g, closures, symmetries = space.spatial(quats, [arb(1)] * n, rho, arb(gamma))
+            if not all(x.contains(0) for x in g):  # the symmetry argument and R_x make g = 0 exactly (docs, section 2b)
+                raise ArithmeticError(f"the twisted ring n = {n}, j = {j}, m = {m} is not stationary in balls: its force is wrong")
             found = bordered_inertia(H, scaled_rows(closures + symmetries))
             planar = _in_plane_restriction(H, closures, quats) if found is not None else None
         if found is not None and planar is not None:
