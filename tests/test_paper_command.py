@@ -17,6 +17,10 @@ def test_closed_and_reactions_agree_with_their_papers_and_draw(tmp_path, capsys)
     out = capsys.readouterr().out
     assert "| closed-hinge | 3 | 3 |" in out and "| closed-figure-eight-6 | 2 | 2 |" in out
     assert "24.525 = G/4, 4" in out and "all agree with the papers" in out
+    # in space, in words: the hinge leaves its plane at (sqrt 17 - 1)/4 (docs/closed.md), the paper's rings
+    assert "- hinge: stable for h2/h1 in [0.05, 0.7807764064]; unstable for h2/h1 in [0.7807764064, 2]" in out
+    assert "plane ring (27), j = 1, equal bodies: stable in space for n = 5, 6," in out
+    assert "twisted ring (26), one turn of twist (m = 1), equal bodies: stable in space for n = 7, 8," in out
     for name in ("closed/closed-hinge", "closed/closed-figure-eight-6", "reactions/reactions-square-plate"):
         assert (tmp_path / f"{name}.png").read_bytes()[:8] == PNG
 

@@ -98,19 +98,20 @@ def in_space() -> list[str]:
 
     lines = []
     for name, family in (("closed-hinge", "hinge"), ("closed-figure-eight-6", "six-body figure-eight")):
-        ds = critical(example(name), "ratio", progress=False)
+        scene = example(name)
+        ds = critical(scene, "ratio", progress=False)
         meaning = _meanings(ds)
-        scan = ds["ratio"].values if "ratio" in ds else None
+        scan = scene.axis("ratio")
         lo, hi = ds["boundary_lower"].values, ds["boundary_upper"].values
         ends = [(a + b) / 2 for a, b in zip(lo, hi) if np.isfinite(a)]
         classes = [meaning.get(int(ds["stability_at_scan_start"]), "?")]
         classes += [meaning.get(int(t), str(t)) for t, a in zip(ds["stability_above"].values, lo) if np.isfinite(a)]
-        start = float(scan[0]) if scan is not None else float(ds.attrs.get("critical_scan_start", np.nan))
-        stops = ends + [float(scan[-1]) if scan is not None else np.nan]
+        start = float(scan[0])
+        stops = ends + [float(scan[-1])]
         stretches = []
         left = start
         for cls, right in zip(classes, stops):
-            stretches.append(f"{cls} for h2/h1 in [{left:.10g}, {right:.10g}]" if right != left else f"{cls} at {right:.10g}")
+            stretches.append(f"{cls} for h2/h1 in [{left:.10g}, {right:.10g}]" if abs(right - left) > 1e-9 * right else f"{cls} at {right:.10g}")
             left = right
         lines.append(f"- {family}: " + "; ".join(stretches) + ".")
     for twist, what in ((0, "plane ring (27), j = 1"), (1, "twisted ring (26), one turn of twist (m = 1)")):
