@@ -96,8 +96,9 @@ def _shim(directory: Path) -> dict:
     dask = bin_dir / "dask"
     dask.write_text(f'#!/bin/sh\nexec "{sys.executable}" -m dask "$@"\n')
     dask.chmod(0o755)
-    python = bin_dir / "python"
-    python.symlink_to(sys.executable)
+    python = bin_dir / "python"  # a script, not a link: a venv's python started through a link outside the venv loses it
+    python.write_text(f'#!/bin/sh\nexec "{sys.executable}" "$@"\n')
+    python.chmod(0o755)
     env = dict(os.environ)
     env["PATH"] = f"{bin_dir}{os.pathsep}{env['PATH']}"
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [env.get("PYTHONPATH")])])
@@ -187,6 +188,16 @@ def test_doc_runs(path, tmp_path, monkeypatch):
 @pytest.mark.parametrize("path", _slow_docs(), ids=lambda p: p.name)
 def test_doc_runs_with_its_slow_blocks(path, tmp_path, monkeypatch):
     run_doc(path, tmp_path, monkeypatch, slow=True)
+
+
+def test_the_shims_python_is_this_interpreter_with_its_packages(tmp_path):
+    """The docs' ``python`` is this interpreter with its environment: inside a venv, the venv (a link to the venv's
+    python from another folder would start the base interpreter, without the venv's packages; .ci/run tests in a venv)."""
+    env = _shim(tmp_path)
+    code = "import sys, flint, xarray, matplotlib; print(sys.prefix); print(sys.base_prefix)"
+    done = subprocess.run(["python", "-c", code], env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == [sys.prefix, sys.base_prefix]
 
 
 def test_every_skip_says_why_and_the_readme_keeps_its_first_two_commands():
