@@ -207,3 +207,21 @@ def test_no_time_to_go_before_a_measured_rate(monkeypatch):
     rate.add(100)
     assert rate.per_second() == pytest.approx(100.0)
     assert "300/1,000 points (30.0 %), 100 points/s, about 7 s to go" == rate.text()
+
+
+def test_a_zarr_atlas_opens_in_plain_xarray_without_a_warning(tmp_path):
+    """Zarr atlases carry consolidated metadata (issue 30): xr.open_zarr reads them quietly, with the same values."""
+    import warnings
+
+    import xarray as xr
+
+    import stabmap
+    from stabmap.store.files import write_atlas
+
+    scene = stabmap.loads_scene('system = "closed"\nfamily = "hinge"\n[grid]\nratio = { values = [0.5, 1.0, 1.5] }\n')
+    ds = stabmap.compute_atlas(scene, threads=1, progress=False)
+    path = write_atlas(ds, tmp_path / "a.zarr")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with xr.open_zarr(path) as back:
+            assert back["stability"].values.tolist() == ds["stability"].values.tolist()

@@ -98,11 +98,42 @@ def test_bad_input_names_the_key(text, message):
 
 
 def test_free_support_rejects_base_and_gravity_axes():
-    free = GOOD.replace('support = "fixed"', 'support = "free"')
+    free = GOOD.replace('support = "fixed"', 'support = "free"').replace("g = 9.81\n", "")
     with pytest.raises(StabmapError, match="K_0"):
         loads_scene(free.replace("joints = [120.0]", "joints = [120.0]\nK_0 = 1.0"))
     with pytest.raises(StabmapError, match="'g' has no effect"):
         loads_scene(free.replace("[grid]", "[grid]\ng = { values = [1.0, 2.0] }"))
+
+
+def test_free_support_rejects_gravity_as_it_rejects_a_base_joint():
+    """g has no torque about a free system's centre of mass: given, it is an error (issue 30), not silently ignored."""
+    free = GOOD.replace('support = "fixed"', 'support = "free"')
+    for text in (free, free.replace("g = 9.81", "g = 3.7")):
+        with pytest.raises(StabmapError, match=r"^g: gravity exerts no torque about a free system's centre of mass"):
+            loads_scene(text)
+    scene = loads_scene(free.replace("g = 9.81\n", ""))
+    with pytest.raises(StabmapError, match="^g: gravity"):
+        dataclasses.replace(scene, g=1.62)
+
+
+@pytest.mark.parametrize("text, message", [
+    (_replace("m_2 = {", "mm_2 = {"), "unknown parameter name 'mm_2'; did you mean 'm_2'?"),
+    (_replace("K_1 = {", "half_hieght_1 = {"), "unknown parameter name 'half_hieght_1'; did you mean 'half_height_1'?"),
+    ('system = "closed"\nfamily = "hinge"\n[grid]\nratoi = { values = [1, 2] }\n', "unknown parameter name 'ratoi'; did you mean 'ratio'?"),
+    ('system = "reactions"\nnodes = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\n[body]\nmass = 1.0\n[grid]\nmas = { values = [1, 2] }\n',
+     "unknown parameter name 'mas'; did you mean 'mass'?"),
+])
+def test_a_misspelt_grid_axis_gets_a_did_you_mean(text, message):
+    with pytest.raises(StabmapError) as info:
+        loads_scene(text)
+    assert message in str(info.value)
+
+
+def test_one_point_axis_with_a_different_stop_is_an_error():
+    with pytest.raises(StabmapError, match=r"grid.omega: num = 1 gives the one value start = 1 and would ignore stop = 200"):
+        loads_scene(_replace("num = 5", "num = 1"))
+    scene = loads_scene(_replace("omega = { start = 1.0, stop = 200.0, num = 5 }", "omega = { start = 7.0, stop = 7.0, num = 1 }"))
+    assert [a.values for a in scene.grid if a.name == "omega"] == [(7.0,)]
 
 
 def test_missing_scene_file(tmp_path):

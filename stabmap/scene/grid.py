@@ -94,6 +94,9 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
             raise StabmapError(f"{where}.num must be a whole number >= 1, got {num!r}")
         start = check_value(f"{where}.start", spec["start"], info)
         stop = check_value(f"{where}.stop", spec["stop"], info)
+        if num == 1 and stop != start:
+            raise StabmapError(f"{where}: num = 1 gives the one value start = {start:g} and would ignore stop = {stop:g}; "
+                               f"give num >= 2, or values = [{start:g}]")
         scale = spec.get("scale", "linear")
         if scale == "linear":
             values = np.linspace(start, stop, num)

@@ -35,12 +35,17 @@ def check_value(where: str, value, info: Parameter) -> float:
     return value
 
 
+def did_you_mean(name: str, known) -> str:
+    """"did you mean 'x'? " when a known name is close to ``name`` (a misspelling), else ""."""
+    close = difflib.get_close_matches(name, list(known), n=1)
+    return f"did you mean {close[0]!r}? " if close else ""
+
+
 def no_unknown(table, allowed, where: str) -> None:
     """A TOML table with only ``allowed`` keys, or a StabmapError naming the first other one."""
     if not isinstance(table, dict):
         raise StabmapError(f"{where} must be a table, got {table!r}")
     unknown = sorted(set(table) - set(allowed))
     if unknown:
-        close = difflib.get_close_matches(unknown[0], list(allowed), n=1)
-        hint = f"did you mean {close[0]!r}? " if close else ""
-        raise StabmapError(f"{where}: unknown key {unknown[0]!r}; {hint}allowed keys are {', '.join(sorted(allowed))}")
+        raise StabmapError(f"{where}: unknown key {unknown[0]!r}; {did_you_mean(unknown[0], allowed)}allowed keys are "
+                           f"{', '.join(sorted(allowed))}")

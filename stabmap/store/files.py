@@ -6,6 +6,7 @@ import contextlib
 import math
 import os
 import shutil
+import warnings
 from pathlib import Path
 
 import dask
@@ -90,7 +91,10 @@ def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         if is_zarr(path):
-            ds.to_zarr(tmp, mode="w", consolidated=False)
+            with warnings.catch_warnings():  # consolidated so that a plain xr.open_zarr reads it quietly and fast;
+                # zarr-python says that Zarr format 3 has no consolidated metadata in its spec yet: known, and harmless
+                warnings.filterwarnings("ignore", message="Consolidated metadata is currently not part")
+                ds.to_zarr(tmp, mode="w", consolidated=True)
         else:
             encoding = {name: {"zlib": True, "complevel": 4, **_chunksizes(ds[name])} for name in ds.data_vars}
             ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=encoding)

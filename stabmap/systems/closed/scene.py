@@ -16,7 +16,7 @@ import numpy as np
 
 from ...errors import StabmapError
 from ...scene.grid import Axis, check_axes, parse_axes
-from ...scene.values import Parameter, check_value, no_unknown
+from ...scene.values import Parameter, check_value, did_you_mean, no_unknown
 from ..base import SceneBase
 from . import checks
 from .families import FAMILIES
@@ -123,7 +123,7 @@ class Scene(SceneBase):
 
 def _parameter(name: str, family: str, explicit: bool) -> Parameter:
     if name not in PARAMETERS:
-        raise StabmapError(f"unknown parameter name {name!r}; a closed chain scans {', '.join(PARAMETERS)}")
+        raise StabmapError(f"unknown parameter name {name!r}; {did_you_mean(name, PARAMETERS)}a closed chain scans {', '.join(PARAMETERS)}")
     if name in _RING_ONLY and family != "ring":
         n = FAMILIES[family].n
         what = "no twisted equilibrium (twist applies to rings)" if name == "twist" else "no winding"

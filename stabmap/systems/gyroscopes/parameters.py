@@ -10,7 +10,7 @@ import re
 from dataclasses import dataclass, replace
 
 from ...errors import StabmapError
-from ...scene.values import Parameter
+from ...scene.values import Parameter, did_you_mean
 
 BODY = {
     "m": Parameter("m", "kg", "mass of body {k} (liquid included)", 0.0, True),
@@ -100,8 +100,10 @@ def parse_name(name: str, n_bodies: int, support: str) -> Name:
         return Name(name, "every_joint", name, 0)
     match = _NAME.match(name)
     if not match:
+        known = [*GLOBAL, *EVERY_BODY, "K"] + [f"K_{k}" for k in range(n_bodies)] + [
+            f"{sym}_{k}" for sym in ("m", "A", "C", "c", "s", "omega", "at", *CAVITY) for k in range(1, n_bodies + 1)]
         raise StabmapError(
-            f"unknown parameter name {name!r}; scannable names are omega, g, "
+            f"unknown parameter name {name!r}; {did_you_mean(name, known)}scannable names are omega, g, "
             "m_k A_k C_k c_k s_k omega_k (body k = 1..n), radius_k half_height_k density_k (the cavity "
             "of body k), K_k (joint k, K_0 the base), at_k (a tree's joint positions), and m A C c s K "
             "for every body or joint at once"

@@ -158,6 +158,9 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
     support = data.get("support", "fixed")
     tree_flag = tree is not None
     grid = parse_axes(data.get("grid", {}), lambda name: _axis_name(name, n, support, tree_flag).parameter)
+    if support == "free" and "g" in data:
+        raise StabmapError('g: gravity exerts no torque about a free system\'s centre of mass and would be ignored; remove g or use '
+                           'support = "fixed"')
     scalars = {k: data[k] for k in ("support", "omega", "g", "K_0", "title") if k in data}
     return Scene(bodies=bodies, joints=tuple(joints), grid=grid, topology=tree, **scalars)
 
@@ -218,6 +221,9 @@ def _validate(scene: Scene) -> None:
     if scene.omega is not None:
         put("omega", check_value("omega", scene.omega, GLOBAL["omega"]))
     put("g", check_value("g", scene.g, GLOBAL["g"]))
+    if scene.free and scene.g != DEFAULT_G:
+        raise StabmapError('g: gravity exerts no torque about a free system\'s centre of mass and would be ignored; remove g or use '
+                           'support = "fixed"')
     joints = tuple(scene.joints)
     if joints and len(joints) != n - 1:
         if tree is not None:

@@ -16,7 +16,7 @@ from __future__ import annotations
 import re
 
 from ...errors import StabmapError
-from ...scene.values import Parameter
+from ...scene.values import Parameter, did_you_mean
 
 AXES = ("x", "y", "z")
 NODE = Parameter("x", "m", "{axis} coordinate of node {k}")
@@ -79,7 +79,11 @@ def parse(name: str, n_nodes: int, kind: str) -> tuple[tuple, Parameter]:
             f"grid axis {name!r} belongs to a scene whose load is given by a [{other}] table; this scene gives "
             f"a [{kind}] table: {_names(kind)}"
         )
-    raise StabmapError(f"unknown parameter name {name!r}; a reactions scene with a [{kind}] table scans {_names(kind)}")
+    vectors = LOAD_VECTORS if kind == "load" else BODY_VECTORS
+    known = [f"{p}_{a}" for p in vectors for a in AXES] + [f"{DIRECTED[kind][0]}_{a}" for a in ANGLES] + ["load_factor"]
+    known += ["mass"] if kind == "body" else []
+    raise StabmapError(f"unknown parameter name {name!r}; {did_you_mean(name, known)}a reactions scene with a [{kind}] table "
+                       f"scans {_names(kind)}")
 
 
 def _names(kind: str) -> str:
