@@ -222,3 +222,17 @@ def test_cli_rejects_a_bad_cavity_without_writing(tmp_path):
     run = subprocess.run([sys.executable, "-m", "stabmap", "atlas", str(path), "-o", str(tmp_path / "a.nc")], capture_output=True, text=True)
     assert run.returncode == 2 and "bodies[1].cavity.density must be > 0" in run.stderr
     assert not (tmp_path / "a.nc").exists()
+
+
+def test_info_says_why_a_cylinder_keeps_its_modes():
+    """A scene without modes keeps the default count and info says so (issue 30: it used to claim the scene asked)."""
+    default = dict(top(CYLINDER.replace(", modes = 3", "")).notes())["body 1"]
+    assert "8 liquid modes kept (modes = 8, the default count)" in default
+    assert "as the scene's modes = 3 asks" in dict(top().notes())["body 1"]
+
+
+def test_a_cylinders_height_axis_is_not_called_a_polar_semi_axis():
+    """issue 30: the half_height axis of a cylinder was labelled "(polar semi-axis)", a spheroid's word."""
+    s = top(grid="[grid]\nhalf_height_1 = { start = 0.04, stop = 0.08, num = 3 }")
+    name = s.parameter("half_height_1").long_name
+    assert name.startswith("half height of the cavity of body 1") and "half a cylinder's length" in name

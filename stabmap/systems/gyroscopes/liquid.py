@@ -288,8 +288,10 @@ def describe(c: Cavity) -> str:
         tol = tolerance_of(c)
         stated = f"mode_tolerance = {tol:g}" if c.mode_tolerance is not None else f'modes = "auto", tail <= {tol:g} of A'
         why = f"the fewest with {stated}" if c.tail_over_A <= tol else f"{stated} not met within the default's {n}; state mode_tolerance to keep more"
+    elif c.modes == cavity.DEFAULT_MODES:  # the scene may not name it: a stored scene writes the default out
+        why = f"modes = {c.modes}, the default count"
     else:
-        why = "as the scene's modes asks"
+        why = f"as the scene's modes = {c.modes} asks"
     lumped = "lumped into A as rigid inertia" if c.tail else "dropped (tail = false)"
     return (
         f"{head} ({why}); the modes left out are {lumped}: at most {100 * c.tail_over_A:.2g} % of A "

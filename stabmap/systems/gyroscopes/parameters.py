@@ -27,7 +27,7 @@ BASE = Parameter("K", "N m rad-1", "stiffness of the base joint", 0.0, False)
 POSITION = Parameter("at", "m", "position of the joint of body {k} on its parent's axis", None, False)
 CAVITY = {
     "radius": Parameter("a", "m", "radius (equatorial semi-axis) of the cavity of body {k}", 0.0, True),
-    "half_height": Parameter("c", "m", "half height (polar semi-axis) of the cavity of body {k}", 0.0, True),
+    "half_height": Parameter("c", "m", "half height of the cavity of body {k} (half a cylinder's length, a spheroid's polar semi-axis)", 0.0, True),
     "density": Parameter("rho", "kg m-3", "density of the liquid in the cavity of body {k}", 0.0, True),
     "centre": Parameter("z", "m", "height of the cavity centre above the lower joint of body {k}", None, False),
     "E": Parameter("E", "kg m2", "inertia coefficient of a liquid mode", 0.0, True),
