@@ -67,9 +67,28 @@ def winding(j, n: int, where: str = "j") -> int:
     return j
 
 
-def twist(m, n: int, where: str = "twist") -> int:
-    """The ring's twist: 0 <= m < n/2 (less than half a turn per joint)."""
+MODELS = ("spatial", "planar")
+
+
+def model(name) -> bool:
+    """Whether the model ``name`` is the spatial one ("spatial" or "planar")."""
+    if name not in MODELS:
+        raise StabmapError(f"model = {name!r}: choose \"spatial\" (stability against every motion, the default) or \"planar\" "
+                           "(the chain confined to its plane)")
+    return name == "spatial"
+
+
+def twist(m, n: int, where: str = "twist", equal: bool = True, spatial: bool = True) -> int:
+    """The ring's twist: 0 <= m < n/2 (less than half a turn per joint); a twisted ring (m > 0) exists in space only
+    (``spatial``) and with equal lengths only (``equal``: its closing force is normal to the plane and balances only
+    equal bodies)."""
     m = whole(where, m, 0)
+    if m and not spatial:
+        raise StabmapError(f"{where} = {m} with model = \"planar\": a twisted ring is an equilibrium in space only; "
+                           "remove twist or use model = \"spatial\"")
+    if m and not equal:
+        raise StabmapError(f"{where} = {m}: a twisted ring needs equal lengths (ratio = 1, or equal lengths = [...]); "
+                           "unequal bodies do not balance its normal force. Set ratio = 1 or remove twist")
     if m and not 2 * m < n:
         raise StabmapError(f"{where} = {m} is out of range for a ring of n = {n} bodies: each joint twists by 2 pi m/n, which must "
                            f"stay below pi, so twist <= {(n - 1) // 2}; lower the twist or add bodies")

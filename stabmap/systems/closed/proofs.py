@@ -40,7 +40,6 @@ working precision is global, so every proof holds ``_LOCK`` while it sets it.
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import math
 import threading
@@ -212,13 +211,7 @@ def ball_inertia(H, rows) -> tuple[int, int] | None:
     ``H`` and ``rows`` (the closures) hold arbs at the current precision; each closure row is scaled by a double
     near 1 / its size (any nonzero scale keeps null(A) and conditions K) and the rotation row is added.
     """
-    n = len(H)
-    A = []
-    for row in rows:
-        size = max(abs(float(x)) for x in row) or 1.0
-        A.append([x * (1.0 / size) for x in row])
-    A.append([arb(1.0 / math.sqrt(n))] * n)
-    return bordered_inertia(H, A)
+    return bordered_inertia(H, scaled_rows(rows) + [[arb(1.0 / math.sqrt(len(H)))] * len(H)])
 
 
 def bordered_inertia(H, A) -> tuple[int, int] | None:
@@ -454,7 +447,8 @@ def krawczyk(theta, rho, lengths, loop_of, bits: int):
 def prove_equilibrium(theta, rho, lengths, loop_of, gamma=None) -> Verdict:
     """The verdict of an equilibrium known only approximately: ``theta`` (n,) [rad] and ``rho`` (L, 2) = R h / c1^2
     [1/m] at exact ``lengths`` (doubles); existence by Krawczyk, inertia in balls; undecided if either fails.
-    With ``gamma`` (c2^2/c1^2, exact) the out-of-plane block is proved over the same box (``in_space``)."""
+    With ``gamma`` (c2^2/c1^2, exact) the out-of-plane block is proved over the same box (``in_space``); without,
+    the planar model's verdict (``planar_only``)."""
     found = False
     for bits in PRECISIONS:
         with precision(bits):
@@ -470,7 +464,7 @@ def prove_equilibrium(theta, rho, lengths, loop_of, gamma=None) -> Verdict:
             out = None if inertia is None or gamma is None else out_of_plane_inertia(c, s, rh, hk, loop_of, arb(gamma))
         if inertia is not None and (gamma is None or out is not None):
             planar = Verdict(1, inertia[0], inertia[1], BY_INTERVAL_NEWTON)
-            return planar if gamma is None else in_space(planar, out)
+            return planar_only(planar) if gamma is None else in_space(planar, out)
     return Verdict(1 if found else -1, -1, -1, UNDECIDED)
 
 
@@ -492,15 +486,16 @@ def planar_only(planar: Verdict) -> Verdict:
     return Verdict(planar.exists, planar.index, planar.nullity, planar.decided_by, planar.index, planar.nullity)
 
 
-def in_space(planar: Verdict, out: tuple[int, int] | None, exact: bool = False) -> Verdict:
+def in_space(planar: Verdict, out: tuple[int, int] | None) -> Verdict:
     """The verdict in space from the planar one and the out-of-plane (index, nullity): the counts add up (the
     reflection through the plane splits the Hessian).  ``out`` None: undecided.  A ring's planar proof by
-    structure becomes a proof in balls (the out-of-plane block was proved in balls) unless ``exact``."""
+    structure becomes a proof in balls (its out-of-plane block is proved in balls); a folded end's stays exact
+    (its out-of-plane block is proved exactly)."""
     if planar.exists != 1 or planar.decided_by == UNDECIDED:
         return planar_only(planar)
     if out is None:
         return Verdict(1, -1, -1, UNDECIDED, planar.index, planar.nullity)
-    by = BY_BALLS if planar.decided_by == BY_STRUCTURE and not exact else planar.decided_by
+    by = BY_BALLS if planar.decided_by == BY_STRUCTURE else planar.decided_by
     return Verdict(1, planar.index + out[0], planar.nullity + out[1], by, planar.index, planar.nullity)
 
 
@@ -524,6 +519,3 @@ class Verdicts:
 
         return Verdicts(field("exists", np.int8), field("index", np.int16), field("nullity", np.int16),
                         field("decided_by", np.int8), field("planar_index", np.int16), field("planar_nullity", np.int16))
-
-    def take(self, at) -> Verdicts:
-        return Verdicts(*(getattr(self, f.name)[at] for f in dataclasses.fields(self)))

@@ -33,7 +33,6 @@ PARAMETERS = {
 }
 _KEYS = {"title", "family", "model", "lengths", "ratio", "h1", "n", "j", "twist", "c1sq", "c2sq", "h", "grid"}
 _RING_ONLY = ("n", "j", "twist")
-MODELS = ("spatial", "planar")
 _PATTERN_ONLY = ("ratio", "h1", "n")  # names that build the lengths: not with explicit lengths
 
 
@@ -176,9 +175,7 @@ def _validate(scene: Scene) -> None:
         object.__setattr__(scene, name, value)
 
     fam = checks.family(scene.family)
-    if scene.model not in MODELS:
-        raise StabmapError(f"model = {scene.model!r}: choose \"spatial\" (stability against every motion, the default) or \"planar\" "
-                           "(the chain confined to its plane)")
+    checks.model(scene.model)
     if not isinstance(scene.title, str):
         raise StabmapError(f"title must be a string, got {scene.title!r}")
     put("grid", tuple(scene.grid))
@@ -240,21 +237,11 @@ def _check_windings(scene: Scene) -> None:
 
 
 def _check_twist(scene: Scene) -> None:
-    """A twisted ring needs equal lengths (its closing force is normal to the plane and balances only equal
-    bodies), space, and a twist of less than half a turn per joint."""
-    twist = scene.values_of("twist")
-    if not twist.max():
-        return
+    """The largest twist of the grid, checked at its smallest n, on every length the grid builds (``checks.twist``)."""
     where = "grid.twist" if scene.axis("twist") is not None else "twist"
-    if not scene.spatial:
-        raise StabmapError(f"{where} = {int(twist.max())} with model = \"planar\": a twisted ring is an equilibrium in space only; "
-                           "remove twist or use model = \"spatial\"")
     lengths = np.asarray(scene.lengths) if scene.lengths else None
-    ratios = scene.values_of("ratio") if lengths is None else None
-    if (lengths is not None and (lengths != lengths[0]).any()) or (ratios is not None and (ratios != 1.0).any()):
-        raise StabmapError(f"{where} = {int(twist.max())}: a twisted ring needs equal lengths (ratio = 1, or equal lengths = [...]); "
-                           "unequal bodies do not balance its normal force. Set ratio = 1 or remove twist")
-    checks.twist(int(twist.max()), int(scene.n_values.min()), where)
+    equal = bool((lengths == lengths[0]).all()) if lengths is not None else bool((scene.values_of("ratio") == 1.0).all())
+    checks.twist(int(scene.values_of("twist").max()), int(scene.n_values.min()), where, equal, scene.spatial)
 
 
 def _check_closing(scene: Scene) -> None:

@@ -38,9 +38,9 @@ import math
 import numpy as np
 from scipy.optimize import root
 
-from . import equations, proofs, space_proofs
+from . import checks, equations, proofs, space_proofs
 from .checks import can_close, positive
-from .solve import Equilibrium, scalars, equilibrium, model_of
+from .solve import Equilibrium, equilibrium, scalars
 
 RESIDUAL = 1e-12
 REGULAR = 1e-10
@@ -157,7 +157,7 @@ def search(lengths, *, c1sq: float = 1.0, c2sq: float | None = None, h: float | 
         raise StabmapError(f"lengths: a closed chain needs at least 3 bodies, got {h_k.size}")
     can_close(h_k)
     c1sq, h, c2sq = scalars(h_k, c1sq, h, c2sq)
-    gamma = space_proofs.gamma_of(c1sq, c2sq) if model_of(model) else None
+    gamma = space_proofs.gamma_of(c1sq, c2sq) if checks.model(model) else None
     n = h_k.size
     starts = 60 * n if starts is None else int(starts)
     rho_scale = 1.0 / h_k.mean()  # forces in units of c1^2 / (h mean h_k): unknowns of order one
@@ -188,6 +188,5 @@ def search(lengths, *, c1sq: float = 1.0, c2sq: float | None = None, h: float | 
     proved = []
     for eq in found:  # each kept shape proved: Krawczyk on the general equations, then its inertia in balls
         verdict = proofs.prove_equilibrium(eq.theta, eq.forces * (h / c1sq), h_k, loop_of, gamma)
-        verdict = proofs.planar_only(verdict) if gamma is None else verdict
         proved.append(equilibrium("found", h_k, eq.theta, eq.forces, verdict, loop_of, c1sq, h, c2sq=c2sq, model=model))
     return sorted(proved, key=lambda e: (e.energy, e.index))

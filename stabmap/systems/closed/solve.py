@@ -146,14 +146,6 @@ def scalars(lengths: np.ndarray, c1sq, h, c2sq=None) -> tuple[float, float, floa
     return c1sq, h, c2sq
 
 
-def model_of(model) -> bool:
-    """Whether ``model`` is the spatial one ("spatial" or "planar"; anything else is an error)."""
-    if model not in ("spatial", "planar"):
-        raise StabmapError(f"model = {model!r}: choose 'spatial' (stability against every motion, the default) or 'planar' "
-                           "(the chain confined to its plane)")
-    return model == "spatial"
-
-
 def equilibrium(shape: str, lengths, theta, forces, verdict: proofs.Verdict, loop_of, c1sq: float, h: float, j=None, *,
                 c2sq: float | None = None, model: str = "spatial", twist: int = 0, phi=None, force_x=None) -> Equilibrium:
     """The Equilibrium of one configuration with its ``verdict`` (``proofs``), decided like an atlas point."""
@@ -218,16 +210,11 @@ def solve(shape: str, lengths, *, c1sq: float = 1.0, c2sq: float | None = None, 
     fam = checks.family(shape)
     h_k = checks.lengths(fam, lengths)
     c1sq, h, c2sq = scalars(h_k, c1sq, h, c2sq)
-    spatial = model_of(model)
+    spatial = checks.model(model)
     n = h_k.size
     if fam.name == "ring":
         j = checks.winding(j, n)
-        twist = checks.twist(twist, n)
-        if twist and (h_k != h_k[0]).any():
-            raise StabmapError(f"twist = {twist}: a twisted ring needs equal lengths (unequal bodies do not balance its normal force); "
-                               "give equal lengths or twist = 0")
-        if twist and not spatial:
-            raise StabmapError(f"twist = {twist} with model = 'planar': a twisted ring is an equilibrium in space only; use model = 'spatial'")
+        twist = checks.twist(twist, n, equal=bool((h_k == h_k[0]).all()), spatial=spatial)
     elif not (isinstance(j, (int, np.integer)) and not isinstance(j, bool) and j == 1):
         raise StabmapError(f"j = {j!r}: the winding j applies to shape = 'ring' only; leave it out for {fam.name!r}")
     elif not (isinstance(twist, (int, np.integer)) and not isinstance(twist, bool) and twist == 0):

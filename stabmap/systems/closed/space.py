@@ -178,6 +178,12 @@ def spatial(quats, lengths, force, gamma, hessian: bool = True):
     return H, g, closures, symmetries
 
 
+def body_frame(cos_theta2, sin_theta2, cos_phi2, sin_phi2):
+    """The quaternion of a body's frame Rx(theta) Rz(phi), from the cosines and sines of theta/2 and phi/2."""
+    zero = cos_theta2 * 0
+    return qmul((cos_theta2, sin_theta2, zero, zero), (cos_phi2, zero, zero, sin_phi2))
+
+
 def twisted_ring(n: int, j: int, m: int, gamma, cos_pi, sin_pi, frac):
     """Quaternions, scaled force and energy of the ring of n equal bodies, winding j and twist m:
     Q_k = Rx(2 pi j k/n) Rz(2 pi m k/n).
@@ -188,12 +194,8 @@ def twisted_ring(n: int, j: int, m: int, gamma, cos_pi, sin_pi, frac):
     alone, up to rotation and spin); the closure force is normal to its plane, rho_x = gamma sin(2 pi j/n)
     sin(2 pi m/n) for h_k = 1, and U = (n/h) [c1^2 (1 - cos 2 pi j/n) + c2^2 (1 + cos 2 pi j/n)(1 - cos 2 pi m/n)/2].
     """
-    quats = []
-    for k in range(1, n + 1):
-        a, b = frac(j * k, n), frac(m * k, n)  # half angles over pi
-        qx = (cos_pi(a), sin_pi(a), sin_pi(a) * 0, sin_pi(a) * 0)
-        qz = (cos_pi(b), cos_pi(b) * 0, cos_pi(b) * 0, sin_pi(b))
-        quats.append(qmul(qx, qz))
+    half = [(frac(j * k, n), frac(m * k, n)) for k in range(1, n + 1)]  # half angles over pi
+    quats = [body_frame(cos_pi(a), sin_pi(a), cos_pi(b), sin_pi(b)) for a, b in half]
     delta, tau = frac(2 * j, n), frac(2 * m, n)
     rho_x = gamma * sin_pi(delta) * sin_pi(tau)
     zero = rho_x * 0

@@ -34,19 +34,20 @@ def gamma_of(c1sq: float, c2sq: float) -> fmpq:
 
 
 # ------------------------------------------------------------------------------------------------- planar shapes
-def out_of_plane_pattern(family: str, r: fmpq, gamma: fmpq, pattern, loop_of) -> tuple[int, int, bool] | None:
-    """(index, nullity, exact) of the out-of-plane block of a two-length family that exists at ratio r."""
+def out_of_plane_pattern(family: str, r: fmpq, gamma: fmpq, pattern, loop_of) -> tuple[int, int] | None:
+    """(index, nullity) of the out-of-plane block of a two-length family that exists at ratio r: exactly at a
+    folded end, in balls elsewhere."""
     if proofs.pattern_existence(family, r) == "folded":
         c, s, rho = proofs.closed_form(family, r, proofs._exact_sqrt)
         H, closures, symmetries = space.out_of_plane(c, s, rho, proofs._pattern_lengths(pattern, r), loop_of, gamma)
-        return (*exact_inertia(H, closures, symmetries), True)
+        return exact_inertia(H, closures, symmetries)
     for bits in PRECISIONS:
         with precision(bits):
             rb = arb(r)
             c, s, rho = proofs.closed_form(family, rb, lambda x: x.sqrt())
             found = out_of_plane_inertia(c, s, rho, proofs._pattern_lengths(pattern, rb), loop_of, arb(gamma))
         if found is not None:
-            return (*found, False)
+            return found
     return None
 
 
@@ -67,9 +68,8 @@ def prove_pattern(family: str, r: fmpq, gamma: fmpq | None, pattern, loop_of, pl
     """The verdict of a two-length family at ratio r and gamma (None: in the plane only)."""
     planar = planar or proofs.prove_pattern(family, r, pattern, loop_of)
     if gamma is None or planar.exists != 1 or planar.decided_by == UNDECIDED:
-        return planar_only(planar) if gamma is None else in_space(planar, (0, 0))
-    found = out_of_plane_pattern(family, r, gamma, pattern, loop_of)
-    return in_space(planar, None if found is None else found[:2], exact=found is not None and found[2])
+        return planar_only(planar)
+    return in_space(planar, out_of_plane_pattern(family, r, gamma, pattern, loop_of))
 
 
 def prove_ring(lengths: list[fmpq], j: int, m: int, gamma: fmpq | None, planar: Verdict | None = None) -> Verdict:
@@ -78,7 +78,7 @@ def prove_ring(lengths: list[fmpq], j: int, m: int, gamma: fmpq | None, planar: 
         return prove_twisted_ring(len(lengths), j, m, gamma)
     planar = planar or proofs.prove_ring(lengths, j)
     if gamma is None or planar.exists != 1:
-        return planar_only(planar) if gamma is None else in_space(planar, (0, 0))
+        return planar_only(planar)
     return in_space(planar, out_of_plane_ring(lengths, j, gamma))
 
 
@@ -156,8 +156,7 @@ def prove_lengths(fam, j: int, m: int, lengths, gamma: fmpq | None, guess=None) 
     theta, rho = guess() if guess is not None else (None, None)
     if theta is None or not (np.isfinite(theta).all() and np.isfinite(rho).all()):
         return UNDECIDED_VERDICT
-    planar = proofs.prove_equilibrium(theta, rho, lengths, loop_of, gamma)
-    return planar_only(planar) if gamma is None else planar
+    return proofs.prove_equilibrium(theta, rho, lengths, loop_of, gamma)
 
 
 __all__ = ["gamma_of", "prove_lengths", "prove_ratios"]

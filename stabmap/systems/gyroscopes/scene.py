@@ -25,6 +25,7 @@ from .topology import Topology
 
 SUPPORTS = ("fixed", "free")
 DEFAULT_G = 9.81
+_G_FREE = 'g: gravity exerts no torque about a free system\'s centre of mass and would be ignored; remove g or use support = "fixed"'
 _TOP_KEYS = {"title", "support", "g", "omega", "joints", "K_0", "topology", "bodies", "grid"}
 _TOPOLOGY_KEYS = {"parent", "at"}
 _BODY_KEYS = {"m", "A", "C", "c", "s", "omega", "fluid", "cavity"}
@@ -159,8 +160,7 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
     tree_flag = tree is not None
     grid = parse_axes(data.get("grid", {}), lambda name: _axis_name(name, n, support, tree_flag).parameter)
     if support == "free" and "g" in data:
-        raise StabmapError('g: gravity exerts no torque about a free system\'s centre of mass and would be ignored; remove g or use '
-                           'support = "fixed"')
+        raise StabmapError(_G_FREE)
     scalars = {k: data[k] for k in ("support", "omega", "g", "K_0", "title") if k in data}
     return Scene(bodies=bodies, joints=tuple(joints), grid=grid, topology=tree, **scalars)
 
@@ -222,8 +222,7 @@ def _validate(scene: Scene) -> None:
         put("omega", check_value("omega", scene.omega, GLOBAL["omega"]))
     put("g", check_value("g", scene.g, GLOBAL["g"]))
     if scene.free and scene.g != DEFAULT_G:
-        raise StabmapError('g: gravity exerts no torque about a free system\'s centre of mass and would be ignored; remove g or use '
-                           'support = "fixed"')
+        raise StabmapError(_G_FREE)
     joints = tuple(scene.joints)
     if joints and len(joints) != n - 1:
         if tree is not None:
