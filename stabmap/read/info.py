@@ -66,10 +66,10 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
     if ds.attrs.get("stabmap_kind") == "critical values":
         head = f"{name}: {ds.attrs.get('title', '')}: critical values along {ds.attrs['critical_along']}"
         comment = textwrap.wrap(ds.attrs["comment"], width=WIDTH, initial_indent="  ", subsequent_indent="  ")
-        from .table import _counts_line, critical_summary
+        from .table import counts_line, critical_summary
 
         dims = list(ds["n_stable_intervals"].dims)
-        counts = textwrap.wrap(_counts_line(critical_summary(ds), dims), width=WIDTH, initial_indent="  ", subsequent_indent="    ")
+        counts = textwrap.wrap(counts_line(critical_summary(ds), dims), width=WIDTH, initial_indent="  ", subsequent_indent="    ")
         return "\n".join([head, *comment, *counts, *intervals(ds, limit)])
     system = systems.of_atlas(ds.attrs)
     s = summary(ds)

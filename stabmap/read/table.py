@@ -72,6 +72,7 @@ def _intervals(ds: xr.Dataset, along: str, dims: list[str]) -> tuple[np.ndarray,
     lo, hi, olo, ohi = (_flat(ds, n, dims, "interval") for n in names)
     line, k = np.nonzero(np.isfinite(lo))
     whole_name = f"{along}_stable_whole"
+    # files made before box proofs have no <along>_stable_whole: their intervals were not proved between scan values
     whole = _flat(ds, whole_name, dims, "interval")[line, k] == 1 if whole_name in ds else np.zeros(line.size, dtype=bool)
     columns = {n: v[line, k] for n, v in zip(names, (lo, hi, olo, ohi))}
     columns.update({"from_scan_start": np.isnan(olo[line, k]), "to_scan_end": np.isnan(ohi[line, k]), "proved_throughout": whole})
@@ -140,7 +141,8 @@ def critical_table(ds: xr.Dataset) -> pd.DataFrame:
     b_lo, b_hi = _flat(ds, "boundary_lower", dims, "boundary"), _flat(ds, "boundary_upper", dims, "boundary")
     below, above = _flat(ds, f"{lab}_below", dims, "boundary"), _flat(ds, f"{lab}_above", dims, "boundary")
     line, k = np.nonzero(np.isfinite(b_lo))
-    shown = (lambda v: np.array([label.meaning(int(x)) for x in v], dtype=object)) if label.flags else (lambda v: v.astype(np.int64))
+    meanings = dict(label.flags)
+    shown = (lambda v: pd.Series(v).map(meanings).to_numpy(dtype=object)) if label.flags else (lambda v: v.astype(np.int64))
     rows("boundary", line, **{lower: b_lo[line, k], upper: b_hi[line, k], f"{lab}_below": shown(below[line, k]), f"{lab}_above": shown(above[line, k])})
     if "undecided_lower" in ds:  # critical files made before box proofs have no gaps
         g_lo, g_hi = _flat(ds, "undecided_lower", dims, "gap"), _flat(ds, "undecided_upper", dims, "gap")
@@ -287,7 +289,7 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
     sym = system.label_symbol
     dims = [c for c in table.columns if c in ds.dims and c in ds.coords]
     u = f" [{s['units']}]" if s["units"] else ""
-    lines = [_counts_line(s, dims)]
+    lines = [counts_line(s, dims)]
     header = [f"{d} [{units[d]}]" if units.get(d) else d for d in dims] + ["row", f"{along} lower{u}", f"{along} upper{u}", "note"]
     rows = []
     for r in (table if not limit else table.iloc[:limit]).to_dict(orient="records"):
@@ -310,7 +312,7 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
     return "\n".join(lines)
 
 
-def _counts_line(s: dict, dims: list[str]) -> str:
+def counts_line(s: dict, dims: list[str]) -> str:
     """One line of counts: intervals, boundaries and gaps on how many lines."""
     u = f" [{s['units']}]" if s["units"] else ""
     on = f"on {s['lines']} line{'s' if s['lines'] != 1 else ''} of {', '.join(dims)}" if dims else "on the one line of the scene"
