@@ -176,6 +176,10 @@ def test_query_csv_json_and_output_file(crit_file, capsys, tmp_path):
     assert doc["along"] == "omega" and doc["units"]["omega_lower"] == "rad s-1" and len(doc["rows"]) == len(rows)
     for js, cs in zip(doc["rows"], rows):
         assert js["row"] == cs["row"] and js["omega_lower"] == (float(cs["omega_lower [rad s-1]"]) if cs["omega_lower [rad s-1]"] else None)
+    # the file, opened lazily as the CLI opens it, has the same summary as the Dataset in memory
+    with stabmap.open_atlas(crit_file, lazy=True) as ds:
+        s = ds.stabmap.summary()
+        assert (s["stable_intervals"], s["boundaries"], s["lines"]) == (6, 4, 6)
     # a selection of lines: the nearest grid value, every row of that line
     code, out, _ = _run(capsys, "query", crit_file, "--csv", "c_1=0.09", "m_1=0:1")
     picked = list(csv.DictReader(io.StringIO(out)))
@@ -261,3 +265,16 @@ def test_closed_chain_csv_along_the_length_ratio(tmp_path, capsys):
     stable = [r for r in rows if r["row"] == "stable_interval"]
     assert len(stable) == 1 and stable[0]["from_scan_start"] == "True" and stable[0]["proved_throughout"] == "False"
     assert [r["row"] for r in rows].count("undecided_gap") >= 2  # points only: every stretch between is a gap, and said
+
+
+def test_query_output_file_for_an_atlas_question(tmp_path, capsys):
+    atlas = stabmap.compute_atlas(from_dict({
+        "support": "fixed", "g": G, "bodies": [dict(TOP, m=1.0, c=0.1)], "grid": {"omega": {"start": 1.0, "stop": 60.0, "num": 12}},
+    }))
+    path = stabmap.write_atlas(atlas, tmp_path / "a.nc")
+    code, printed, _ = _run(capsys, "query", path, "--fraction", "--csv")
+    target = tmp_path / "f.csv"
+    assert code == 0 and _run(capsys, "query", path, "--fraction", "--csv", "-o", target)[:2] == (0, f"wrote {target}\n")
+    assert target.read_text() == printed
+    row = next(csv.DictReader(io.StringIO(printed)))
+    assert int(row["stable"]) == sum(_stable(float(w), 0.1, 1.0) for w in atlas["omega"].values)
