@@ -92,11 +92,13 @@ def atlas(scene, example, output, png, threads, workers, scheduler, chunk_points
 
 @cli.command(short_help="What an atlas file holds: scene, axes, stable fraction, who decided.")
 @click.argument("atlas")
-def info(atlas):
-    """What an atlas file holds: scene, axes, stable fraction, who decided."""
+@click.option("--limit", type=int, default=8, show_default=True, metavar="N", help="critical values: points of the other axes listed (0: all)")
+@click.option("--all", "every", is_flag=True, help="critical values: list every point and every undecided gap (--limit 0)")
+def info(atlas, limit, every):
+    """What an atlas file holds: scene, axes, stable fraction, who decided; critical values: the stable intervals."""
     from . import jobs
 
-    click.echo(jobs.info(atlas))
+    click.echo(jobs.info(atlas, limit=0 if every else limit))
 
 
 @cli.command(
@@ -110,6 +112,7 @@ examples:
   stabmap query a.nc --smallest-stable omega --over K_1    smallest stable omega for each K_1
   stabmap query a.nc --smallest-stable omega=0: --csv      ... of positive spin rates only, as CSV
   stabmap query a.nc --boundaries omega K_1=3 --locate     every change, however narrow, located to 1e-10
+  stabmap query crit.nc --csv -o crit.csv                  critical values: every stable interval and boundary
 \b
 Without --locate, boundaries are known to grid resolution only; --locate computes critical values of the
 atlas's scene along the selected lines: complete, and located to 1e-10 (docs/critical.md)."""
@@ -126,7 +129,9 @@ atlas's scene along the selected lines: complete, and located to 1e-10 (docs/cri
 @click.option("--csv", "fmt", flag_value="csv", help="print CSV (every row)")
 @click.option("--json", "fmt", flag_value="json", help="print JSON (every row)")
 @click.option("--limit", type=int, default=40, metavar="N", help="rows of a text table (default 40; 0: all)")
-def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, fmt, limit):
+@click.option("-o", "--output", metavar="FILE", help="write the answer to FILE (atomically) instead of printing it")
+@_overwrite
+def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, fmt, limit, output, overwrite):
     """Ask a saved atlas: the label at a point, the stable fraction, boundaries, the smallest stable value.
 
     NAME=VALUE selects the grid value of NAME nearest to VALUE (the value used is printed); NAME=LO:HI keeps the
@@ -135,7 +140,7 @@ def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, fmt
     from . import jobs
 
     click.echo(jobs.query(atlas, items, fraction=fraction, boundaries=boundaries, smallest_stable=smallest_stable,
-                          over=over, locate=locate, fmt=fmt or "text", limit=limit))
+                          over=over, locate=locate, fmt=fmt or "text", limit=limit, output=output, overwrite=overwrite))
 
 
 @cli.command(short_help="Draw an atlas (or critical values) to a PNG or PDF file.")

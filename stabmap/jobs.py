@@ -196,13 +196,15 @@ def critical(
     return Done(lines, "\n".join(intervals(ds)) if listing else "")
 
 
-def info(path: str | Path) -> str:
-    """``stabmap info``: what an atlas file holds."""
+def info(path: str | Path, limit: int = 8) -> str:
+    """``stabmap info``: what an atlas file holds; ``limit``: points of critical values listed (0: all)."""
     from .read.info import describe
     from .store.files import open_atlas
 
+    if limit < 0:
+        raise StabmapError(f"--limit must be >= 0 (0 lists every point), got {limit}")
     with open_atlas(path, lazy=True) as ds:
-        return describe(ds, str(path))
+        return describe(ds, str(path), limit)
 
 
 def query(
@@ -217,16 +219,20 @@ def query(
     fmt: str = "text",
     limit: int = 40,
     progress: bool | None = None,
+    output: str | Path | None = None,
+    overwrite: bool = False,
 ) -> str:
     """``stabmap query``: the label at a point, or the answer to one question about a slice (docs/query.md).
 
     ``items`` are ``NAME=VALUE`` or ``NAME=LO:HI``; a question's axis may also come first among them.
     ``locate``: answer --boundaries and --smallest-stable with critical values of the atlas's scene (complete,
     located to 1e-10: ``stabmap.read.located``) instead of the grid.
+    A critical-values file answers with its table (``stabmap.read.table``): every stable interval, boundary and gap.
+    ``output``: write the answer to this file (atomically; an existing one only if ``overwrite``) instead of returning it.
     """
     from .read import query as q
     from .read.report import render
-    from .store.files import open_atlas
+    from .store.files import check_new_output, open_atlas
 
     items = list(items)
     asked = [opt for opt, v in (("--fraction", fraction or None), ("--boundaries", boundaries), ("--smallest-stable", smallest_stable)) if v]
@@ -244,10 +250,18 @@ def query(
                 raise StabmapError(f"{option}: name the axis to search along first, e.g. {option} omega K_1=3")
             items.insert(0, axis)
             smallest_stable = "omega"
+    if output is not None:
+        check_new_output(output, overwrite)
     ds = open_atlas(path, lazy=True)  # read chunk by chunk: bounded memory at any size
-    if ds.attrs.get("stabmap_kind") == "critical values":
-        raise StabmapError(f"{path} holds critical values, not an atlas; 'stabmap info {path}' lists its intervals")
     sel = q.parse_selection(items)
+    if ds.attrs.get("stabmap_kind") == "critical values":
+        from .read.table import render_table, select_lines
+
+        if asked or locate or over is not None:
+            given = asked[0] if asked else "--locate" if locate else "--over"
+            raise StabmapError(f"{path} holds critical values, not an atlas, and {given} asks an atlas; 'stabmap query {path}' "
+                               "(--csv or --json; NAME=VALUE picks lines) lists its stable intervals and boundaries")
+        return _answer(render_table(select_lines(ds, sel), fmt, limit=limit), output)
     if locate:
         from .read import located
 
@@ -269,7 +283,17 @@ def query(
                 "--smallest-stable [AXIS]; see 'stabmap query --help'"
             )
         result = q.label_at(ds, **sel)
-    return render(result, fmt, limit=limit, atlas=ds)
+    return _answer(render(result, fmt, limit=limit, atlas=ds), output)
+
+
+def _answer(text: str, output: str | Path | None) -> str:
+    """The answer, or, with ``output``, the answer written there (atomically) and a line saying so."""
+    if output is None:
+        return text
+    from .store.files import write_text
+
+    write_text(text + "\n", output)
+    return f"wrote {output}"
 
 
 def plot(

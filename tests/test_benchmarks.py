@@ -125,3 +125,10 @@ def test_bench_cells_quick(capsys):
     (stress,) = out["stress"]
     assert stress["boundaries"] >= 3 and stress["false_whole"] == 0 and stress["wrong_interior"] == 0 and stress["checked"] > 0
     assert "| scene | degree | points |" in capsys.readouterr().out
+
+
+def test_bench_tables_quick(capsys):
+    rows = runpy.run_path(str(SCRIPTS / "bench_tables.py"))["main"](["--quick"])
+    # tiling the file ten times gives ten times the lines and the CSV rows (an interval and a boundary per line)
+    assert [r["lines"] for r in rows] == [5, 50] and [r["csv_rows"] for r in rows] == [10, 100]
+    assert "| lines | to_dataframe s |" in capsys.readouterr().out

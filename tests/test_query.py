@@ -396,7 +396,7 @@ def test_cli_critical_values_file_and_missing_file(tmp_path, capsys):
     crit = stabmap.critical(scene({"omega": {"start": 0.5, "stop": 30.5, "num": 7}}), "omega")
     path = stabmap.write_atlas(crit, tmp_path / "crit.nc")
     code, _, err = run(capsys, path, "--boundaries", "omega")
-    assert code == 2 and "holds critical values, not an atlas; 'stabmap info" in err
+    assert code == 2 and "holds critical values, not an atlas, and --boundaries asks an atlas; 'stabmap query" in err
     with pytest.raises(stabmap.StabmapError, match="holds critical values"):
         crit.stabmap.stable_fraction()
     code, _, err = run(capsys, tmp_path / "nope.nc", "--fraction")

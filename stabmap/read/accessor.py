@@ -11,6 +11,7 @@ operation keeps working and returns plain Datasets):
 >>> ds.stabmap.boundaries("omega", K_1=3).to_dataframe()
 >>> ds.stabmap.smallest_stable("omega", over="K_1").smallest_stable.plot()
 >>> ds.stabmap.plot("map.png", sel={"K_1": 3})
+>>> stabmap.open_atlas("critical.nc").stabmap.to_dataframe()    # one row per stable interval
 
 Each method calls the function of the same name with the Dataset as its first argument, so the two always
 give the same answer.  This module imports nothing of stabmap at load time: it is loaded while xarray
@@ -56,10 +57,16 @@ class StabmapAccessor:
         return smallest_stable(self._ds, along, over, **sel)
 
     def summary(self) -> dict:
-        """Counts that describe the whole atlas: :func:`stabmap.summary`."""
+        """Counts that describe the whole atlas, or a critical-values file's intervals per line: :func:`stabmap.summary`."""
         from .summary import summary
 
         return summary(self._ds)
+
+    def to_dataframe(self):
+        """One row per stable interval of a critical-values file: :func:`stabmap.read.table.intervals_frame`."""
+        from .table import intervals_frame
+
+        return intervals_frame(self._ds)
 
     def plot(self, path: str | Path, **kw) -> Path:
         """Draw the atlas to a PNG or PDF file: :func:`stabmap.plot_atlas` (``x=``, ``y=``, ``sel=``, ...).

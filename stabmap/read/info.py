@@ -56,16 +56,21 @@ def fixed_parameters(ds: xr.Dataset, system, item=None) -> list[tuple[str, list[
     return out
 
 
-def describe(ds: xr.Dataset, name: str = "") -> str:
+def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
     """The scene, axes, fixed parameters, counts and provenance of an atlas (or the intervals of critical values).
 
     Every line fits in :data:`WIDTH` characters but for a single word longer than that (a path); fixed parameters
     come in the system's groups (per body for gyroscopes), each group's scene notes (liquid modes) beside it.
+    ``limit``: lines of critical values listed (0: every line, and every gap of each; an atlas lists nothing per line).
     """
     if ds.attrs.get("stabmap_kind") == "critical values":
         head = f"{name}: {ds.attrs.get('title', '')}: critical values along {ds.attrs['critical_along']}"
         comment = textwrap.wrap(ds.attrs["comment"], width=WIDTH, initial_indent="  ", subsequent_indent="  ")
-        return "\n".join([head, *comment, *intervals(ds)])
+        from .table import counts_line, critical_summary
+
+        dims = list(ds["n_stable_intervals"].dims)
+        counts = textwrap.wrap(counts_line(critical_summary(ds), dims), width=WIDTH, initial_indent="  ", subsequent_indent="    ")
+        return "\n".join([head, *comment, *counts, *intervals(ds, limit)])
     system = systems.of_atlas(ds.attrs)
     s = summary(ds)
     a = ds.attrs
@@ -146,7 +151,11 @@ def scene_notes(attrs: dict) -> dict[str, list[str]]:
 
 
 def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
-    """Stable intervals of a critical-values Dataset, for the first ``limit`` points of the other axes."""
+    """Stable intervals of a critical-values Dataset, for the first ``limit`` points of the other axes (0: all of them,
+    and then every undecided gap, not only the first 4 of each point)."""
+    if limit < 0:
+        raise StabmapError(f"--limit must be >= 0 (0 lists every point), got {limit}")
+    gaps_shown = 4 if limit else None
     along = ds.attrs["critical_along"]
     names = [f"{along}_stable_{end}" for end in ("lower", "upper", "lower_outer", "upper_outer")]
     dims = [d for d in ds[names[0]].dims if d != "interval"]
@@ -159,7 +168,7 @@ def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
         g = g.stack(point=dims) if dims else g.expand_dims(point=[0])
         gaps = g["n_undecided"].values, g["undecided_lower"].transpose("point", "gap").values, g["undecided_upper"].transpose("point", "gap").values
     lines = []
-    for p, label in enumerate(table["point"].values[:limit]):
+    for p, label in enumerate(table["point"].values[:limit or None]):
         where = ", ".join(f"{d} = {v:g}" for d, v in zip(dims, label)) if dims else "the scene"
         parts = [
             f"{lo[p, k]:.10g} ({'scan start' if np.isnan(olo[p, k]) else 'boundary'}) to "
@@ -171,9 +180,10 @@ def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
         lines.append(f"{where}: stable {along}{shown} " + ("; ".join(parts) if parts else "nowhere in the scan"))
         if gaps is not None and gaps[0][p]:
             n = int(gaps[0][p])
-            pieces = [f"{a:.10g} to {b:.10g}" for a, b in zip(gaps[1][p, :n][:4], gaps[2][p, :n][:4])]
-            more = f" and {n - 4} more" if n > 4 else ""
+            pieces = [f"{a:.10g} to {b:.10g}" for a, b in zip(gaps[1][p, :n][:gaps_shown], gaps[2][p, :n][:gaps_shown])]
+            more = f" and {n - gaps_shown} more (--all lists every one)" if gaps_shown and n > gaps_shown else ""
             lines.append(f"  not proved inside {n} gap{'s' if n > 1 else ''}: " + "; ".join(pieces) + more)
-    if lo.shape[0] > limit:
-        lines.append(f"... and {lo.shape[0] - limit} more points in the file")
+    if limit and lo.shape[0] > limit:
+        lines.append(f"... and {lo.shape[0] - limit} more points in the file (--all or --limit 0 lists every one; "
+                     "'stabmap query FILE --csv' gives them as a table)")
     return lines

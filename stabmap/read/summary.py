@@ -6,6 +6,7 @@ import numpy as np
 import xarray as xr
 
 from .. import systems
+from ..errors import StabmapError
 from ..store.dataset import edges
 from ..store.variables import CELL
 
@@ -20,6 +21,9 @@ def _counts(values) -> dict[int, int]:
 def summary(ds: xr.Dataset) -> dict:
     """Points, the stable fraction, a histogram of the label and of who decided.
 
+    A critical-values Dataset (``stabmap critical``) gets its own counts instead, per line of its other axes:
+    :func:`stabmap.read.table.critical_summary`.
+
     Keys: ``points``, ``stable``, ``degenerate`` (label < 0, but for ``absent`` and ``undecided``), ``absent`` (the
     system's ``absent_label``: nothing to decide there), ``undecided`` (its ``undecided_label``: not proved),
     ``stable_fraction``, the label's name (a
@@ -27,7 +31,14 @@ def summary(ds: xr.Dataset) -> dict:
     ``decided_by``).  An atlas with cells (``stabmap.run.cells``) adds ``cell`` (counts by flag meaning) and
     ``cell_volume`` (each meaning's share of the scanned volume, cells weighted by their size).
     """
+    if ds.attrs.get("stabmap_kind") == "critical values":  # its own counts: intervals, boundaries, gaps per line
+        from .table import critical_summary
+
+        return critical_summary(ds)
     system = systems.of_atlas(ds.attrs)
+    if system.label not in ds:
+        raise StabmapError(f"this Dataset is not a stabmap atlas or critical-values file (no {system.label}); "
+                           "open one with stabmap.open_atlas(PATH)")
     label = _counts(ds[system.label].data)
     points = sum(label.values())
     stable = label.get(system.stable_label, 0) if system.stable_label is not None else 0

@@ -105,6 +105,19 @@ def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
     return path
 
 
+def write_text(text: str, path: str | Path) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically: a temporary file in the same directory, renamed when complete."""
+    path = check_writable(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+    except BaseException:
+        _remove(tmp)
+        raise
+    return path
+
+
 def _chunksizes(var: xr.DataArray) -> dict:
     """netCDF chunks equal to the dask chunks of a streamed variable (each one written once, whole)."""
     if var.chunks is None or var.ndim == 0:
