@@ -95,8 +95,9 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
             values = spec["values"]
             if not isinstance(values, list) or not values:
                 raise StabmapError(f"{where}.values must be a non-empty list of numbers")
+            converted = [units.in_si(f"{where}.values[{i + 1}]", v, info.units) for i, v in enumerate(values)]
             unit = units.common_unit(f"{where}.values", values)
-            values = [units.in_si(f"{where}.values[{i + 1}]", v, info.units) for i, v in enumerate(values)]
+            values = converted
             axes.append(Axis(name, tuple(values), spec.get("scale", "values"), _display(spec, unit)))
             continue
         for key in ("start", "stop", "num"):
@@ -105,9 +106,9 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
         num = spec["num"]
         if isinstance(num, bool) or not isinstance(num, int) or num < 1:
             raise StabmapError(f"{where}.num must be a whole number >= 1, got {num!r}")
-        unit = units.common_unit(where, [spec["start"], spec["stop"]])
         start = check_value(f"{where}.start", spec["start"], info)
         stop = check_value(f"{where}.stop", spec["stop"], info)
+        unit = units.common_unit(where, [spec["start"], spec["stop"]])
         if num == 1 and stop != start:
             raise StabmapError(f"{where}: num = 1 gives the one value start = {start:g} and would ignore stop = {stop:g}; "
                                f"give num >= 2, or values = [{start:g}]")

@@ -45,7 +45,7 @@ def scene_attrs(ds: xr.Dataset) -> dict:
         try:
             grid.append(Axis(axis.name, tuple(float(v) for v in values), axis.scale, axis.display_units))
         except StabmapError as exc:
-            raise StabmapError(f"cannot write this part of an atlas as an atlas: {exc} (select values in grid order, each once)") from None
+            raise StabmapError(f"cannot write this part of an atlas: {exc}; select values in grid order, each once") from None
         cut.append(axis.name)
     if not cut:
         return {}
