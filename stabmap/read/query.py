@@ -173,7 +173,7 @@ def _not_an_axis(ds: xr.Dataset, name: str, dims: list[str], role: str = "") -> 
 
 
 def _number(name: str, value, units: str = "") -> float:
-    if isinstance(value, str) and not _plain(value):
+    if isinstance(value, str) and not _plain(value) and looks_like_rate(value):
         value = in_si(name, value, units)  # a spin rate may carry its unit: "14000 rpm"
     try:
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, str, np.integer, np.floating)):
