@@ -51,7 +51,8 @@ def factor(unit: str) -> float:
 
 
 def in_si(where: str, value, units: str):
-    """``value`` with a spin rate's unit converted to rad/s (a float); anything but a string is returned as it is.
+    """``value`` with a spin rate's unit converted to rad/s (a float); anything but a string with a unit is returned
+    as it is.
 
     ``units`` are the CF units of the quantity (``Parameter.units`` or a coordinate's ``units``): a string with a
     unit is accepted for a spin rate (``rad s-1``) only.
@@ -59,8 +60,8 @@ def in_si(where: str, value, units: str):
     if not isinstance(value, str):
         return value
     number, unit = split(where, value)
-    if unit is None:
-        return number
+    if unit is None:  # a number written as a string is not a number: the caller's check says so
+        return value
     if units != SPIN:
         shown = f" [{units}]" if units and units != "1" else ""
         raise StabmapError(f"{where} = {value!r}: a unit is accepted for spin rates only ({ACCEPTED}); "
