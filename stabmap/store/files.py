@@ -85,14 +85,11 @@ def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
     """Write ``ds`` to ``path`` (netCDF4 with zlib level 4, or Zarr for ``.zarr``) atomically.
 
     The data go to a temporary file in the same directory, renamed over
-    ``path`` only when complete, so a failure or Ctrl-C never leaves a partial file.  A part of an atlas
-    (``ds.sel(...)``) is written with its stored scene rewritten to the part's grid (``stabmap.store.subset``),
-    so that the file's scene still reproduces it.
+    ``path`` only when complete, so a failure or Ctrl-C never leaves a partial file.  ``ds`` is written as it is:
+    ``stabmap.write_atlas`` (``stabmap.store.subset.write_atlas``) also rewrites the stored scene of a part of
+    an atlas (``ds.sel(...)``) to the part's grid.
     """
-    from .subset import scene_attrs
-
     path = check_writable(path)
-    ds = ds.assign_attrs(scene_attrs(ds))
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         if is_zarr(path):

@@ -1,21 +1,30 @@
-"""The stored scene of a part of an atlas (``ds.sel(...)``, ``ds.isel(...)``): rewritten to the part's grid.
+"""``stabmap.write_atlas``: an atlas, or a part of one (``ds.sel(...)``, ``ds.isel(...)``) with its own scene.
 
 An atlas carries the scene that made it (global attribute ``scene``).  A part of it still carries the whole
 grid, so that scene would no longer reproduce the file; :func:`scene_attrs` gives the scene on the part's own
 grid instead: an axis cut by a slice or a list of values keeps those values, and an axis fixed at one value
 (``ds.sel(omega=42.0)``, a scalar coordinate now) becomes a one-value axis.  What the scene chose from its
 whole grid (a cavity's ``modes = "auto"``) is kept (``SceneBase.with_grid``), so the part's scene decides each
-of its points as the whole atlas did.
+of its points as the whole atlas did.  (``store.files.write_atlas`` writes a Dataset as it is; it cannot call
+this module, which reads scenes, without an import cycle: reading a scene file asks ``store.files`` what it is.)
 """
 
 from __future__ import annotations
 
 import datetime as dt
+from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
 from ..errors import StabmapError
+from . import files
+
+
+def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
+    """Write ``ds`` to ``path`` (netCDF4 ``.nc`` or Zarr ``.zarr``) atomically, as ``store.files.write_atlas``; a
+    part of an atlas with its stored scene rewritten to the part's grid (:func:`scene_attrs`)."""
+    return files.write_atlas(ds.assign_attrs(scene_attrs(ds)), path)
 
 
 def scene_attrs(ds: xr.Dataset) -> dict:
