@@ -293,3 +293,21 @@ half_height_1 = { start = 0.0125, stop = 0.05, num = 4 }
     part = s.with_grid(short)
     assert (part.bodies[0].cavity.modes, part.bodies[0].cavity.kept) == (chosen, chosen)
     assert loads_scene(part.to_toml()).bodies[0].cavity.kept == chosen
+
+
+def test_figures_label_a_spin_rate_axis_in_its_display_unit(in_rpm):
+    from stabmap.read.plot import atlas_figure
+
+    for x, y in (("omega", "c_1"), ("c_1", "omega")):
+        fig = atlas_figure(in_rpm, x=x, y=y)
+        fig.canvas.draw()
+        ax = fig.axes[0]
+        i = 0 if x == "omega" else 1  # omega along x, then along y
+        axis, label, (lo, hi) = (ax.xaxis, ax.get_xlabel(), ax.get_xlim()) if i == 0 else (ax.yaxis, ax.get_ylabel(), ax.get_ylim())
+        assert label.endswith("[rpm]")
+        ticks = [(t.get_position()[i], t.get_text()) for t in axis.get_ticklabels() if lo <= t.get_position()[i] <= hi]
+        assert len(ticks) >= 3
+        for where, text in ticks:  # data in rad/s, labels at round rpm
+            assert float(text) == pytest.approx(where / RPM, rel=1e-12) and float(text) % 10 == 0
+    plain = atlas_figure(stabmap.compute_atlas(loads_scene(TOP.format(start=5.0, stop=20.0)), threads=1, progress=False))
+    assert plain.axes[0].get_xlabel().endswith("[rad\u00a0s$^{-1}$]")
