@@ -18,6 +18,10 @@ import numpy as np
 import xarray as xr
 
 from ..errors import StabmapError
+from ..scene.grid import Axis, parse_axes
+from ..scene.text import parse
+from ..scene.values import Parameter
+from ..systems import loads_scene
 from . import files
 
 
@@ -30,11 +34,6 @@ def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
 def scene_attrs(ds: xr.Dataset) -> dict:
     """The global attributes to change so that ``ds``'s stored scene reproduces its grid: ``{}`` when it does already
     (a whole atlas, critical values, a file without a scene); else ``scene`` rewritten and a ``history`` line."""
-    from ..scene.grid import Axis, parse_axes
-    from ..scene.text import parse
-    from ..scene.values import Parameter
-    from ..systems import loads_scene
-
     text = ds.attrs.get("scene")
     if text is None or ds.attrs.get("stabmap_kind") == "critical values":
         return {}
