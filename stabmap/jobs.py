@@ -310,12 +310,15 @@ def plot(
     """``stabmap plot``: draw an atlas (or critical values) to a PNG or PDF file (an existing one only if ``overwrite``)."""
     from .read import plot as figures
     from .read.query import parse_selection
+    from .scene.units import in_si
     from .store.files import check_new_output, open_atlas
 
     figures.check_figure_path(output)
     check_new_output(output, overwrite)
     ds = open_atlas(path, lazy=True)  # read chunk by chunk: bounded memory at any size
     chosen = parse_selection(list(sel), ranges=False, option="--sel")
+    # A spin rate given with its unit (--sel omega="14000 rpm") in the file's units, rad/s.
+    chosen = {k: in_si(f"--sel {k}", v, str(ds[k].attrs.get("units", ""))) if k in ds.coords else v for k, v in chosen.items()}
     if ds.attrs.get("stabmap_kind") == "critical values":
         given = [opt for opt, v in (("--x", x), ("--y", y), ("--facet", facet), ("--max-panels", max_panels)) if v is not None]
         if given:

@@ -9,6 +9,7 @@ import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError
+from ..scene import units
 from .summary import summary
 
 
@@ -34,6 +35,15 @@ def wrapped(head: str, items: list[str], indent: str = "  ", width: int = WIDTH,
     lines = textwrap.wrap(text, width=width, initial_indent=first, subsequent_indent=" " * len(first),
                           break_long_words=False, break_on_hyphens=False) or [first.rstrip()]
     return [line.replace("\u00a0", " ") for line in lines]
+
+
+def display_range(c: xr.DataArray) -> str:
+    """`` (= 5000 .. 20000 rpm)`` for an axis with ``display_units`` (a spin rate the scene gave in rpm or Hz), else ""."""
+    unit = c.attrs.get("display_units")
+    if not unit:
+        return ""
+    k = units.factor(str(unit))
+    return f" (= {float(c.min()) / k:.6g} .. {float(c.max()) / k:.6g} {unit})"
 
 
 def fixed_parameters(ds: xr.Dataset, system, item=None) -> list[tuple[str, list[str]]]:
@@ -83,8 +93,9 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
     name_width = max([10, *map(len, dims)])
     for d in dims:
         c = ds[d]
+        shown = display_range(c)
         lines.append(
-            f"    {d:<{name_width}} {plural(c.size, 'point'):>11}  {float(c.min()):.6g} .. {float(c.max()):.6g} {c.attrs.get('units', '')}  "
+            f"    {d:<{name_width}} {plural(c.size, 'point'):>11}  {float(c.min()):.6g} .. {float(c.max()):.6g} {c.attrs.get('units', '')}{shown}  "
             f"({c.attrs.get('scale', '')})  {c.attrs.get('long_name', '')}"
         )
     groups = fixed_parameters(ds, system)

@@ -43,6 +43,7 @@ from .. import systems
 from ..store.files import check_writable
 from ..store.variables import CELL, INFERRED
 from .blocks import block_factors, reduce_blocks
+from ..scene import units
 from .info import fixed_parameters, scene_notes, unit_suffix
 
 MAX_PANELS = 12  # default limit of small multiples
@@ -449,8 +450,9 @@ def _symbol(ds: xr.Dataset, name: str) -> str:
     return f"${base}_{{{k}}}$" if k else f"${base}$"
 
 
-def axis_label(ds: xr.Dataset, dim: str, width: int = 60) -> str:
-    """'common spin rate ω [rad s⁻¹]': the coordinate's long_name (parentheses dropped), symbol and units."""
+def axis_label(ds: xr.Dataset, dim: str, width: int = 60, shown: str = "") -> str:
+    """'common spin rate ω [rad s⁻¹]': the coordinate's long_name (parentheses dropped), symbol and units
+    (``shown``: the units its tick labels are shown in, see :func:`display_ticks`)."""
     attrs = ds[dim].attrs
     name = re.sub(r"\s*\([^)]*\)", "", attrs.get("long_name", "")).replace(" about its centre of mass", "").strip()
     sym = _symbol(ds, dim)
@@ -460,10 +462,30 @@ def axis_label(ds: xr.Dataset, dim: str, width: int = 60) -> str:
         text = f"{name} ({dim})"
     else:
         text = f"{name} {sym}"
-    units = _units(str(attrs.get("units", "")))
+    units = shown or _units(str(attrs.get("units", "")))
     if units:
         text += f" [{units}]"
     return textwrap.fill(text, width, break_long_words=False, break_on_hyphens=False)
+
+
+def display_ticks(ds: xr.Dataset, dim: str, axis) -> str:
+    """Tick labels of a linear spin-rate axis in its ``display_units`` (rpm, Hz), at round values of that unit; the
+    data stay in rad/s.  Returns the unit shown, or "" (no display unit, or a log axis: left as it is)."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator
+
+    unit = str(ds[dim].attrs.get("display_units", ""))
+    if not unit or axis.get_scale() == "log":
+        return ""
+    k = units.factor(unit)
+
+    class Scaled(MaxNLocator):
+        def tick_values(self, vmin, vmax):
+            return super().tick_values(vmin / k, vmax / k) * k
+
+    if not isinstance(axis.get_major_locator(), FixedLocator):  # ticks at listed values stay there
+        axis.set_major_locator(Scaled(nbins="auto", steps=[1, 2, 2.5, 5, 10]))
+    axis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v / k:g}"))
+    return unit
 
 
 def _value_text(ds: xr.Dataset, dim: str, value: float) -> str:
@@ -653,15 +675,16 @@ def atlas_figure(
             if np.min(np.diff(v_)) >= (v_[-1] - v_[0]) / 12:  # ... unless their labels would collide
                 setter(v)
 
+    shown = {dim: display_ticks(ds, dim, axis) for dim, axis in ((plan.x, first.xaxis), (plan.y, first.yaxis)) if dim}
     if plan.facet is None:
-        first.set_xlabel(axis_label(ds, plan.x))
+        first.set_xlabel(axis_label(ds, plan.x, shown=shown[plan.x]))
         if plan.y:
-            first.set_ylabel(axis_label(ds, plan.y, width=45))
+            first.set_ylabel(axis_label(ds, plan.y, width=45, shown=shown[plan.y]))
     else:
         for n, ax in enumerate(axes):  # tick labels only where no panel is below / to the left
             ax.tick_params(labelbottom=n + ncols >= len(panels), labelleft=n % ncols == 0)
-        maps.supxlabel(axis_label(ds, plan.x, width=int(12 * (size[0] - _LEGEND_WIDTH))), fontsize=10)
-        maps.supylabel(axis_label(ds, plan.y, width=int(10 * size[1])), fontsize=10)
+        maps.supxlabel(axis_label(ds, plan.x, width=int(12 * (size[0] - _LEGEND_WIDTH)), shown=shown[plan.x]), fontsize=10)
+        maps.supylabel(axis_label(ds, plan.y, width=int(10 * size[1]), shown=shown.get(plan.y, "")), fontsize=10)
 
     handles = [class_patch(v, system) for v in present]
     if drawn["stability"]:

@@ -37,6 +37,7 @@ import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError
+from ..scene.units import common_unit, in_si, looks_like_rate, split
 from ..store.variables import INFERRED
 from .blocks import changes, compute, first_true
 
@@ -171,7 +172,9 @@ def _not_an_axis(ds: xr.Dataset, name: str, dims: list[str], role: str = "") -> 
     return StabmapError(f"{role}{name!r} is not an axis of this atlas; its axes are: {axes}")
 
 
-def _number(name: str, value) -> float:
+def _number(name: str, value, units: str = "") -> float:
+    if isinstance(value, str) and not _plain(value) and looks_like_rate(value):
+        value = in_si(name, value, units)  # a spin rate may carry its unit: "14000 rpm"
     try:
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, str, np.integer, np.floating)):
             raise ValueError
@@ -183,7 +186,15 @@ def _number(name: str, value) -> float:
     return value
 
 
-def _request(name: str, value) -> float | tuple[float | None, float | None]:
+def _plain(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _request(name: str, value, units: str = "") -> float | tuple[float | None, float | None]:
     """A number, or a range (lo, hi) with lo <= hi (None: unbounded), from a user's value."""
     if isinstance(value, slice):
         if value.step is not None:
@@ -194,8 +205,8 @@ def _request(name: str, value) -> float | tuple[float | None, float | None]:
             raise StabmapError(f"{name}={value!r}: a range is a pair (lo, hi), e.g. {name}=(1.0, 2.5)")
         ends = tuple(value)
     else:
-        return _number(name, value)
-    lo, hi = (None if v is None else _number(name, v) for v in ends)
+        return _number(name, value, units)
+    lo, hi = (None if v is None else _number(name, v, units) for v in ends)
     if lo is not None and hi is not None and lo > hi:
         lo, hi = hi, lo
     return lo, hi
@@ -219,9 +230,9 @@ def select(ds: xr.Dataset, sel: dict, *, along: str | None = None) -> tuple[xr.D
     for name, value in sel.items():
         if name not in dims:
             raise _not_an_axis(ds, name, dims)
-        requested = _request(name, value)
-        grid = np.asarray(ds[name].values, dtype=np.float64)
         units = str(ds[name].attrs.get("units", ""))
+        requested = _request(name, value, units)
+        grid = np.asarray(ds[name].values, dtype=np.float64)
         if isinstance(requested, tuple):
             lo, hi = requested
             keep = np.ones(grid.size, dtype=bool)
@@ -286,7 +297,7 @@ def label_at(ds: xr.Dataset, **point: float) -> Label:
     missing = [d for d in dims if d not in point]
     if missing:
         raise StabmapError(f"give a value for every axis; missing: {', '.join(missing)} (e.g. {missing[0]}={float(ds[missing[0]][0]):g})")
-    point = {k: _number(k, v) for k, v in point.items()}
+    point = {k: _number(k, v, str(ds[k].attrs.get("units", ""))) for k, v in point.items()}
     sel = ds.sel(point, method="nearest") if dims else ds
     outside = tuple(
         d for d in dims if not float(ds[d].min()) <= float(point[d]) <= float(ds[d].max())
@@ -584,6 +595,19 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
     return out
 
 
+def _end(text: str, where: str) -> float | str | None:
+    """One end of a selection: None (open), a number, or a number with a unit, kept as text (``select`` converts it
+    by the axis's units); an unknown unit a StabmapError naming ``where``, anything else a ValueError."""
+    if not text:
+        return None
+    if _plain(text):
+        return float(text)
+    if not looks_like_rate(text):
+        raise ValueError(text)
+    split(where, text)  # its unit is known, or a StabmapError naming it
+    return text
+
+
 def parse_selection(items: list[str], *, ranges: bool = True, option: str = "") -> dict:
     """``NAME=VALUE`` (nearest grid value) and, with ``ranges``, ``NAME=LO:HI`` (LO: and :HI open) as a selection.
 
@@ -602,10 +626,17 @@ def parse_selection(items: list[str], *, ranges: bool = True, option: str = "") 
         if len(ends) > 2 or (len(ends) == 2 and not ranges):
             raise StabmapError(f"{prefix}{item!r}: a range is NAME=LO:HI, e.g. {key}=0:10" if ranges else f"{prefix}{item!r}: give one value, e.g. {key}=42.5")
         try:
-            numbers = [float(e) if e.strip() else None for e in ends]
+            numbers = [_end(e.strip(), f"{prefix}{key}") for e in ends]
+        except StabmapError:  # an unknown unit, named
+            raise
         except ValueError:
             what = "a number or a range LO:HI" if ranges else "a number"
-            raise StabmapError(f"{prefix}{item!r}: {value!r} is not {what}; write e.g. {key}=42.5" + (f" or {key}=0:10" if ranges else "")) from None
+            raise StabmapError(f"{prefix}{item!r}: {value!r} is not {what}; write e.g. {key}=42.5" + (f" or {key}=0:10" if ranges else "")
+                               + f' (a spin rate may carry its unit: {key}="14000 rpm")') from None
+        # A unit after a range is that of both ends: omega=5000:20000rpm (mixed units are an error).
+        unit = common_unit(f"{prefix}{item!r}", [e for e in numbers if isinstance(e, str)])
+        if unit is not None:
+            numbers = [f"{e} {unit}" if isinstance(e, float) else e for e in numbers]
         if len(numbers) == 1 and numbers[0] is None:
             raise StabmapError(f"{prefix}{item!r}: no value; write e.g. {key}=42.5" + (f" or {key}=0:10" if ranges else ""))
         out[key] = numbers[0] if len(numbers) == 1 else tuple(numbers)

@@ -4,7 +4,9 @@ An axis is named exactly like the parameter it scans (the name becomes the
 Dataset dimension) and holds its values, sorted and distinct.  In TOML it is
 ``name = { start = .., stop = .., num = .., scale = "linear" | "log" }`` or
 ``name = { values = [...] }``.  Which names exist and what values they may take
-is the system's (``parameter``, a function of the name).
+is the system's (``parameter``, a function of the name).  A spin-rate axis may be
+given in rpm or Hz (``start = "5000 rpm"``, one unit for the whole axis): its
+values are stored in rad/s and the unit is kept as the axis's ``display_units``.
 """
 
 from __future__ import annotations
@@ -15,10 +17,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import StabmapError
+from . import units
 from .values import Parameter, check_value, no_unknown
 
 SCALES = ("linear", "log", "values")
-_AXIS_KEYS = {"start", "stop", "num", "scale", "values"}
+_AXIS_KEYS = {"start", "stop", "num", "scale", "values", "display_units"}
 _NUMBER = Parameter("", "", "")  # any finite number: the limits are the system's (check_axes)
 
 
@@ -29,6 +32,7 @@ class Axis:
     name: str
     values: tuple[float, ...]
     scale: str = "linear"  # "linear" | "log" | "values" (listed explicitly)
+    display_units: str = ""  # a spin rate's unit for display, "rpm" or "Hz"; "": the stored unit (values are SI)
 
     def __post_init__(self):
         where = f"grid.{self.name}"
@@ -42,6 +46,7 @@ class Axis:
             raise StabmapError(f"{where}: values must be distinct and sorted (increasing or decreasing)")
         if self.scale == "log" and min(self.values) <= 0:
             raise StabmapError(f'{where}: scale = "log" needs values > 0, got {min(self.values)}')
+        object.__setattr__(self, "display_units", units.check_display(f"{where}.display_units", self.display_units))
 
     @property
     def array(self) -> np.ndarray:
@@ -53,8 +58,11 @@ class Axis:
         if self.scale in ("linear", "log") and n > 2:
             spaced = np.geomspace if self.scale == "log" else np.linspace
             if np.array_equal(spaced(self.values[0], self.values[-1], n), self.array):
-                return {"start": self.values[0], "stop": self.values[-1], "num": n, "scale": self.scale}
-        return {"values": list(self.values), "scale": self.scale}
+                return {"start": self.values[0], "stop": self.values[-1], "num": n, "scale": self.scale, **self._display()}
+        return {"values": list(self.values), "scale": self.scale, **self._display()}
+
+    def _display(self) -> dict:
+        return {"display_units": self.display_units} if self.display_units else {}
 
 
 def check_axes(axes: tuple[Axis, ...], parameter: Callable[[str], Parameter]) -> None:
@@ -66,6 +74,9 @@ def check_axes(axes: tuple[Axis, ...], parameter: Callable[[str], Parameter]) ->
         info = parameter(a.name)
         for i, v in enumerate(a.values):
             check_value(f"grid.{a.name}.values[{i + 1}]", v, info)
+        if a.display_units and info.units != units.SPIN:
+            raise StabmapError(f"grid.{a.name}.display_units: only a spin-rate axis [rad s-1] has display units; "
+                               f"{a.name} is in [{info.units}], remove display_units")
 
 
 def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
@@ -78,13 +89,16 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
         where = f"grid.{name}"
         no_unknown(spec, _AXIS_KEYS, where)
         if "values" in spec:
-            extra = set(spec) - {"values", "scale"}
+            extra = set(spec) - {"values", "scale", "display_units"}
             if extra:
                 raise StabmapError(f"{where}: give either values or start/stop/num, not both (remove {sorted(extra)[0]!r})")
             values = spec["values"]
             if not isinstance(values, list) or not values:
                 raise StabmapError(f"{where}.values must be a non-empty list of numbers")
-            axes.append(Axis(name, tuple(values), spec.get("scale", "values")))
+            converted = [units.in_si(f"{where}.values[{i + 1}]", v, info.units) for i, v in enumerate(values)]
+            unit = units.common_unit(f"{where}.values", values)
+            values = converted
+            axes.append(Axis(name, tuple(values), spec.get("scale", "values"), _display(spec, unit)))
             continue
         for key in ("start", "stop", "num"):
             if key not in spec:
@@ -94,6 +108,7 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
             raise StabmapError(f"{where}.num must be a whole number >= 1, got {num!r}")
         start = check_value(f"{where}.start", spec["start"], info)
         stop = check_value(f"{where}.stop", spec["stop"], info)
+        unit = units.common_unit(where, [spec["start"], spec["stop"]])
         if num == 1 and stop != start:
             raise StabmapError(f"{where}: num = 1 gives the one value start = {start:g} and would ignore stop = {stop:g}; "
                                f"give num >= 2, or values = [{start:g}]")
@@ -106,8 +121,13 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
             values = np.geomspace(start, stop, num)
         else:
             raise StabmapError(f'{where}.scale must be "linear" or "log", got {scale!r}')
-        axes.append(Axis(name, tuple(float(v) for v in values), scale))
+        axes.append(Axis(name, tuple(float(v) for v in values), scale, _display(spec, unit)))
     return tuple(axes)
+
+
+def _display(spec: dict, unit: str | None) -> str:
+    """The display unit of an axis: ``display_units`` if given, else the unit its values were written in."""
+    return spec.get("display_units", unit if unit in units.DISPLAY else "")
 
 
 def resample(scene, **nums: int):
@@ -120,6 +140,6 @@ def resample(scene, **nums: int):
         if a.name in nums:
             lo, hi = a.values[0], a.values[-1]
             values = np.geomspace(lo, hi, nums[a.name]) if a.scale == "log" else np.linspace(lo, hi, nums[a.name])
-            a = Axis(a.name, tuple(float(v) for v in values), a.scale)
+            a = replace(a, values=tuple(float(v) for v in values))
         axes.append(a)
     return replace(scene, grid=tuple(axes))

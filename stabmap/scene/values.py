@@ -7,6 +7,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import StabmapError
+from .units import in_si
 
 
 @dataclass(frozen=True)
@@ -21,7 +22,8 @@ class Parameter:
 
 
 def check_value(where: str, value, info: Parameter) -> float:
-    """Return ``value`` as a float or raise a StabmapError naming ``where``."""
+    """Return ``value`` as a float or raise a StabmapError naming ``where``; a spin rate may carry a unit ("14000 rpm")."""
+    value = in_si(where, value, info.units)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise StabmapError(f"{where} must be a number, got {value!r}")
     value = float(value)

@@ -38,8 +38,10 @@ def coordinates(system, scene, skip: tuple[str, ...] = ()) -> dict:
             continue
         info = system.parameter(scene, axis.name)
         name = f"{axis.name}_bounds"
-        coords[axis.name] = (axis.name, axis.array, {"units": info.units, "long_name": info.long_name, "scale": axis.scale,
-                                                     "bounds": name})
+        attrs = {"units": info.units, "long_name": info.long_name, "scale": axis.scale, "bounds": name}
+        if axis.display_units:  # the unit the scene gave (rpm, Hz): values stay SI, readers may show them in it
+            attrs["display_units"] = axis.display_units
+        coords[axis.name] = (axis.name, axis.array, attrs)
         coords[name] = ((axis.name, BOUNDS_DIM), bounds(axis.array), {"units": info.units,
                         "long_name": f"edges of the grid cells along {axis.name} (midpoints between grid values)"})
     for key, value in system.fixed_values(scene).items():

@@ -85,7 +85,9 @@ def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
     """Write ``ds`` to ``path`` (netCDF4 with zlib level 4, or Zarr for ``.zarr``) atomically.
 
     The data go to a temporary file in the same directory, renamed over
-    ``path`` only when complete, so a failure or Ctrl-C never leaves a partial file.
+    ``path`` only when complete, so a failure or Ctrl-C never leaves a partial file.  ``ds`` is written as it is:
+    ``stabmap.write_atlas`` (``stabmap.store.subset.write_atlas``) also rewrites the stored scene of a part of
+    an atlas (``ds.sel(...)``) to the part's grid.
     """
     path = check_writable(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")

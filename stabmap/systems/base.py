@@ -16,7 +16,7 @@ belong to its physics:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import ClassVar
 
@@ -42,6 +42,11 @@ class SceneBase:
     def to_dict(self) -> dict:
         """The scene's TOML table, without the ``system`` key."""
         raise NotImplementedError
+
+    def with_grid(self, grid: tuple[Axis, ...]) -> "SceneBase":
+        """The same scene on ``grid`` (a subset of its own, ``store.subset``), with every choice this scene made from
+        its grid kept as it is, so that each point is decided as before."""
+        return replace(self, grid=tuple(grid))
 
     def to_toml(self) -> str:
         """The scene as TOML text that ``stabmap.loads_scene`` reads back to an equal scene."""

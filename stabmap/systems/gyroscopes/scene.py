@@ -113,6 +113,12 @@ class Scene(SceneBase):
                 out.append((f"body {k}", liquid.describe(b.cavity)))
         return out
 
+    def with_grid(self, grid: tuple[Axis, ...]) -> Scene:
+        # modes = "auto" chose its count from this grid's extremes; a subset keeps that count, and so its labels.
+        bodies = tuple(b if b.cavity is None or b.cavity.modes != liquid.AUTO
+                       else replace(b, cavity=replace(b.cavity, modes=b.cavity.kept, mode_tolerance=None)) for b in self.bodies)
+        return replace(self, bodies=bodies, grid=tuple(grid))
+
     def to_dict(self) -> dict:
         out = {"title": self.title, "support": self.support}
         if not self.free:
@@ -329,7 +335,8 @@ def fixed_values(scene: Scene) -> dict[str, float]:
     """Every scalar parameter of the scene that is not a grid axis, by its scannable name."""
     names = {a.name for a in scene.grid}
     out = {}
-    if scene.omega is not None and "omega" not in names:
+    own = all(b.omega is not None or f"omega_{k}" in names for k, b in enumerate(scene.bodies, start=1))
+    if scene.omega is not None and "omega" not in names and not own:  # in force only where a body does not set its own
         out["omega"] = scene.omega
     if not scene.free and "g" not in names:
         out["g"] = scene.g

@@ -177,10 +177,10 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
 
 
 # ------------------------------------------------------------------------------------------------------ the checks
-def _vector(value, where: str) -> Vector:
+def _vector(value, where: str, info: Parameter = _ANY) -> Vector:
     if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 3:
         raise StabmapError(f"{where} must be a 3-vector [x, y, z], got {value!r}")
-    return tuple(check_value(f"{where}[{d}]", v, _ANY) for d, v in enumerate(value))
+    return tuple(check_value(f"{where}[{d}]", v, info) for d, v in enumerate(value))
 
 
 def _validate(scene: Scene) -> None:
@@ -222,7 +222,8 @@ def _checked_body(b: Body) -> Body:
     if not isinstance(b, Body):
         raise StabmapError(f"body must be a Body(mass, ...), got {b!r}")
     mass = check_value("body.mass", b.mass, parameters.MASS)
-    vectors = {key: _vector(getattr(b, key), f"body.{key}") for key in ("centre", "gravity", "acceleration", "omega", "alpha")}
+    vectors = {key: _vector(getattr(b, key), f"body.{key}") for key in ("centre", "gravity", "acceleration", "alpha")}
+    vectors["omega"] = _vector(b.omega, "body.omega", parameters.BODY_VECTORS["omega"])  # rad/s, or rpm and Hz
     raw = b.inertia
     if isinstance(raw, (str, bytes)) or not hasattr(raw, "__len__") or len(raw) != 3:
         raise StabmapError(f"body.inertia must be 3 principal moments [Ixx, Iyy, Izz] or a 3x3 tensor [kg m2], got {raw!r}")
