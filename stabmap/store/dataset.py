@@ -45,6 +45,7 @@ def coordinates(system, scene, skip: tuple[str, ...] = ()) -> dict:
     for key, value in system.fixed_values(scene).items():
         info = system.parameter(scene, key)
         coords[key] = ((), np.float64(value), {"units": info.units, "long_name": info.long_name})
+    coords.update({k: v for k, v in system.derived_coords(scene).items() if not set(v[0]) & set(skip)})
     return coords
 
 

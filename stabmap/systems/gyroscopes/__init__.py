@@ -47,8 +47,14 @@ class Gyroscopes(System):
     label_title = "complex root pairs N$_c$"
     stable_label = 0
     provenance = "decided_by"
-    symbols = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho"}
+    symbols = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho",
+               "M_alpha": r"M_\alpha", "S_g": "S_g", "C_over_A": "C/A", "aspect": "h/a"}
     scene_module = _scene
+
+    def derived_coords(self, scene: Scene) -> dict[str, tuple]:
+        from .ratios import coordinates
+
+        return coordinates(scene, scene.parameter)
 
     def attrs(self, scene: Scene) -> dict:
         attrs = {"support": scene.support, "n_bodies": scene.n, "polynomial_degree_bound": scene.degree}
