@@ -15,6 +15,7 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
+from scipy import special
 
 import reference as ref
 from stabmap import loads_scene
@@ -272,3 +273,42 @@ def test_the_moved_quantity_replaces_its_fixed_coordinate_and_the_aspect_keeps_t
     text = ("omega = 1.0\n[[bodies]]\nm = 3.0\nA = 0.05\nC = 0.02\nc = 0.1\n" + CAVITY + "\n[grid]\naspect_1 = { values = [1.0, 40.0] }")
     with pytest.raises(StabmapError, match="less than the frozen liquid"):
         loads_scene(text)
+
+
+# ------------------------------------------------------------------------------- Stewartson's cylinder eigenfrequencies
+def _kelvin_roots(ka: float, lo: float = 0.2) -> list[float]:
+    """Every frequency sigma (body frame, over the spin) with lo < |sigma| < 2 of an m = 1 inertial wave of axial
+    wavenumber k in a full cylinder of radius a (Kelvin): xi^2 = (ka)^2 (4 - sigma^2) / sigma^2 and no flow through
+    the wall, sigma xi J1'(xi) + 2 J1(xi) = 0.  Found by a scan in sigma (scipy) and refined by mpmath, without the
+    cavity module's brackets."""
+    mpmath.mp.dps = 30
+
+    def f(s):
+        s = mpmath.mpf(s)
+        xi = ka * mpmath.sqrt(4 - s * s) / abs(s)
+        return s * xi * mpmath.besselj(1, xi, derivative=1) + 2 * mpmath.besselj(1, xi)
+
+    roots = []
+    for a, b in ((-2.0, -lo), (lo, 2.0)):
+        grid = np.linspace(a, b, 4001)
+        xi = ka * np.sqrt(4 - grid**2) / np.abs(grid)
+        vals = grid * xi * special.jvp(1, xi) + 2 * special.jv(1, xi)  # the scan in floats, each root refined by mpmath
+        for x0, x1, v0, v1 in zip(grid, grid[1:], vals, vals[1:]):
+            if v0 * v1 < 0:
+                roots.append(float(mpmath.findroot(f, (x0, x1), solver="anderson")))
+    return sorted(roots)
+
+
+@pytest.mark.parametrize("c_over_a", [0.5, 1.0, 2.0, 3.5])
+def test_cylinder_modes_are_kelvins_inertial_waves(c_over_a):
+    # Stewartson (1959) tabulates these eigenfrequencies against c/a; his tables are not at hand, so the reference is
+    # the dispersion relation itself, solved for sigma = lambda_l / omega = 2 / kappa (docs/projectile.md).
+    from stabmap import cavity
+
+    modes = cavity.cylinder_modes(1.0, c_over_a, 1.0, n_max=2, j_max=40)
+    for n in (1, 2):
+        ka = (2 * n - 1) * math.pi / (2 * c_over_a)
+        sigma = sorted(s for s in (2.0 / modes["kappa"][n - 1].ravel()) if abs(s) > 0.2)
+        want = _kelvin_roots(ka)
+        assert len(sigma) == len(want) > 0
+        np.testing.assert_allclose(sigma, want, rtol=1e-11, atol=1e-13)

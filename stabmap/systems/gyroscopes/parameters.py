@@ -39,7 +39,7 @@ EVERY_BODY = ("m", "A", "C", "c", "s")  # grid axes that set one parameter of ev
 # of mass, and the gyroscopic stability factor it gives, S_g = C_1^2 omega_1^2 / (4 A_1 M_alpha).
 PROJECTILE = {
     "M_alpha": Parameter("M_alpha", "N m rad-1", "aerodynamic overturning moment coefficient of body 1 about its centre of mass", None, False),
-    "S_g": Parameter("S_g", "1", "gyroscopic stability factor of body 1, C^2 omega^2 / (4 A M_alpha)", 0.0, True),
+    "S_g": Parameter("S_g", "1", "gyroscopic stability factor of body 1", 0.0, True),  # C^2 omega^2 / (4 A M_alpha)
 }
 # Dimensionless axes (``ratios``): each moves one underlying quantity, the scene's [hold] says which is held.
 RATIO = {
