@@ -91,7 +91,8 @@ class Gyroscopes(System):
     def fastest_axes(self, scene: Scene) -> tuple[int, ...]:
         # The kernels rebuild the inertia and stiffness matrices only when a point's masses, lengths or
         # stiffnesses differ from the previous point's: runs of points that differ only in spin skip that work.
-        return tuple(d for d, a in enumerate(scene.grid) if a.name == "omega" or a.name.startswith("omega_"))
+        spins = {"omega", "S_g"} if scene.hold.S_g == "M_alpha" else {"omega"}  # S_g moves the spin by default
+        return tuple(d for d, a in enumerate(scene.grid) if a.name in spins or a.name.startswith("omega_"))
 
     def cost(self, scene: Scene) -> Cost:
         from .points import point_arrays
