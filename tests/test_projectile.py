@@ -173,6 +173,8 @@ def test_hold_omega_moves_M_alpha():
     assert pts.joint[:, 0].tolist() == [-12.5, -3.125]
     assert (pts.body[:, 0, 5] == 10.0).all()
     assert "S_g" not in box_axes(s)
+    ds = atlas.compute(s, progress=False, threads=1)
+    assert ds["M_alpha"].dims == ("S_g",) and "K_0" not in ds.coords and float(ds["omega"]) == 10.0
 
 
 # ------------------------------------------------------------------------------------------------ the ratio axes

@@ -363,7 +363,7 @@ def fixed_values(scene: Scene) -> dict[str, float]:
         if b.cavity is not None and b.cavity.geometric:
             for key in SCANNABLE_CAVITY:
                 out[f"{key}_{k}"] = getattr(b.cavity, key)
-    if not scene.free and scene.M_alpha is None:
+    if not scene.free and not ratios.projectile(scene):  # M_alpha takes the base joint's place
         out["K_0"] = scene.K_0
     if scene.M_alpha is not None and "M_alpha" not in names:
         out["M_alpha"] = scene.M_alpha
