@@ -258,6 +258,8 @@ def test_aspect_ratio_equals_scanning_the_sizes(hold):
      "half_height_1 = { values = [0.01] }", 'hold.aspect = "half_height"'),
     ('omega = 1.0\n[hold]\naspect = "volume"\n[[bodies]]\nm = 9.0\nA = 1.0\nC = 1.0\nc = 0.0\n' + CAVITY + "\n[grid]\n"
      "aspect_1 = { values = [1.0] }\nradius_1 = { values = [0.01] }", "remove 'radius_1'"),
+    ('omega = 1.0\n[hold]\naspect = "volume"\n[[bodies]]\nm = 9.0\nA = 1.0\nC = 1.0\nc = 0.0\n' + CAVITY + "\n[grid]\n"
+     "aspect_1 = { values = [1.0] }\nhalf_height_1 = { values = [0.01] }", "hold.aspect = 'volume'.*set hold.aspect = \"half_height\""),
     ('omega = 1.0\n[hold]\naspect = "length"\n[[bodies]]\nm = 1.0\nA = 1.0\nC = 1.0\nc = 0.0', "hold.aspect must be one of"),
     ('omega = 1.0\n[hold]\nC_over_a = "A"\n[[bodies]]\nm = 1.0\nA = 1.0\nC = 1.0\nc = 0.0', "did you mean 'C_over_A'"),
     ("omega = 1.0\n[[bodies]]\nm = 1.0\nA = 1.0\nC = 1.0\nc = 0.0\n[grid]\nC_over_A = { values = [1.0] }", "did you mean"),

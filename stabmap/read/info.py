@@ -79,7 +79,7 @@ def describe(ds: xr.Dataset, name: str = "") -> str:
     for d in dims:
         c = ds[d]
         lines.append(
-            f"    {d:<{name_width}} {plural(c.size, 'point'):>11}  {float(c.min()):.6g} .. {float(c.max()):.6g} {c.attrs.get('units', '')}  "
+            f"    {d:<{name_width}} {plural(c.size, 'point'):>11}  {float(c.min()):.6g} .. {float(c.max()):.6g}{unit_suffix(c.attrs.get('units'))}  "
             f"({c.attrs.get('scale', '')})  {c.attrs.get('long_name', '')}"
         )
     groups = fixed_parameters(ds, system)

@@ -10,7 +10,7 @@ coordinates over the grid axes they depend on.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -58,17 +58,19 @@ def _omega_1(scene) -> str:
     return "omega_1" if scene.bodies[0].omega is not None else "omega"
 
 
-def moved(scene, name: str) -> tuple[str, ...]:
-    """The parameter names a ratio axis ``name`` moves (empty for an ordinary axis)."""
+def moved(scene, name: str, hold: Hold | None = None) -> tuple[str, ...]:
+    """The parameter names a ratio axis ``name`` moves (empty for an ordinary axis), under ``hold`` (default: the
+    scene's)."""
+    hold = scene.hold if hold is None else hold
     parsed = parse_name(name, scene.n, scene.support)
     if parsed.symbol == "S_g":
-        return (_omega_1(scene),) if scene.hold.S_g == "M_alpha" else ("M_alpha",)
+        return (_omega_1(scene),) if hold.S_g == "M_alpha" else ("M_alpha",)
     if parsed.kind != "ratio":
         return ()
     k = parsed.index
     if parsed.symbol == "C_over_A":
-        return (f"C_{k}",) if scene.hold.C_over_A == "A" else (f"A_{k}",)
-    return {"radius": (f"half_height_{k}",), "half_height": (f"radius_{k}",)}.get(scene.hold.aspect, (f"radius_{k}", f"half_height_{k}"))
+        return (f"C_{k}",) if hold.C_over_A == "A" else (f"A_{k}",)
+    return {"radius": (f"half_height_{k}",), "half_height": (f"radius_{k}",)}.get(hold.aspect, (f"radius_{k}", f"half_height_{k}"))
 
 
 def projectile(scene) -> bool:
@@ -87,7 +89,9 @@ def check(scene) -> None:
         name = parse_name(axis.name, scene.n, scene.support)
         if taken:
             what = "S_g" if name.symbol == "S_g" else name.symbol
-            other = next(c for c in CHOICES[what] if c != getattr(scene.hold, what))
+            # the other hold that leaves the clashing quantity alone (volume moves both of a cavity's sizes)
+            other = next(c for c in CHOICES[what] if c != getattr(scene.hold, what)
+                         and taken[0] not in moved(scene, axis.name, replace(scene.hold, **{what: c})))
             clash = taken[0] if taken[0] in names else _every(taken[0])
             raise StabmapError(
                 f"grid axes {axis.name!r} and {clash!r}: {axis.name} moves {taken[0]} (hold.{what} = "
