@@ -20,6 +20,7 @@ from scipy import special
 import reference as ref
 from stabmap import loads_scene
 from stabmap.errors import StabmapError
+from stabmap.read.info import describe
 from stabmap.run import atlas
 from stabmap.run.critical import critical
 from stabmap.systems.gyroscopes import SYSTEM, exact
@@ -163,6 +164,8 @@ def test_the_S_g_coordinate_where_M_alpha_is_given():
     nc = ds.n_complex_pairs.values
     assert ((nc == 0) == (ds["S_g"].values >= 1)).all()  # no grid point sits on S_g = 1 within rounding here
     assert "M_alpha" in ds.coords and float(ds["M_alpha"]) == 3.0 and "K_0" not in ds.coords
+    text = describe(ds, "shell.nc")
+    assert "set by the axes:" in text and "S_g        over omega, A_1: 0.0833333 .. 16.6667" in text
 
 
 def test_hold_omega_moves_M_alpha():
