@@ -321,3 +321,33 @@ def test_cylinder_modes_are_kelvins_inertial_waves(c_over_a):
         want = _kelvin_roots(ka)
         assert len(sigma) == len(want) > 0
         np.testing.assert_allclose(sigma, want, rtol=1e-11, atol=1e-13)
+
+
+def test_S_g_moves_body_1s_own_spin_and_leaves_the_others():
+    text = """
+    M_alpha = 2.0
+    g = 0.0
+    omega = 30.0
+    [[bodies]]
+    m = 2.0
+    A = 0.5
+    C = 0.25
+    c = 0.0
+    s = 0.3
+    omega = 7.0
+    [[bodies]]
+    m = 0.5
+    A = 0.01
+    C = 0.02
+    c = 0.05
+    [grid]
+    S_g = { values = [1.0, 4.0] }
+    """
+    s = loads_scene(text)
+    pts = point_arrays(s, {"S_g": np.array([1.0, 4.0])})
+    assert pts.body[:, 0, 5].tolist() == [8.0, 16.0]  # 2 sqrt(0.5 * 2 * S_g) / 0.25
+    assert pts.body[:, 1, 5].tolist() == [30.0, 30.0]
+    ds = atlas.compute(s, progress=False, threads=1)
+    assert ds["omega_1"].values.tolist() == [8.0, 16.0] and float(ds["omega"]) == 30.0
+    with pytest.raises(StabmapError, match="remove 'omega_1'"):
+        loads_scene(text + "omega_1 = { values = [1.0] }")
