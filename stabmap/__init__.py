@@ -25,6 +25,7 @@ from .version import __version__
 _API = {
     "Axis": "stabmap.scene.grid",
     "Body": "stabmap.systems.gyroscopes.scene",
+    "Hold": "stabmap.systems.gyroscopes.ratios",
     "Scene": "stabmap.systems.gyroscopes.scene",
     "StableFraction": "stabmap.read.query",
     "atlas_figure": "stabmap.read.plot",

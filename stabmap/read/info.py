@@ -95,9 +95,18 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
         c = ds[d]
         shown = display_range(c)
         lines.append(
-            f"    {d:<{name_width}} {plural(c.size, 'point'):>11}  {float(c.min()):.6g} .. {float(c.max()):.6g} {c.attrs.get('units', '')}{shown}  "
+            f"    {d:<{name_width}} {plural(c.size, 'point'):>11}  {float(c.min()):.6g} .. {float(c.max()):.6g}{unit_suffix(c.attrs.get('units'))}{shown}  "
             f"({c.attrs.get('scale', '')})  {c.attrs.get('long_name', '')}"
         )
+    # auxiliary coordinates: what a ratio axis (S_g, C/A, h/a) moves, and S_g where M_alpha acts (docs/projectile.md)
+    derived = [k for k, c in ds.coords.items() if c.ndim and k not in ds.dims and not str(k).endswith("_bounds")]
+    if derived:
+        lines.append("  set by the axes:")
+    for k in derived:
+        c = ds[k]
+        lines += textwrap.wrap(f"{k:<{name_width}} over {', '.join(c.dims)}: {float(c.min()):.6g} .. {float(c.max()):.6g}"
+                               f"{unit_suffix(c.attrs.get('units'))}  {c.attrs.get('long_name', '')}", width=WIDTH,
+                               initial_indent="    ", subsequent_indent="      ")
     groups = fixed_parameters(ds, system)
     if groups:
         lines.append("  fixed:")

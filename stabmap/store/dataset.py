@@ -47,6 +47,10 @@ def coordinates(system, scene, skip: tuple[str, ...] = ()) -> dict:
     for key, value in system.fixed_values(scene).items():
         info = system.parameter(scene, key)
         coords[key] = ((), np.float64(value), {"units": info.units, "long_name": info.long_name})
+    for key, (dims, values, attrs) in system.derived_coords(scene).items():  # a moved quantity replaces its fixed value
+        coords.pop(key, None)
+        if not set(dims) & set(skip):
+            coords[key] = (dims, values, attrs)
     return coords
 
 

@@ -135,6 +135,11 @@ class System:
         """The scene's scalar parameters that are not grid axes, by their scannable names (scalar coordinates)."""
         return {} if self.scene_module is None else self.scene_module.fixed_values(scene)
 
+    def derived_coords(self, scene: SceneBase) -> dict[str, tuple]:
+        """Auxiliary coordinates computed from the grid, ``{name: (dims, values, attrs)}``, dims among the grid
+        axes (e.g. what a ratio axis moves).  They replace a fixed parameter of the same name.  Default: none."""
+        return {}
+
     def attrs(self, scene: SceneBase) -> dict:
         """Global attributes that describe the scene beyond its TOML (netCDF-safe values)."""
         return {}

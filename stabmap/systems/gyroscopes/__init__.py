@@ -47,8 +47,14 @@ class Gyroscopes(System):
     label_title = "complex root pairs N$_c$"
     stable_label = 0
     provenance = "decided_by"
-    symbols = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho"}
+    symbols = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho",
+               "M_alpha": r"M_\alpha", "S_g": "S_g", "C_over_A": "C/A", "aspect": "h/a"}
     scene_module = _scene
+
+    def derived_coords(self, scene: Scene) -> dict[str, tuple]:
+        from .ratios import coordinates
+
+        return coordinates(scene, scene.parameter)
 
     def attrs(self, scene: Scene) -> dict:
         attrs = {"support": scene.support, "n_bodies": scene.n, "polynomial_degree_bound": scene.degree}
@@ -85,7 +91,8 @@ class Gyroscopes(System):
     def fastest_axes(self, scene: Scene) -> tuple[int, ...]:
         # The kernels rebuild the inertia and stiffness matrices only when a point's masses, lengths or
         # stiffnesses differ from the previous point's: runs of points that differ only in spin skip that work.
-        return tuple(d for d, a in enumerate(scene.grid) if a.name == "omega" or a.name.startswith("omega_"))
+        spins = {"omega", "S_g"} if scene.hold.S_g == "M_alpha" else {"omega"}  # S_g moves the spin by default
+        return tuple(d for d, a in enumerate(scene.grid) if a.name in spins or a.name.startswith("omega_"))
 
     def cost(self, scene: Scene) -> Cost:
         from .points import point_arrays

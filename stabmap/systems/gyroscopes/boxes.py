@@ -57,22 +57,33 @@ class BoxArrays:
 def box_axes(scene: Scene) -> set[str]:
     """The grid axes along which a box can be enclosed: all but those whose kernel inputs are not monotone in them.
 
-    Every kernel input is then a copy of one scanned value, or that value minus a constant (a cavity's tail),
-    so the inputs at a box's two corners bound the inputs at every point of it.  Not enclosed: a cavity's size
+    Every kernel input is then a copy of one scanned value, or that value minus a constant (a cavity's tail), or
+    rounded once from it (C = C/A times A, -M_alpha), so the inputs at a box's two corners bound the inputs at every point of it.  Not enclosed: a cavity's size
     or density (the modes depend on them), and a column (m, A, C, c) of a body whose cavity's liquid stabmap
     adds (liquid_in_body = false: the frozen liquid moves the centre of mass with them).
     """
     out = set()
     for axis in scene.grid:
         name = parse_name(axis.name, scene.n, scene.support)
-        if name.kind == "cavity":
+        # An aspect ratio moves the modes, A = C / ratio takes two roundings with a cavity's tail, and S_g moving
+        # M_alpha (hold.S_g = "omega") divides: nodes only.  C = ratio A (one rounding), -M_alpha (exact) and S_g
+        # moving the spin (monotone; the corners widened by _spin_margin) are enclosed.
+        if name.kind == "cavity" or name.symbol == "aspect" or (name.symbol == "C_over_A" and scene.hold.C_over_A == "C"):
             continue
-        if name.kind in ("body", "every_body") and name.symbol != "omega":
+        if name.symbol == "S_g" and (scene.hold.S_g != "M_alpha" or _spin_not_monotone(scene)):
+            continue
+        if name.kind in ("body", "every_body", "ratio") and name.symbol != "omega":
             bodies = [scene.bodies[name.index - 1]] if name.kind == "body" else scene.bodies
             if any(b.cavity is not None and b.cavity.geometric and not b.cavity.liquid_in_body for b in bodies):
                 continue
         out.add(axis.name)
     return out
+
+
+def _spin_not_monotone(scene: Scene) -> bool:
+    """Whether a grid axis besides S_g moves body 1's A or C: omega = 2 sqrt(A M_alpha S_g) / C then falls along one
+    axis of a box as it grows along S_g, and a box's corners no longer hold the spins inside it."""
+    return bool({a.name for a in scene.grid} & {"A", "C", "A_1", "C_1", "C_over_A_1"})
 
 
 def unenclosed(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -104,6 +115,7 @@ def _corners(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.nda
         if np.any(spans):
             raise ValueError(f"a box cannot be enclosed along {key!r} (box_axes)")
     lo, hi = point_arrays(scene, lower), point_arrays(scene, upper)
+    _spin_margin(scene, lower, upper, lo, hi)
     if not (np.array_equal(lo.E, hi.E) and np.array_equal(lo.kappa, hi.kappa)):  # pragma: no cover - box_axes rules it out
         raise ValueError("the liquid modes differ across the box")
     return lo, hi
@@ -136,7 +148,27 @@ def _spin_rows(scene: Scene, lo: PointArrays, hi: PointArrays, moves: dict[str, 
 
 
 def _is_spin(scene: Scene, key: str) -> bool:
-    return parse_name(key, scene.n, scene.support).symbol == "omega"
+    """omega, omega_k, and S_g where it moves the spin (``ratios``)."""
+    symbol = parse_name(key, scene.n, scene.support).symbol
+    return symbol == "omega" or (symbol == "S_g" and scene.hold.S_g == "M_alpha")
+
+
+SPIN_MARGIN = 4  # floats: omega = 2 sqrt(A M_alpha S_g) / C rounds four times, each by half a float at most
+
+
+def _spin_margin(scene: Scene, lower: dict, upper: dict, lo: PointArrays, hi: PointArrays) -> None:
+    """Widen the corners' spins outward where a box moves S_g: omega(S_g) is increasing, so the spins of the box lie
+    between the exact spins of its corners, each within SPIN_MARGIN floats of the rounded one."""
+    if "S_g" not in lower:
+        return
+    npts = lo.body.shape[0]
+    moves = np.broadcast_to(np.asarray(lower["S_g"]) != np.asarray(upper["S_g"]), (npts,))[:, None]
+    w_lo, w_hi = lo.body[..., 5], hi.body[..., 5]
+    moving = moves & (w_lo != w_hi)
+    a, b = np.minimum(w_lo, w_hi), np.maximum(w_lo, w_hi)
+    for _ in range(SPIN_MARGIN):
+        a, b = np.nextafter(a, -np.inf), np.nextafter(b, np.inf)
+    lo.body[..., 5], hi.body[..., 5] = np.where(moving, a, w_lo), np.where(moving, b, w_hi)
 
 
 def _mechanical(scene: Scene, key: str) -> bool:

@@ -35,17 +35,29 @@ CAVITY = {
 }
 SCANNABLE_CAVITY = ("radius", "half_height", "density")
 EVERY_BODY = ("m", "A", "C", "c", "s")  # grid axes that set one parameter of every body at once (identical bodies)
+# A projectile (docs/projectile.md): an aerodynamic overturning moment on body 1 about a fixed point at its centre
+# of mass, and the gyroscopic stability factor it gives, S_g = C_1^2 omega_1^2 / (4 A_1 M_alpha).
+PROJECTILE = {
+    "M_alpha": Parameter("M_alpha", "N m rad-1", "aerodynamic overturning moment coefficient of body 1 about its centre of mass", None, False),
+    "S_g": Parameter("S_g", "1", "gyroscopic stability factor of body 1", 0.0, True),  # C^2 omega^2 / (4 A M_alpha)
+}
+# Dimensionless axes (``ratios``): each moves one underlying quantity, the scene's [hold] says which is held.
+RATIO = {
+    "C_over_A": Parameter("C/A", "1", "ratio of the axial to the equatorial moment of inertia of body {k}", 0.0, False),
+    "aspect": Parameter("h/a", "1", "aspect ratio of the cavity of body {k}: height (twice half_height) over radius", 0.0, True),
+}
 GLOBAL = {
     "omega": Parameter("omega", "rad s-1", "common spin rate", None, False),
     "g": Parameter("g", "m s-2", "gravitational acceleration", None, False),
 }
 
-_NAME = re.compile(r"^(m|A|C|c|s|omega|K|at|radius|half_height|density)_(\d+)$")
+_NAME = re.compile(r"^(m|A|C|c|s|omega|K|at|radius|half_height|density|C_over_A|aspect)_(\d+)$")
 
 
 @dataclass(frozen=True)
 class Name:
-    """A parsed parameter name: kind is 'global', 'body', 'cavity', 'joint', 'position', 'every_body' or 'every_joint'.
+    """A parsed parameter name: kind is 'global', 'body', 'cavity', 'joint', 'position', 'every_body', 'every_joint',
+    'projectile' (M_alpha, S_g) or 'ratio' (C_over_A_k, aspect_k).
 
     index is 1-based (K: 0 = base); 0 for the common axes of every body (``m``, ``A``, ``C``, ``c``, ``s``)
     and of every joint between bodies (``K``, which leaves the base joint K_0 alone).
@@ -60,6 +72,10 @@ class Name:
     def info(self) -> Parameter:
         if self.kind == "global":
             return GLOBAL[self.symbol]
+        if self.kind == "projectile":
+            return PROJECTILE[self.symbol]
+        if self.kind == "ratio":
+            return RATIO[self.symbol]
         if self.kind in ("joint", "every_joint"):
             return BASE if self.kind == "joint" and self.index == 0 else JOINT
         if self.kind == "cavity":
@@ -92,6 +108,13 @@ def parse_name(name: str, n_bodies: int, support: str) -> Name:
         if name == "g" and support == "free":
             raise StabmapError("grid axis 'g' has no effect with support = \"free\" (gravity exerts no torque about the centre of mass); remove it")
         return Name(name, "global", name, 0)
+    if name in PROJECTILE:
+        if support == "free":
+            raise StabmapError(
+                f"{name!r}: M_alpha acts about a fixed point at body 1's centre of mass; use support = \"fixed\" with "
+                "bodies[1].c = 0 (a single body in flight moves about its centre of mass as on a fixed point there)"
+            )
+        return Name(name, "projectile", name, 0)
     if name in EVERY_BODY:
         return Name(name, "every_body", name, 0)
     if name == "K":
@@ -100,13 +123,13 @@ def parse_name(name: str, n_bodies: int, support: str) -> Name:
         return Name(name, "every_joint", name, 0)
     match = _NAME.match(name)
     if not match:
-        known = [*GLOBAL, *EVERY_BODY, "K"] + [f"K_{k}" for k in range(n_bodies)] + [
-            f"{sym}_{k}" for sym in ("m", "A", "C", "c", "s", "omega", "at", *CAVITY) for k in range(1, n_bodies + 1)]
+        known = [*GLOBAL, *PROJECTILE, *EVERY_BODY, "K"] + [f"K_{k}" for k in range(n_bodies)] + [
+            f"{sym}_{k}" for sym in ("m", "A", "C", "c", "s", "omega", "at", *CAVITY, *RATIO) for k in range(1, n_bodies + 1)]
         raise StabmapError(
             f"unknown parameter name {name!r}; {did_you_mean(name, known)}scannable names are omega, g, "
-            "m_k A_k C_k c_k s_k omega_k (body k = 1..n), radius_k half_height_k density_k (the cavity "
-            "of body k), K_k (joint k, K_0 the base), at_k (a tree's joint positions), and m A C c s K "
-            "for every body or joint at once"
+            "m_k A_k C_k c_k s_k omega_k C_over_A_k (body k = 1..n), radius_k half_height_k density_k aspect_k "
+            "(the cavity of body k), K_k (joint k, K_0 the base), at_k (a tree's joint positions), M_alpha S_g "
+            "(a projectile), and m A C c s K for every body or joint at once"
         )
     symbol, index = match.group(1), int(match.group(2))
     if symbol == "K":
@@ -125,4 +148,6 @@ def parse_name(name: str, n_bodies: int, support: str) -> Name:
         if index == 1:
             raise StabmapError(f"{name!r}: body 1's joint is the base point (or a free system's reference point); it has no position to scan")
         return Name(name, "position", symbol, index)
+    if symbol in RATIO:
+        return Name(name, "ratio", symbol, index)
     return Name(name, "cavity" if symbol in CAVITY else "body", symbol, index)

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import liquid, topology
+from . import liquid, ratios, topology
 from .parameters import BODY_COLUMNS, SCANNABLE_CAVITY, parse_name
 from .scene import Scene
 
@@ -57,7 +57,10 @@ def base_arrays(scene: Scene):
     for k, b in enumerate(scene.bodies):
         omega = b.omega if b.omega is not None else scene.omega
         body[k] = (b.m, b.A, b.C, b.c, b.s, 0.0 if omega is None else omega)
-    joint = np.array((scene.K_0,) + scene.joint_stiffness(), dtype=np.float64)
+    # M_alpha overturns body 1 about the fixed point at its centre of mass: -M_alpha at (1, 1) of the stiffness,
+    # where a base stiffness K_0 would go (the scene refuses the two together); the negation is exact.
+    base = scene.K_0 if scene.M_alpha is None else -scene.M_alpha
+    joint = np.array((base,) + scene.joint_stiffness(), dtype=np.float64)
     lmax = max(1, int(scene.nmodes.max()))
     E = np.zeros((n, lmax))
     kappa = np.ones((n, lmax))
@@ -70,7 +73,7 @@ def base_arrays(scene: Scene):
 def point_arrays(scene: Scene, values: dict[str, np.ndarray]) -> PointArrays:
     """Per-point arrays for points given by grid-axis values (arrays broadcast together, C order)."""
     body0, joint0, g0, E0, kappa0 = base_arrays(scene)
-    arrays = {name: np.asarray(v, dtype=np.float64) for name, v in values.items()}
+    arrays = {name: np.asarray(v, dtype=np.float64) for name, v in ratios.underlying(scene, values).items()}
     shape = np.broadcast_shapes(*(a.shape for a in arrays.values())) if arrays else ()
     npts = int(np.prod(shape, dtype=np.int64))
     body = np.broadcast_to(body0, shape + body0.shape).copy()
@@ -96,6 +99,8 @@ def point_arrays(scene: Scene, values: dict[str, np.ndarray]) -> PointArrays:
             joint[..., 1:] = value[..., None]
         elif name.kind == "joint":
             joint[..., name.index] = value
+        elif name.kind == "projectile":  # M_alpha; S_g was turned into what it moves (ratios.underlying)
+            joint[..., 0] = -value
         elif name.kind == "body":
             body[..., name.index - 1, BODY_COLUMNS.index(name.symbol)] = value
         elif name.kind == "position":

@@ -18,15 +18,16 @@ from ...errors import StabmapError
 from ...scene.grid import Axis, check_axes, parse_axes
 from ...scene.values import Parameter, check_value, no_unknown
 from ..base import SceneBase
-from . import liquid
+from . import liquid, ratios
 from .liquid import Cavity
-from .parameters import BASE, BODY, EVERY_BODY, GLOBAL, JOINT, SCANNABLE_CAVITY, parse_name
+from .parameters import BASE, BODY, EVERY_BODY, GLOBAL, JOINT, PROJECTILE, SCANNABLE_CAVITY, parse_name
+from .ratios import Hold
 from .topology import Topology
 
 SUPPORTS = ("fixed", "free")
 DEFAULT_G = 9.81
 _G_FREE = 'g: gravity exerts no torque about a free system\'s centre of mass and would be ignored; remove g or use support = "fixed"'
-_TOP_KEYS = {"title", "support", "g", "omega", "joints", "K_0", "topology", "bodies", "grid"}
+_TOP_KEYS = {"title", "support", "g", "omega", "joints", "K_0", "M_alpha", "hold", "topology", "bodies", "grid"}
 _TOPOLOGY_KEYS = {"parent", "at"}
 _BODY_KEYS = {"m", "A", "C", "c", "s", "omega", "fluid", "cavity"}
 _FLUID_KEYS = {"E", "kappa"}
@@ -71,6 +72,8 @@ class Scene(SceneBase):
     title: str = ""
     grid: tuple[Axis, ...] = field(default=())
     topology: Topology | None = None  # None: a chain
+    M_alpha: float | None = None  # aerodynamic overturning moment on body 1 about its centre of mass [N m/rad]
+    hold: Hold = field(default_factory=Hold)  # what the ratio axes (S_g, C_over_A_k, aspect_k) hold
 
     def __post_init__(self):
         _validate(self)
@@ -128,6 +131,10 @@ class Scene(SceneBase):
         out["joints"] = list(self.joint_stiffness())
         if not self.free:
             out["K_0"] = self.K_0
+        if self.M_alpha is not None:
+            out["M_alpha"] = self.M_alpha
+        if self.hold != Hold():
+            out["hold"] = self.hold.to_dict()
         if self.topology is not None:
             out["topology"] = {"parent": list(self.topology.parent), "at": list(self.topology.at)}
         bodies = []
@@ -167,7 +174,9 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
     grid = parse_axes(data.get("grid", {}), lambda name: _axis_name(name, n, support, tree_flag).parameter)
     if support == "free" and "g" in data:
         raise StabmapError(_G_FREE)
-    scalars = {k: data[k] for k in ("support", "omega", "g", "K_0", "title") if k in data}
+    scalars = {k: data[k] for k in ("support", "omega", "g", "K_0", "M_alpha", "title") if k in data}
+    if "hold" in data:
+        scalars["hold"] = ratios.parse_hold(data["hold"])
     return Scene(bodies=bodies, joints=tuple(joints), grid=grid, topology=tree, **scalars)
 
 
@@ -186,6 +195,9 @@ def _topology(raw: dict, n: int) -> Topology:
 
 def _body(raw: dict, k: int, n: int, base_dir: Path | None, tree: bool) -> Body:
     where = f"bodies[{k}]"
+    if isinstance(raw, dict) and "M_alpha" in raw:
+        raise StabmapError(f"{where}.M_alpha: M_alpha is a top-level key and acts on body 1, about its centre of mass "
+                           "(the fixed point); move it out of [[bodies]]")
     no_unknown(raw, _BODY_KEYS, where)
     values = {}
     for key in ("m", "A", "C", "c", "s"):
@@ -242,8 +254,13 @@ def _validate(scene: Scene) -> None:
     if K_0 and scene.free:
         raise StabmapError('K_0: a free system has no base joint; remove K_0 or use support = "fixed"')
     put("K_0", K_0)
+    if scene.M_alpha is not None:
+        put("M_alpha", check_value("M_alpha", scene.M_alpha, PROJECTILE["M_alpha"]))
+    if not isinstance(scene.hold, Hold):
+        raise StabmapError(f"hold must be a Hold (a [hold] table), got {scene.hold!r}")
     put("grid", tuple(scene.grid))
     check_axes(scene.grid, scene.parameter)
+    ratios.check(scene)
     _check_omega(scene)
     put("bodies", _check_cavities(scene))
 
@@ -292,7 +309,7 @@ def _axis_name(name: str, n: int, support: str, tree: bool):
 
 
 def _check_omega(scene: Scene) -> None:
-    names = {a.name for a in scene.grid}
+    names = {a.name for a in scene.grid} | {m for a in scene.grid for m in ratios.moved(scene, a.name)}
     own = [b.omega is not None or f"omega_{k + 1}" in names for k, b in enumerate(scene.bodies)]
     if "omega" in names and all(own):
         raise StabmapError("grid axis 'omega' has no effect: every body sets its own omega (scan omega_k instead)")
@@ -304,6 +321,7 @@ def _check_omega(scene: Scene) -> None:
 def _check_cavities(scene: Scene) -> tuple[Body, ...]:
     """The bodies, each cavity checked against the grid and its number of modes chosen for it."""
     axes = {a.name: a.array for a in scene.grid}
+    axes.update(ratios.grid_values(scene))  # what the ratio axes move (C_k, A_k, a cavity's sizes)
     bodies = []
     for k, b in enumerate(scene.bodies, start=1):
         cav = b.cavity
@@ -352,8 +370,10 @@ def fixed_values(scene: Scene) -> dict[str, float]:
         if b.cavity is not None and b.cavity.geometric:
             for key in SCANNABLE_CAVITY:
                 out[f"{key}_{k}"] = getattr(b.cavity, key)
-    if not scene.free:
+    if not scene.free and not ratios.projectile(scene):  # M_alpha takes the base joint's place
         out["K_0"] = scene.K_0
+    if scene.M_alpha is not None and "M_alpha" not in names:
+        out["M_alpha"] = scene.M_alpha
     if "K" not in names:
         for j, K in enumerate(scene.joint_stiffness(), start=1):
             out[f"K_{j}"] = K
