@@ -71,3 +71,34 @@ class StabmapAccessor:
         if self._ds.attrs.get("stabmap_kind") == "critical values":
             return plot_critical(self._ds, path, **kw)
         return plot_atlas(self._ds, path, **kw)
+
+    def style(self, name: str | None = None) -> dict:
+        """Arguments of xarray's ``plot`` that draw the class variable ``name`` (default: the label, e.g.
+        ``n_complex_pairs``) in stabmap's colours: ``ds.stability.plot(**ds.stabmap.style("stability"))``
+        (:func:`stabmap.read.style.style`)."""
+        from .. import systems
+        from .style import style
+
+        system = systems.of_atlas(self._ds.attrs)
+        return style(self._ds[name or system.label], system)
+
+
+@xr.register_dataarray_accessor("stabmap")
+class StabmapArrayAccessor:
+    """One class variable of an atlas drawn by xarray in stabmap's colours: ``ds.stability.stabmap.plot()``."""
+
+    def __init__(self, da: xr.DataArray) -> None:
+        self._da = da
+
+    def style(self) -> dict:
+        """``cmap``, ``norm`` and ``cbar_kwargs`` for xarray's ``plot``: :func:`stabmap.read.style.style`."""
+        from .style import style
+
+        return style(self._da)
+
+    def plot(self, **kwargs):
+        """``da.plot.pcolormesh(**kwargs)`` in stabmap's colours, with a colour bar naming the classes
+        (:func:`stabmap.read.style.plot`)."""
+        from .style import plot
+
+        return plot(self._da, **kwargs)
