@@ -124,6 +124,16 @@ def test_a_variable_without_classes_is_a_clear_error(dry):
         dry.omega_bounds.stabmap.style()
     with pytest.raises(StabmapError, match="stability has one axis; xarray's colour maps need two"):
         dry.stability.isel(c_1=0).stabmap.plot()
+    three = xr.concat([dry.stability, dry.stability], dim="K_1")
+    with pytest.raises(StabmapError, match=r"stability has 3 axes \(K_1, omega, c_1\).*col='c_1'"):
+        three.stabmap.plot()
+    grid = three.stabmap.plot(col="K_1")  # panels, as xarray makes them
+    try:
+        assert grid.axs.size == 2 and all(isinstance(m.norm, matplotlib.colors.BoundaryNorm) for m in grid._mappables)
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close("all")
 
 
 # ------------------------------------------------------------------------------------------------------ legends

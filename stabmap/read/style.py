@@ -100,6 +100,11 @@ def plot(da: xr.DataArray, system=None, **kwargs):
     if da.ndim < 2:
         raise StabmapError(f"{da.name} has {'one axis' if da.ndim == 1 else 'no axis'}; xarray's colour maps need two "
                            "(stabmap.plot_atlas draws a strip of one axis)")
+    extra = [d for d in da.dims if d not in (kwargs.get("col"), kwargs.get("row"))]
+    if len(extra) > 2:
+        raise StabmapError(f"{da.name} has {len(extra)} axes ({', '.join(map(str, extra))}) beyond col= and row=; a map shows two: "
+                           f"select the others, e.g. ds.{da.name}.sel({extra[-1]}=...).stabmap.plot(), or make panels of one, "
+                           f"col={str(extra[-1])!r}")
     merged = style(da, system)
     merged.update(kwargs)
     return da.plot.pcolormesh(**merged)
