@@ -11,9 +11,12 @@ operation keeps working and returns plain Datasets):
 >>> ds.stabmap.boundaries("omega", K_1=3).to_dataframe()
 >>> ds.stabmap.smallest_stable("omega", over="K_1").smallest_stable.plot()
 >>> ds.stabmap.plot("map.png", sel={"K_1": 3})
+>>> ds.stability.sel(K_1=3).stabmap.plot()            # xarray's own plot, in stabmap's colours
+>>> ds.n_complex_pairs.sel(K_1=3).plot(**ds.stabmap.style())
 
 Each method calls the function of the same name with the Dataset as its first argument, so the two always
-give the same answer.  This module imports nothing of stabmap at load time: it is loaded while xarray
+give the same answer. A DataArray's ``.stabmap`` draws one class variable with xarray in stabmap's colours
+(:mod:`stabmap.read.style`).  This module imports nothing of stabmap at load time: it is loaded while xarray
 itself is being imported.
 """
 
