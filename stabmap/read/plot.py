@@ -718,7 +718,7 @@ def _area_text(s: AreaShares, part: bool) -> str:
         text += f", {100 * s.other:.1f} % degenerate"
     text += f"; {100 * (s.change + s.undecided):.1f} % undecided"
     if s.change > 0:
-        text += f" ({100 * s.change:.1f} % in cells proved to hold a boundary)"
+        text += f" ({100 * s.change:.1f} % in cells holding a boundary)"
     return text
 
 
@@ -732,7 +732,7 @@ def _title(
     title = [_fill_title(ds.attrs.get("title", "") or "stabmap atlas", chars)]
     part = plan.facet is not None or bool(plan.fixed)
     if shares is not None:
-        title.append(textwrap.fill(_area_text(shares, part), chars))
+        title.append(textwrap.fill(_area_text(shares, part), min(chars, 60)))  # narrower: clear of the legend beside it
     elif stable is not None:
         title.append(f"{100 * stable / points:.1f} % of {'the ' if part else ''}{points:,} grid points{' shown' if part else ''} stable")
     else:
