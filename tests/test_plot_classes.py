@@ -117,6 +117,16 @@ def test_closed_chain_flags_take_the_colours_of_their_meanings():
     s = closed_system.SYSTEM
     for meaning, value in (("stable", s.stable_label), ("unstable", 1), ("absent", s.absent_label), ("undecided", s.undecided_label)):
         assert by_meaning[meaning] == colour(value, s.stable_label, s.absent_label, s.undecided_label)
+    # flags listed in another order draw the same: each cell in its meaning's colour
+    import matplotlib.pyplot as plt
+
+    backwards = da.assign_attrs(flag_values=flags.attrs()["flag_values"][::-1], flag_meanings=" ".join(flags.meanings[::-1]))
+    try:
+        got = facecolours(backwards.stabmap.plot())
+        want = [to_rgba(by_meaning[flags.meaning(int(v))]) for v in da.values.ravel()]
+        np.testing.assert_allclose(got, want, atol=1e-6)
+    finally:
+        plt.close("all")
 
 
 def test_a_variable_without_classes_is_a_clear_error(dry):

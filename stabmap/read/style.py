@@ -79,7 +79,7 @@ def style(da: xr.DataArray, system=None) -> dict:
     from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.ticker import FuncFormatter
 
-    found = classes(da, system)
+    found = sorted(classes(da, system))  # a norm's bins rise; flags may be listed in any order
     if not found:
         raise StabmapError(f"{da.name}: no values to draw (an empty selection)")
     values = np.array([v for v, _, _ in found], dtype=float)
