@@ -130,6 +130,9 @@ def test_closed_chain_flags_take_the_colours_of_their_meanings():
 
 
 def test_a_variable_without_classes_is_a_clear_error(dry):
+    with pytest.raises(StabmapError, match=r"style\('stabilty'\): no such variable in this atlas; its class variables are: "
+                                           r"n_complex_pairs, stability, decided_by, cell"):
+        dry.stabmap.style("stabilty")
     with pytest.raises(StabmapError, match=r"omega_bounds: stabmap's colours are for class variables.*ds.omega_bounds.plot\(\)"):
         dry.omega_bounds.stabmap.style()
     with pytest.raises(StabmapError, match="stability has one axis; xarray's colour maps need two"):

@@ -82,8 +82,14 @@ class StabmapAccessor:
         from .. import systems
         from .style import style
 
+        from ..errors import StabmapError
+
         system = systems.of_atlas(self._ds.attrs)
-        return style(self._ds[name or system.label], system)
+        name = name or system.label
+        if name not in self._ds.data_vars:
+            classes = [str(v) for v in self._ds.data_vars if v == system.label or "flag_meanings" in self._ds[v].attrs]
+            raise StabmapError(f"style({name!r}): no such variable in this atlas; its class variables are: {', '.join(classes)}")
+        return style(self._ds[name], system)
 
 
 @xr.register_dataarray_accessor("stabmap")
