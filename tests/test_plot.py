@@ -144,7 +144,7 @@ def test_legend_has_one_entry_per_class_present_and_fixed_colours():
     fig = atlas_figure(ds)
     labels = [t.get_text() for t in legend_of(fig).get_texts()]
     assert labels == [class_label(-1), class_label(0), class_label(1), class_label(3), "stability boundary", "N$_c$ changes", "inferred from cell\ncorners (not computed)"]
-    assert labels[1] == "stable (all roots real)" and labels[2] == "1 complex pair" and labels[3] == "3 complex pairs"
+    assert labels[1] == "stable (all roots real)" and labels[2] == "unstable: 1 complex pair" and labels[3] == "unstable: 3 complex pairs"
     ax = fig.axes[0]
     for v in (-1, 0, 1, 3):  # class colours do not depend on which classes are present
         (cells,) = drawn(ax, f"cells-{v}")

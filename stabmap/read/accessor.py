@@ -12,9 +12,12 @@ operation keeps working and returns plain Datasets):
 >>> ds.stabmap.smallest_stable("omega", over="K_1").smallest_stable.plot()
 >>> ds.stabmap.plot("map.png", sel={"K_1": 3})
 >>> stabmap.open_atlas("critical.nc").stabmap.to_dataframe()    # one row per stable interval
+>>> ds.stability.sel(K_1=3).stabmap.plot()            # xarray's own plot, in stabmap's colours
+>>> ds.n_complex_pairs.sel(K_1=3).plot(**ds.stabmap.style())
 
 Each method calls the function of the same name with the Dataset as its first argument, so the two always
-give the same answer.  This module imports nothing of stabmap at load time: it is loaded while xarray
+give the same answer. A DataArray's ``.stabmap`` draws one class variable with xarray in stabmap's colours
+(:mod:`stabmap.read.style`).  This module imports nothing of stabmap at load time: it is loaded while xarray
 itself is being imported.
 """
 
@@ -78,3 +81,40 @@ class StabmapAccessor:
         if self._ds.attrs.get("stabmap_kind") == "critical values":
             return plot_critical(self._ds, path, **kw)
         return plot_atlas(self._ds, path, **kw)
+
+    def style(self, name: str | None = None) -> dict:
+        """Arguments of xarray's ``plot`` that draw the class variable ``name`` (default: the label, e.g.
+        ``n_complex_pairs``) in stabmap's colours: ``ds.stability.plot(**ds.stabmap.style("stability"))``
+        (:func:`stabmap.read.style.style`)."""
+        from .. import systems
+        from .style import style
+
+        from ..errors import StabmapError
+
+        system = systems.of_atlas(self._ds.attrs)
+        name = name or system.label
+        if name not in self._ds.data_vars:
+            classes = [str(v) for v in self._ds.data_vars if v == system.label or "flag_meanings" in self._ds[v].attrs]
+            raise StabmapError(f"style({name!r}): no such variable in this atlas; its class variables are: {', '.join(classes)}")
+        return style(self._ds[name], system)
+
+
+@xr.register_dataarray_accessor("stabmap")
+class StabmapArrayAccessor:
+    """One class variable of an atlas drawn by xarray in stabmap's colours: ``ds.stability.stabmap.plot()``."""
+
+    def __init__(self, da: xr.DataArray) -> None:
+        self._da = da
+
+    def style(self) -> dict:
+        """``cmap``, ``norm`` and ``cbar_kwargs`` for xarray's ``plot``: :func:`stabmap.read.style.style`."""
+        from .style import style
+
+        return style(self._da)
+
+    def plot(self, **kwargs):
+        """``da.plot.pcolormesh(**kwargs)`` in stabmap's colours, with a colour bar naming the classes
+        (:func:`stabmap.read.style.plot`)."""
+        from .style import plot
+
+        return plot(self._da, **kwargs)

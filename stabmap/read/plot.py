@@ -42,6 +42,7 @@ from ..errors import StabmapError
 from .. import systems
 from ..store.files import check_writable
 from ..store.variables import CELL, INFERRED
+from .areas import AreaShares, area_shares
 from .blocks import block_factors, reduce_blocks
 from ..scene import units
 from .info import fixed_parameters, scene_notes, unit_suffix
@@ -595,7 +596,9 @@ def atlas_figure(
     ye = _edges(np.asarray(ds[plan.y], dtype=float), "log" if _log_axis(ds, plan.y) else None) if plan.y else np.array([0.0, 1.0])
     xe, ye = _block_edges(xe, factors[1]), _block_edges(ye, factors[0]) if plan.y else ye
     n_stable = None if stable is None else totals.get(stable, 0)
-    title = _title(ds, plan, n_stable, points, 70 if plan.facet is None else int(12 * (width - _LEGEND_WIDTH)), factors, shape)
+    shares = _panel_areas(ds, plan, fix, panels, cut, stable)
+    title = _title(ds, plan, n_stable, points, 70 if plan.facet is None else int(12 * (width - _LEGEND_WIDTH)), factors, shape,
+                   shares=None if shares is None else AreaShares.mean(shares))
     lines = title.count("\n") + 1
     if plan.facet is None:
         size = (width, 5.2) if plan.y else (width, max(1.4 + 0.17 * lines, 0.22 * (len(present) + 4)) + 0.6)
@@ -613,7 +616,7 @@ def atlas_figure(
 
     drawn = {"stability": False, "classes": False, "inferred": False, "light": False, "node-only": False,
              "node-only-light": False, "change": False}
-    for ax, blocks, (r, c) in zip(axes, data, panels):
+    for n, (ax, blocks, (r, c)) in enumerate(zip(axes, data, panels)):
         values, mixed = blocks.low, blocks.mixed
         _fill(ax, values, xe, ye, cmap, norm, stable, absent, undecided)
         bits = np.zeros(values.shape, dtype=np.int32) if blocks.any_flag is None else blocks.any_flag
@@ -649,8 +652,10 @@ def atlas_figure(
             if plan.row is not None:
                 parts.append(_value_text(ds, plan.row, float(ds[plan.row][r])))
             if stable is not None:
-                parts.append(f"{100 * blocks.counts.get(stable, 0) / sum(blocks.counts.values()):.0f} % stable")
-                ax.set_title("\n".join([", ".join(parts[:-1]), parts[-1]]) if plan.row is not None else f"{parts[0]}  ({parts[1]})", fontsize=9)
+                parts.append(f"{100 * shares[n].stable:.0f} % of its area proved stable" if shares is not None  # as the title
+                             else f"{100 * blocks.counts.get(stable, 0) / sum(blocks.counts.values()):.0f} % stable")
+                two_lines = plan.row is not None or shares is not None  # the longer text of areas needs its own line
+                ax.set_title("\n".join([", ".join(parts[:-1]), parts[-1]]) if two_lines else f"{parts[0]}  ({parts[1]})", fontsize=9)
             else:  # a system without stability: the panel's coordinates only
                 ax.set_title("\n".join(parts), fontsize=9)
 
@@ -714,14 +719,44 @@ def atlas_figure(
     return fig
 
 
+def _panel_areas(ds: xr.Dataset, plan: FigurePlan, fix: dict, panels: list, cut, stable: int | None) -> list[AreaShares] | None:
+    """Each panel's shares of its area proved stable, unstable, ... (:mod:`stabmap.read.areas`); None where the atlas
+    proves no class over a whole cell here (no ``cell``, no stability, or a grid too coarse for box proofs): the
+    title then counts grid points."""
+    if stable is None or CELL.name not in ds:
+        return None
+    from .summary import cell_sizes
+
+    cell = ds[CELL.name].isel(fix)
+    wy = cell_sizes(ds, plan.y) if plan.y else np.ones(1)
+    label = ds[systems.of_atlas(ds.attrs).label].isel(fix)
+    shares = area_shares([cut(label, r, c) for r, c in panels], [cut(cell, r, c) for r, c in panels], wy, cell_sizes(ds, plan.x), stable)
+    return shares if any(s.proved_any for s in shares) else None
+
+
+def _area_text(s: AreaShares, part: bool) -> str:
+    """'69.2 % of the scanned area proved stable, 28.5 % unstable; 2.3 % undecided (...)'."""
+    text = f"{100 * s.stable:.1f} % of the {'area shown' if part else 'scanned area'} proved stable, {100 * s.unstable:.1f} % unstable"
+    if s.other > 0:
+        text += f", {100 * s.other:.1f} % degenerate"
+    text += f"; {100 * (s.change + s.undecided):.1f} % undecided"
+    if s.change > 0:
+        text += f" ({100 * s.change:.1f} % in cells holding a boundary)"
+    return text
+
+
 def _title(
-    ds: xr.Dataset, plan: FigurePlan, stable: int | None, points: int, chars: int, factors: tuple[int, int] = (1, 1), shape: tuple[int, int] = (1, 1)
+    ds: xr.Dataset, plan: FigurePlan, stable: int | None, points: int, chars: int, factors: tuple[int, int] = (1, 1), shape: tuple[int, int] = (1, 1),
+    shares: AreaShares | None = None,
 ) -> str:
-    """The atlas title, the stable fraction of the ``points`` shown (``stable``: how many are stable; None for a
-    system without stability), the fixed axes, the panels, the notes and the rule that reduced a large grid."""
+    """The atlas title, the share of the area drawn that its cells prove stable (``shares``), or else the stable
+    fraction of the ``points`` shown (``stable``: how many are stable; None for a system without stability), the
+    fixed axes, the panels, the notes and the rule that reduced a large grid."""
     title = [_fill_title(ds.attrs.get("title", "") or "stabmap atlas", chars)]
     part = plan.facet is not None or bool(plan.fixed)
-    if stable is not None:
+    if shares is not None:
+        title.append(textwrap.fill(_area_text(shares, part), min(chars, 60)))  # narrower: clear of the legend beside it
+    elif stable is not None:
         title.append(f"{100 * stable / points:.1f} % of {'the ' if part else ''}{points:,} grid points{' shown' if part else ''} stable")
     else:
         title.append(f"{points:,} grid points{' shown' if part else ''}")

@@ -138,7 +138,8 @@ class Gyroscopes(System):
             return "degenerate (p \u2261 0)"
         if value == 0:
             return "stable (all roots real)"
-        return f"{value} complex pair{'s' if value > 1 else ''}"
+        # every class but N_c = 0 is unstable: the legend says so, not only how many pairs (issue 30)
+        return f"unstable: {value} complex pair{'s' if value > 1 else ''}"
 
     def inferred(self, label: np.ndarray) -> dict[str, np.ndarray]:
         return {"stability": stability_from_pairs(label), "decided_by": np.full(np.shape(label), BY_INFERRED, dtype=np.int8)}

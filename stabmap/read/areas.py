@@ -1,0 +1,77 @@
+"""The share of a map's scanned area that its cells prove stable or unstable, for the titles of figures.
+
+A grid point's share of the grid depends on the grid (a log axis crowds points at its low end); a cell's share of
+the area does not. Cells are weighted by their size from the axis's cell edges, the same edges as the atlas's
+bounds variables (``stabmap.store.dataset.edges``; docs/cells.md), read chunk by chunk like every other pass over
+a lazy atlas (:mod:`stabmap.read.blocks`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..store.variables import CELL
+
+_WHOLE, _CHANGE = CELL.value("whole_cell"), CELL.value("contains_change")
+
+
+@dataclass(frozen=True)
+class AreaShares:
+    """Shares of the area drawn (each in [0, 1], together 1).
+
+    ``stable`` and ``unstable``: whole cells proved stable or unstable (any other class, such as degenerate,
+    is ``other``); ``change``: cells proved to hold a boundary, so neither; ``undecided``: cells whose label is
+    proved at the grid point only, or not even there (``node_only``, ``not_proved``).
+    """
+
+    stable: float
+    unstable: float
+    other: float
+    change: float
+    undecided: float
+
+    @property
+    def proved_any(self) -> bool:
+        """Whether a class is proved over any whole cell (cells holding a boundary alone say nothing of classes)."""
+        return self.stable + self.unstable + self.other > 0
+
+    @staticmethod
+    def mean(shares: list[AreaShares]) -> AreaShares:
+        """The shares of several maps of equal area together (the panels of one figure)."""
+        return AreaShares(*(float(np.mean([getattr(s, k) for s in shares])) for k in ("stable", "unstable", "other", "change", "undecided")))
+
+
+def area_shares(labels, cells, wy: np.ndarray, wx: np.ndarray, stable: int) -> list[AreaShares]:
+    """The :class:`AreaShares` of each of several maps of one size, shape (ny, nx) each (numpy or dask: the panels
+    of a figure), computed in one pass.
+
+    Parameters
+    ----------
+    labels, cells : sequences of arrays, shape (ny, nx)
+        Each map's label and its ``cell`` flag.
+    wy, wx : arrays of float, shape (ny,) and (nx,)
+        The cells' sizes along y and x (ones along an axis of one value).
+    stable : int
+        The label of a stable point.
+    """
+    import dask.array as da
+
+    from .blocks import as_dask, compute
+
+    sums = []
+    for label, cell in zip(labels, cells):
+        label = as_dask(label)
+        cell = as_dask(cell).rechunk(label.chunks)
+        wxd = da.from_array(np.asarray(wx, dtype=float), chunks=(label.chunks[1],))[None, :]
+        whole = cell == _WHOLE
+        masks = (whole & (label == stable), whole & (label >= 0) & (label != stable), whole & (label < 0), cell == _CHANGE)
+        sums.extend(da.where(m, wxd, 0.0).sum(axis=1) for m in masks)  # per row: no (ny, nx) array of weights
+    rows = compute(*sums)
+    total = float(np.sum(wy)) * float(np.sum(wx))
+    out = []
+    for p in range(len(labels)):
+        parts = [float(np.dot(wy, rows[4 * p + k])) / total for k in range(4)]
+        out.append(AreaShares(*parts, undecided=max(0.0, 1.0 - sum(parts))))
+    return out
