@@ -214,6 +214,7 @@ def query(
     smallest_stable: str | None = None,
     over: str | None = None,
     locate: bool = False,
+    roots: bool = False,
     fmt: str = "text",
     limit: int = 40,
     progress: bool | None = None,
@@ -229,7 +230,8 @@ def query(
     from .store.files import open_atlas
 
     items = list(items)
-    asked = [opt for opt, v in (("--fraction", fraction or None), ("--boundaries", boundaries), ("--smallest-stable", smallest_stable)) if v]
+    asked = [opt for opt, v in (("--fraction", fraction or None), ("--boundaries", boundaries), ("--smallest-stable", smallest_stable),
+                                ("--roots", roots or None)) if v]
     if len(asked) > 1:
         raise StabmapError(f"ask one question at a time: {' and '.join(asked)} were both given")
     if limit < 0:
@@ -248,6 +250,13 @@ def query(
     if ds.attrs.get("stabmap_kind") == "critical values":
         raise StabmapError(f"{path} holds critical values, not an atlas; 'stabmap info {path}' lists its intervals")
     sel = q.parse_selection(items)
+    if roots:
+        from .read.roots import roots as roots_at
+
+        if fmt == "csv":
+            raise StabmapError("--roots prints text or --json")
+        found = roots_at(ds, **sel)
+        return found.to_json() if fmt == "json" else found.text()
     if locate:
         from .read import located
 

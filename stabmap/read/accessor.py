@@ -55,6 +55,12 @@ class StabmapAccessor:
 
         return smallest_stable(self._ds, along, over, **sel)
 
+    def roots(self, **point: float):
+        """Every characteristic root at ``point``, recomputed from the atlas's scene: :func:`stabmap.roots`."""
+        from .roots import roots
+
+        return roots(self._ds, **point)
+
     def summary(self) -> dict:
         """Counts that describe the whole atlas: :func:`stabmap.summary`."""
         from .summary import summary

@@ -80,7 +80,7 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
     shape = tuple(b - a for a, b in location)
     chunk = _Chunk(scene, location)
     extra = system.dims(scene)
-    out = {v.name: np.empty(shape + tuple(extra[d] for d in v.dims), dtype=v.dtype) for v in system.variables}
+    out = {v.name: np.empty(shape + tuple(extra[d] for d in v.dims), dtype=v.dtype) for v in system.outputs(scene)}
     label = np.zeros(shape, dtype=out[system.label].dtype)
     cell = np.full(shape, NODE_ONLY, dtype=CELL.dtype)
     known = np.zeros(shape, dtype=bool)
@@ -102,7 +102,8 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
 
     if known.any():
         for k, v in system.proved_box(label[known]).items():
-            out[k][known] = v
+            if k in out:  # an output the scene left out (System.outputs)
+                out[k][known] = v
         out[system.label][known] = label[known]
     # Nodes no box holds: computed, in the order the kernels are quickest on, then their cells classified.
     nodes = np.argwhere(~known)

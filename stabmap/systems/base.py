@@ -204,6 +204,12 @@ class System:
         """
         raise NotImplementedError(f"the {self.name} system proves boxes but does not say what a box-proved node holds")
 
+    def roots(self, scene: SceneBase, values: dict[str, float]) -> tuple[list, str] | None:
+        """Every characteristic root at one point (``stabmap.read.roots``): a list of records with ``value``,
+        ``radius``, ``multiplicity``, ``kind``, ``origin``, ``liquid_share`` and ``growth_rate``, and the rule that
+        decided ``origin``.  None (the default): the system has no such roots."""
+        return None
+
     def inferred(self, label: np.ndarray) -> dict[str, np.ndarray] | None:
         """The other variables of points given ``label`` without being computed (adaptive refinement).
 
@@ -212,6 +218,15 @@ class System:
         return None
 
     # ------------------------------------------------------------------ outputs
+    def outputs(self, scene: SceneBase) -> tuple[Variable, ...]:
+        """The ``variables`` that ``evaluate`` returns and an atlas of ``scene`` stores (default: all of them);
+        a system whose scenes opt in or out of some outputs names those left out here."""
+        return tuple(self.variables)
+
+    def atlas_outputs(self, scene: SceneBase) -> tuple[Variable, ...]:
+        """Every variable of an atlas of ``scene``: its ``outputs`` and ``cell``."""
+        return self.outputs(scene) + (CELL,)
+
     @property
     def atlas_variables(self) -> tuple[Variable, ...]:
         """Every variable of an atlas file: the system's ``variables`` and ``cell`` (``stabmap.run.cells``)."""
