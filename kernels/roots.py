@@ -22,7 +22,7 @@ import numpy as np
 from . import dd
 from .block import LAPLACE_MAX
 from .charpoly import allocate, charpoly_point, same_structure
-from .inclusion import _disk_radii, approximate, find_root
+from .inclusion import POLISH_SWEEPS, _aberth, _disk_radii, _polish, _snap_real, approximate, find_root
 from .options import kernel
 from .scaling import nonzero_span, rescale, root_scale
 
@@ -61,17 +61,25 @@ def roots_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_z, out_r
     R = np.empty(D)
     group = np.empty(D, np.int64)
     flags = np.empty(D, np.bool_)
+    # The previous point's approximations start the next point's iteration: neighbouring grid points have nearby
+    # roots, so a few sweeps replace Bini's start (they prove nothing either way; the disks do).
+    last = np.zeros(3, np.int64)  # (usable, degree, scale exponent) of the approximations left in z
     for p in range(npts):
         out_status[p] = ROOTS_FAILED
         if not laplace:
             continue
         charpoly_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, same_structure(body, joint, at, g, p))
-        out_status[p] = _point(c, X, a, z, R, group, flags, out_z[p], out_r[p], out_kind[p], out_rate[p])
+        out_status[p] = _point(c, X, a, z, R, group, flags, out_z[p], out_r[p], out_kind[p], out_rate[p], last)
 
 
 @kernel
-def _point(c, X, a, z, R, group, flags, oz, orad, okind, orate):
-    """One point's roots from its coefficient enclosure c (ascending, (hi, lo, rad)); see ``roots_block``."""
+def _point(c, X, a, z, R, group, flags, oz, orad, okind, orate, last):
+    """One point's roots from its coefficient enclosure c (ascending, (hi, lo, rad)); see ``roots_block``.
+
+    ``last``: (usable, degree, scale exponent) of the approximations z holds on entry; updated on exit.
+    """
+    warm = last[0] == 1
+    last[0] = 0
     D = c.shape[0] - 1
     oz[:] = complex(np.nan, np.nan)
     orad[:] = np.nan
@@ -96,8 +104,14 @@ def _point(c, X, a, z, R, group, flags, oz, orad, okind, orate):
         R[0] = 0.0
         if not _disk_radii(X, 1, z, R):
             return ROOTS_FAILED
+    elif warm and last[1] == d:
+        # a warm start whose disks overlap may just not have converged: Bini's start then decides
+        if not (_warm(X, d, a, z, flags, last[2] - shift) and _disk_radii(X, d, z, R) and _separated(z, R, d)):
+            if not (approximate(X, d, a, z, flags) and _disk_radii(X, d, z, R)):
+                return ROOTS_FAILED
     elif not (approximate(X, d, a, z, flags) and _disk_radii(X, d, z, R)):
         return ROOTS_FAILED
+
     for i in range(d):
         group[i] = i
     for i in range(d):
@@ -140,4 +154,37 @@ def _point(c, X, a, z, R, group, flags, oz, orad, okind, orate):
         if not meets:
             lower = max(lower, low_i)
     orate[0], orate[1], orate[2] = min(max(best, lower), upper), lower, upper
+    if d > 1:  # z now holds the roots in lambda itself (scale exponent 0): the next point may start from them
+        last[0], last[1], last[2] = 1, d, 0
     return ROOTS_OK
+
+
+@kernel
+def _separated(z, R, d):
+    """True if no two disks meet (the test of the grouping below)."""
+    for i in range(d):
+        for j in range(i + 1, d):
+            if abs(z[i] - z[j]) * (1.0 - 4.0 * dd.U) <= (R[i] + R[j]) * (1.0 + 2.0 * dd.U):
+                return False
+    return True
+
+
+@kernel
+def _warm(X, d, a, z, flags, e):
+    """``inclusion.approximate`` started from z times 2**e instead of Bini's circles; False if that start fails."""
+    for k in range(d + 1):
+        a[k] = X[k, 0]
+    for i in range(d):
+        z[i] = complex(math.ldexp(z[i].real, e), math.ldexp(z[i].imag, e))
+        if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
+            return False
+        for j in range(i):
+            if z[i] == z[j]:  # Aberth's step divides by z_i - z_j
+                return False
+    _aberth(a, d, z, flags)
+    for i in range(d):
+        if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
+            return False
+    _polish(X, d, z, POLISH_SWEEPS)
+    _snap_real(X, d, z)
+    return True
