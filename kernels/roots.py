@@ -22,7 +22,7 @@ import numpy as np
 from . import dd
 from .block import LAPLACE_MAX
 from .charpoly import allocate, charpoly_point, same_structure
-from .inclusion import POLISH_SWEEPS, _aberth, _disk_radii, _polish, _snap_real, approximate, find_root
+from .inclusion import POLISH_SWEEPS, aberth, disk_radii, polish, snap_real, approximate, find_root
 from .options import kernel
 from .scaling import nonzero_span, rescale, root_scale
 
@@ -102,14 +102,18 @@ def _point(c, X, a, z, R, group, flags, oz, orad, okind, orate, last):
     if d == 1:  # one real root, -X_0 / X_1 (the disk of a linear polynomial needs no approximations)
         z[0] = -X[0, 0] / X[1, 0]
         R[0] = 0.0
-        if not _disk_radii(X, 1, z, R):
+        if not disk_radii(X, 1, z, R):
             return ROOTS_FAILED
     elif warm and last[1] == d:
-        # a warm start whose disks overlap may just not have converged: Bini's start then decides
-        if not (_warm(X, d, a, z, flags, last[2] - shift) and _disk_radii(X, d, z, R) and _separated(z, R, d)):
-            if not (approximate(X, d, a, z, flags) and _disk_radii(X, d, z, R)):
-                return ROOTS_FAILED
-    elif not (approximate(X, d, a, z, flags) and _disk_radii(X, d, z, R)):
+        # float Aberth sweeps from the last roots; the double-double polish only where the disks overlap, and
+        # Bini's start where they still do (a warm start may just not have converged)
+        if not (_warm(X, d, a, z, flags, last[2] - shift) and disk_radii(X, d, z, R) and _separated(z, R, d)):
+            polish(X, d, z, POLISH_SWEEPS)
+            snap_real(X, d, z)
+            if not (disk_radii(X, d, z, R) and _separated(z, R, d)):
+                if not (approximate(X, d, a, z, flags) and disk_radii(X, d, z, R)):
+                    return ROOTS_FAILED
+    elif not (approximate(X, d, a, z, flags) and disk_radii(X, d, z, R)):
         return ROOTS_FAILED
 
     for i in range(d):
@@ -171,7 +175,8 @@ def _separated(z, R, d):
 
 @kernel
 def _warm(X, d, a, z, flags, e):
-    """``inclusion.approximate`` started from z times 2**e instead of Bini's circles; False if that start fails."""
+    """``inclusion.approximate`` started from z times 2**e instead of Bini's circles, without its double-double
+    polish (well separated roots need none for their disks); False if that start fails."""
     for k in range(d + 1):
         a[k] = X[k, 0]
     for i in range(d):
@@ -181,10 +186,9 @@ def _warm(X, d, a, z, flags, e):
         for j in range(i):
             if z[i] == z[j]:  # Aberth's step divides by z_i - z_j
                 return False
-    _aberth(a, d, z, flags)
+    aberth(a, d, z, flags)
     for i in range(d):
         if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
             return False
-    _polish(X, d, z, POLISH_SWEEPS)
-    _snap_real(X, d, z)
+    snap_real(X, d, z)
     return True
