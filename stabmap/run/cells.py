@@ -250,7 +250,7 @@ class _Chunk:
             corners = np.concatenate([nodes[near] + s for s in sides])
             unique, back = np.unique(corners, axis=0, return_inverse=True)
             at = {n: e[unique[:, k]] for k, (n, e) in enumerate(zip(self.names, self.edges))}
-            corner_label = self.system.evaluate(self.scene, at)[self.system.label].reshape(-1)[back.reshape(-1)]
+            corner_label = self.system.evaluate(self.system.labels_only(self.scene), at)[self.system.label].reshape(-1)[back.reshape(-1)]
             changed = np.any(corner_label.reshape(len(sides), -1) != node_label[near][None, :], axis=0)
             cell[near[changed]] = CONTAINS_CHANGE
         # Sub-boxes between the node and the cell's edges, halved while they fail and pay.

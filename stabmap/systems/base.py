@@ -147,6 +147,11 @@ class System:
         return [("", list(names))] if names else []
 
     # ------------------------------------------------------------------ points
+    def labels_only(self, scene: SceneBase) -> SceneBase:
+        """``scene`` with every optional output off: what a computation that needs the label alone (critical
+        values) evaluates.  Default: the scene itself."""
+        return scene
+
     def dims(self, scene: SceneBase) -> dict[str, int]:
         """Sizes of the dimensions of ``variables`` beyond the grid's."""
         return {}

@@ -86,6 +86,11 @@ class Gyroscopes(System):
         # the growth rate is on unless the scene turns it off, the frequencies (D values a point) only if it asks
         return VARIABLES + (GROWTH_VARIABLES if scene.growth_rate else ()) + (FREQUENCY_VARIABLES if scene.frequencies else ())
 
+    def labels_only(self, scene: Scene) -> Scene:
+        import dataclasses
+
+        return dataclasses.replace(scene, growth_rate=False, frequencies=False)
+
     def dims(self, scene: Scene) -> dict[str, int]:
         return {"root": scene.degree}
 
