@@ -11,7 +11,7 @@ from __future__ import annotations
 import flint
 import numpy as np
 
-from ...kernels import NONREAL, REAL, UNSEPARATED, roots_block
+from ...kernels import NONREAL, REAL, roots_block
 from . import exact
 from .decide import kernel_args
 from .outputs import EFOLDING_TIME, FREQUENCY, FREQUENCY_RADIUS, GROWTH_RATE, GROWTH_RATE_LOWER, GROWTH_RATE_METHOD, GROWTH_RATE_UPPER, ROOT_KIND
@@ -144,4 +144,4 @@ def _take(points: PointArrays, index: np.ndarray) -> PointArrays:
                        points.free, points.parent, points.at[index])
 
 
-__all__ = ["rates", "not_computed", "exact_roots", "UNSEPARATED"]
+__all__ = ["rates", "not_computed", "exact_roots"]
