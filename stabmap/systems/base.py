@@ -215,6 +215,11 @@ class System:
         decided ``origin``.  None (the default): the system has no such roots."""
         return None
 
+    def at_proved_nodes(self, scene: SceneBase, values: dict[str, np.ndarray], label: np.ndarray) -> dict[str, np.ndarray] | None:
+        """Variables of ``outputs(scene)`` that the system computes at nodes whose ``label`` a box proof holds (1-D arrays
+        of grid-axis ``values``), over ``proved_box``'s.  None (the default): ``proved_box`` says all."""
+        return None
+
     def inferred(self, label: np.ndarray) -> dict[str, np.ndarray] | None:
         """The other variables of points given ``label`` without being computed (adaptive refinement).
 

@@ -152,6 +152,15 @@ class Gyroscopes(System):
         return {"stability": stability_from_pairs(label), "decided_by": np.full(np.shape(label), BY_BOX, dtype=np.int8),
                 **not_computed(label, proved=True)}
 
+    def at_proved_nodes(self, scene: Scene, values: dict[str, np.ndarray], label: np.ndarray) -> dict[str, np.ndarray] | None:
+        # the box proved N_c at the node; the roots there are cheaper than a decision (docs/rates.md)
+        if not (scene.growth_rate or scene.frequencies):
+            return None
+        from .points import point_arrays
+        from .rates import rates
+
+        return rates(point_arrays(scene, values), label, scene.growth_rate, scene.frequencies)
+
     def class_name(self, value: int) -> str:
         if value < 0:
             return "degenerate (p \u2261 0)"

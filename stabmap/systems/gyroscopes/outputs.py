@@ -66,8 +66,8 @@ def stability_from_pairs(nc: np.ndarray) -> np.ndarray:
 
 
 # ------------------------------------------------------------------ growth rates and frequencies (docs/rates.md)
-_NOT_COMPUTED = ("NaN where growth_rate_method is not_computed or degenerate: a point proved over a box (unstable) "
-                 "or inferred (--refine) is not evaluated on its own, and its rate is not made up")
+_NOT_COMPUTED = ("NaN where growth_rate_method is not_computed or degenerate: a point inferred (--refine) is not "
+                 "evaluated, and its rate is not made up")
 GROWTH_RATE = Variable(
     "growth_rate",
     "float32",
@@ -100,7 +100,8 @@ GROWTH_RATE_METHOD = Variable(
     comment="all_roots_real: n_complex_pairs = 0 is proved, so the rate is exactly 0; "
     "inclusion_disks: Braess-Hadeler inclusion disks around every root in double-double interval arithmetic; "
     "exact_arb_roots: the exact rational polynomial's roots isolated by FLINT/Arb (where the disks were too wide); "
-    "not_computed: the point was proved over a box and is unstable, or inferred (decided_by says which); "
+    "not_computed: the point was inferred (--refine), not computed; a point proved over a box has its rate computed "
+    "at the node from its proved label; "
     "degenerate: p is identically zero",
     flags=((0, "all_roots_real"), (1, "inclusion_disks"), (2, "exact_arb_roots"), (3, "not_computed"), (4, "degenerate")),
 )
@@ -112,7 +113,7 @@ FREQUENCY = Variable(
     comment="every root of p(lambda) with multiplicity, ascending; a real root is a mode's frequency (lambda < 0: "
     "prograde), a complex pair's two roots share their real part. For one top without liquid the two roots are the "
     "nutation (larger |lambda|) and precession frequencies. NaN beyond the degree of p and where not computed "
-    "(growth_rate_method not_computed or degenerate). Opt-in: the scene key frequencies = true",
+    "(inferred or degenerate points). Opt-in: the scene key frequencies = true",
     dims=("root",),
     fill=float("nan"),
 )

@@ -66,7 +66,8 @@ def rates(points: PointArrays, nc: np.ndarray, growth: bool = True, frequencies:
 
 
 def not_computed(label: np.ndarray, proved: bool) -> dict[str, np.ndarray]:
-    """The rate variables of points not evaluated one by one: 0 where N_c = 0 is ``proved``, flagged NaN elsewhere.
+    """The rate variables of points not evaluated one by one: 0 where N_c = 0 is ``proved``, flagged NaN elsewhere
+    (inferred points; a box-proved node's NaN are then replaced by ``rates`` at the node: ``at_proved_nodes``).
 
     The frequency variables come as (k, 1) columns of fill, which broadcast over the ``root`` dimension.
     """
