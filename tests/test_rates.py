@@ -147,7 +147,11 @@ def mp_roots(points, p: int) -> list:
     poly = exact.char_poly(points.body[p], points.joint[p], points.g[p], points.E[p], points.kappa[p], points.nmodes,
                            points.free, points.parent, points.at[p])
     coeffs = [mpmath.mpf(int(q.p)) / mpmath.mpf(int(q.q)) for q in reversed(poly.coeffs())]
-    return mpmath.polyroots(coeffs, maxsteps=400, extraprec=400)
+    zeros = 0
+    while coeffs[-1] == 0:  # exact lambda = 0 roots, counted from the exact coefficients
+        coeffs.pop()
+        zeros += 1
+    return [mpmath.mpf(0)] * zeros + list(mpmath.polyroots(coeffs, maxsteps=400, extraprec=400))
 
 
 @pytest.mark.parametrize("n", [2, 3])
@@ -170,6 +174,42 @@ def test_chains_with_liquid_enclose_the_mpmath_roots(n):
             hit = [k for k in free if abs(float(mpmath.re(z)) - out["frequency"][i, k]) <= out["frequency_radius"][i, k]]
             assert hit, (n, omega[i], z)
             free.remove(hit[0])
+
+
+FREE = """
+support = "free"
+joints = [2.0]
+frequencies = true
+[[bodies]]
+m = 1.0
+A = 0.02
+C = 0.03
+c = 0.10
+s = 0.25
+fluid = { E = [1e-3], kappa = [1.31] }
+[[bodies]]
+m = 0.5
+A = 0.01
+C = 0.002
+c = 0.08
+[grid]
+omega = { start = 0.0, stop = 100.0, num = 3 }
+"""
+
+
+def test_free_chain_keeps_its_exact_zero_roots():
+    """A free chain's lambda = 0 roots (the rigid tilts) are exact: stored as 0 with radius 0, proved real."""
+    scene = loads_scene(FREE)
+    omega = np.array([0.0, 10.0, 55.0])
+    out = evaluate(scene, omega=omega)
+    points = point_arrays(scene, {"omega": omega})
+    for i in range(omega.size):
+        want = sorted(mp_roots(points, i), key=lambda z: float(mpmath.re(z)))
+        zeros = sum(1 for z in want if z == 0)
+        assert zeros >= 1 and int(np.sum((out["frequency"][i] == 0) & (out["frequency_radius"][i] == 0))) >= zeros
+        for k, z in enumerate(want):
+            assert abs(float(mpmath.re(z)) - out["frequency"][i, k]) <= out["frequency_radius"][i, k]
+        assert np.all(out["root_kind"][i] == 0) and out["growth_rate"][i] == 0
 
 
 def test_box_proved_nodes_are_computed_and_inferred_ones_flagged():
