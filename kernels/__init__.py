@@ -8,6 +8,7 @@ modules import each other relatively, so they work under either name.
 """
 
 from .block import box_block, charpoly_block, count_block, decide_block, linearise_block, nodes_box_block
+from .roots import NONREAL, REAL, ROOTS_FAILED, UNSEPARATED, roots_block
 from .status import DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL
 
 __all__ = [
@@ -17,6 +18,11 @@ __all__ = [
     "decide_block",
     "linearise_block",
     "nodes_box_block",
+    "roots_block",
+    "NONREAL",
+    "REAL",
+    "ROOTS_FAILED",
+    "UNSEPARATED",
     "DECIDED_DISKS",
     "DECIDED_FLOAT",
     "DECIDED_INERTIA",

@@ -129,7 +129,7 @@ def _aberth_step(z, d, i, p, dp):
 
 
 @kernel
-def _polish(X, d, z, sweeps):
+def polish(X, d, z, sweeps):
     """Aberth sweeps with p and p' in double-double until no approximation moves by more than 2**-50 of itself.
 
     The float iteration resolves a cluster of k roots only to about u**(1/k) of
@@ -150,7 +150,7 @@ def _polish(X, d, z, sweeps):
 
 
 @kernel
-def _aberth(a, d, z, done):
+def aberth(a, d, z, done):
     """Aberth-Ehrlich iteration on the float polynomial a (ascending, degree d), in place."""
     done[:d] = False
     for _ in range(MAX_ITER):
@@ -173,7 +173,7 @@ def _aberth(a, d, z, done):
 
 
 @kernel
-def _snap_real(X, d, z):
+def snap_real(X, d, z):
     """Put approximations of simple real roots exactly on the real axis (then Newton-polish them).
 
     A disk can certify a real root only if its centre is real.  An approximation
@@ -209,7 +209,7 @@ def find_root(parent, i):
 
 
 @kernel
-def _disk_radii(X, d, z, R):
+def disk_radii(X, d, z, R):
     """Rigorous radii d |w_i| (see module docstring); False if a bound is not finite or z repeat."""
     mu = 1.0 + 16.0 * (d + 4) * dd.U
     lead = (abs(X[d, 0]) * (1.0 - 4.0 * dd.U) - abs(X[d, 1]) - X[d, 2]) / mu
@@ -253,12 +253,12 @@ def approximate(X, d, a, z, flags):
     if a[0] == 0.0 or a[d] == 0.0:
         return False
     _start(a, d, z)
-    _aberth(a, d, z, flags)
+    aberth(a, d, z, flags)
     for i in range(d):
         if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
             return False
-    _polish(X, d, z, POLISH_SWEEPS)
-    _snap_real(X, d, z)
+    polish(X, d, z, POLISH_SWEEPS)
+    snap_real(X, d, z)
     return True
 
 
@@ -272,7 +272,7 @@ def count_complex_pairs_inclusion(X, d, a, z, R, group, flags):
     """
     if not approximate(X, d, a, z, flags):
         return -1, UNDECIDED
-    if not _disk_radii(X, d, z, R):
+    if not disk_radii(X, d, z, R):
         return -1, UNDECIDED
     parent, size = group[:d], group[d : 2 * d]
     for i in range(d):

@@ -20,12 +20,14 @@ import numba
 import numpy as np
 
 from . import options
-from .block import box_block, decide_block, nodes_box_block
+from .block import box_block, decide_block, linearise_block, nodes_box_block
+from .roots import roots_block
 
 
 def signatures() -> list[tuple]:
     """Argument types of every (kernel, signature) the labelled layer calls on C arrays: ``decide_block`` for
-    points, ``box_block`` and ``nodes_box_block`` for boxes (critical values)."""
+    points, ``box_block`` and ``nodes_box_block`` for boxes (critical values), ``roots_block`` for growth rates
+    and frequencies, ``linearise_block`` for the roots' origin (``stabmap query --roots``)."""
     npts, n, lmax = 1, 1, 1
     body, joint, g = np.empty((npts, n, 6)), np.empty((npts, n)), np.empty(npts)
     E, kappa, nmodes = np.empty((npts, n, lmax)), np.empty((npts, n, lmax)), np.empty(n, np.int64)
@@ -38,8 +40,12 @@ def signatures() -> list[tuple]:
     b4, j3, g2, a3 = body[:, None], joint[:, None], g[:, None], at[:, None]
     nodes = (b4, b4.copy(), j3, j3.copy(), g2, g2.copy(), E, kappa, nmodes, False, parent, a3, a3.copy(), g2.copy(), g.copy(), g.copy(),
              g2.copy(), g.copy(), g.copy(), False) + out + (np.empty(npts, np.int8),)
+    roots = args[:9] + (np.empty((npts, 2), np.complex128), np.empty((npts, 2)), np.empty((npts, 2), np.int8), np.empty((npts, 3)),
+                        np.empty(npts, np.int8))
+    linear = args[:9] + (np.empty((npts, 2, 2)),)
     return [(decide_block, tuple(numba.typeof(a) for a in args)), (box_block, tuple(numba.typeof(a) for a in box)),
-            (nodes_box_block, tuple(numba.typeof(a) for a in nodes))]
+            (nodes_box_block, tuple(numba.typeof(a) for a in nodes)), (roots_block, tuple(numba.typeof(a) for a in roots)),
+            (linearise_block, tuple(numba.typeof(a) for a in linear))]
 
 
 def precompile() -> dict:

@@ -42,6 +42,7 @@ _API = {
     "open_atlas": "stabmap.store.files",
     "plot_atlas": "stabmap.read.plot",
     "plot_critical": "stabmap.read.plot",
+    "roots": "stabmap.read.roots",
     "smallest_stable": "stabmap.read.query",
     "stable_fraction": "stabmap.read.query",
     "summary": "stabmap.read.summary",

@@ -113,6 +113,7 @@ examples:
   stabmap query a.nc --smallest-stable omega=0: --csv      ... of positive spin rates only, as CSV
   stabmap query a.nc --boundaries omega K_1=3 --locate     every change, however narrow, located to 1e-10
   stabmap query crit.nc --csv -o crit.csv                  critical values: every stable interval and boundary
+  stabmap query a.nc omega=42.5 K_1=3 --roots              every root there, enclosed, with kind and origin
 \b
 Without --locate, boundaries are known to grid resolution only; --locate computes critical values of the
 atlas's scene along the selected lines: complete, and located to 1e-10 (docs/critical.md)."""
@@ -126,12 +127,14 @@ atlas's scene along the selected lines: complete, and located to 1e-10 (docs/cri
 @click.option("--over", metavar="NAME", help="with --smallest-stable: the one axis that labels the answer")
 @click.option("--locate", is_flag=True, help="with --boundaries or --smallest-stable: critical values of the atlas's scene, "
               "every change located to 1e-10, undecided stretches listed (computes)")
+@click.option("--roots", is_flag=True, help="every characteristic root at the point (computed there, not the nearest grid point): "
+              "proved enclosure, multiplicity, real or complex pair, liquid mode or structural (docs/rates.md)")
 @click.option("--csv", "fmt", flag_value="csv", help="print CSV (every row)")
 @click.option("--json", "fmt", flag_value="json", help="print JSON (every row)")
 @click.option("--limit", type=int, default=40, metavar="N", help="rows of a text table (default 40; 0: all)")
 @click.option("-o", "--output", metavar="FILE", help="write the answer to FILE (atomically) instead of printing it")
 @_overwrite
-def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, fmt, limit, output, overwrite):
+def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, roots, fmt, limit, output, overwrite):
     """Ask a saved atlas: the label at a point, the stable fraction, boundaries, the smallest stable value.
 
     NAME=VALUE selects the grid value of NAME nearest to VALUE (the value used is printed); NAME=LO:HI keeps the
@@ -140,7 +143,7 @@ def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, fmt
     from . import jobs
 
     click.echo(jobs.query(atlas, items, fraction=fraction, boundaries=boundaries, smallest_stable=smallest_stable,
-                          over=over, locate=locate, fmt=fmt or "text", limit=limit, output=output, overwrite=overwrite))
+                          over=over, locate=locate, roots=roots, fmt=fmt or "text", limit=limit, output=output, overwrite=overwrite))
 
 
 @cli.command(short_help="Draw an atlas (or critical values) to a PNG or PDF file.")

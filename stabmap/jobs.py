@@ -216,6 +216,7 @@ def query(
     smallest_stable: str | None = None,
     over: str | None = None,
     locate: bool = False,
+    roots: bool = False,
     fmt: str = "text",
     limit: int = 40,
     progress: bool | None = None,
@@ -235,7 +236,8 @@ def query(
     from .store.files import check_new_output, open_atlas
 
     items = list(items)
-    asked = [opt for opt, v in (("--fraction", fraction or None), ("--boundaries", boundaries), ("--smallest-stable", smallest_stable)) if v]
+    asked = [opt for opt, v in (("--fraction", fraction or None), ("--boundaries", boundaries), ("--smallest-stable", smallest_stable),
+                                ("--roots", roots or None)) if v]
     if len(asked) > 1:
         raise StabmapError(f"ask one question at a time: {' and '.join(asked)} were both given")
     if limit < 0:
@@ -262,6 +264,13 @@ def query(
             raise StabmapError(f"{path} holds critical values, not an atlas, and {given} asks an atlas; 'stabmap query {path}' "
                                "(--csv or --json; NAME=VALUE picks lines) lists its stable intervals and boundaries")
         return _answer(render_table(select_lines(ds, sel), fmt, limit=limit), output)
+    if roots:
+        from .read.roots import roots as roots_at
+
+        if fmt == "csv":
+            raise StabmapError("--roots prints text or --json")
+        found = roots_at(ds, **sel)
+        return _answer(found.to_json() if fmt == "json" else found.text(), output)
     if locate:
         from .read import located
 

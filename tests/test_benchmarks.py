@@ -132,3 +132,12 @@ def test_bench_tables_quick(capsys):
     # tiling the file ten times gives ten times the lines and the CSV rows (an interval and a boundary per line)
     assert [r["lines"] for r in rows] == [5, 50] and [r["csv_rows"] for r in rows] == [10, 100]
     assert "| lines | to_dataframe s |" in capsys.readouterr().out
+
+
+def test_bench_rates_quick(capsys):
+    rows = runpy.run_path(str(SCRIPTS / "bench_rates.py"))["main"](["--quick"])
+    assert [(r["scene"], r["cells"], r["way"]) for r in rows] == [
+        (s, c, w) for s in ("paper-n1-fixed", "paper-n2-fixed", "paper-n3-fixed") for c in (True, False) for w in ("plain", "growth", "frequencies")]
+    for r in rows:  # the rate variables add 17 bytes a point to the plain atlas's 5, the frequencies 17 per root
+        assert r["bytes"] == r["points"] * (5 + 17 * (r["way"] != "plain") + 17 * r["degree"] * (r["way"] == "frequencies"))
+    assert "| scene | degree | points |" in capsys.readouterr().out

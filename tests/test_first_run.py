@@ -128,7 +128,7 @@ def test_atlas_refine_and_critical_call_only_the_precompiled_signatures():
     code = """
         import json
         import stabmap
-        from stabmap.kernels import box_block, decide_block, nodes_box_block, precompile
+        from stabmap.kernels import box_block, decide_block, linearise_block, nodes_box_block, precompile, roots_block
         from stabmap.scene.grid import resample
         scene = stabmap.example("paper-n3-fixed")
         small = resample(scene, **{a.name: 9 for a in scene.grid})
@@ -138,7 +138,8 @@ def test_atlas_refine_and_critical_call_only_the_precompiled_signatures():
         through_zero = stabmap.loads_scene(
             'support = "fixed"\\n[[bodies]]\\nm = 1.0\\nA = 0.02\\nC = 0.03\\nc = 0.1\\n[grid]\\nomega = { start = -2.0, stop = 2.0, num = 5 }\\n')
         stabmap.critical(through_zero, "omega", progress=False, threads=1)  # plain boxes at omega = 0
-        called = decide_block.signatures + box_block.signatures + nodes_box_block.signatures
+        stabmap.roots(small, **{a.name: a.values[0] for a in small.grid})  # query --roots
+        called = decide_block.signatures + box_block.signatures + nodes_box_block.signatures + roots_block.signatures + linearise_block.signatures
         print(json.dumps({"called": sorted(map(str, called)),
                           "precompiled": sorted(str(sig) for _, sig in precompile.signatures())}))
     """

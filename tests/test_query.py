@@ -311,6 +311,9 @@ def test_cli_label_keeps_its_form(atlas_file, capsys):
         "c_1 = 0.1 -> nearest grid point 0.1 m",
         "n_complex_pairs = 0",
         "stability = stable (decided by interval sturm sequence)",
+        "growth_rate = 0 (proved in [0, 0])",
+        "efolding_time = inf",
+        "growth_rate_method = all_roots_real",
         "cell = node_only (the label is proved at the grid point only; at the requested point it is not decided)",
     ]
     code, out, _ = run(capsys, atlas_file, "omega=0", "c_1=0.1", "--json")

@@ -59,6 +59,12 @@ class StabmapAccessor:
 
         return smallest_stable(self._ds, along, over, **sel)
 
+    def roots(self, **point: float):
+        """Every characteristic root at ``point``, recomputed from the atlas's scene: :func:`stabmap.roots`."""
+        from .roots import roots
+
+        return roots(self._ds, **point)
+
     def summary(self) -> dict:
         """Counts that describe the whole atlas, or a critical-values file's intervals per line: :func:`stabmap.summary`."""
         from .summary import summary

@@ -308,7 +308,10 @@ def label_at(ds: xr.Dataset, **point: float) -> Label:
     for v in system.atlas_variables:
         if v.name in sel:
             x = sel[v.name].values
-            values[v.name] = v.meaning(int(x)) if v.flags else (x.item() if x.ndim == 0 else x)
+            if v.flags:  # a flag variable on a dimension of its own (root_kind, say): one meaning per entry
+                values[v.name] = v.meaning(int(x)) if x.ndim == 0 else [v.meaning(int(e)) for e in x.ravel()]
+            else:
+                values[v.name] = x.item() if x.ndim == 0 else x
     return Label(
         requested={k: float(v) for k, v in point.items()},
         grid_point={d: float(sel[d]) for d in dims},

@@ -57,8 +57,12 @@ def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
     for k, v in label.requested.items():
         note = " (outside the grid: nearest edge)" if k in label.outside else ""
         lines.append(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g}{_units(atlas, k)}" + note)
-    shown = [(k, v) for k, v in label.values.items() if k != label.provenance]
-    lines += [f"{k} = {_value(v)}" + (f" ({CELL_TEXT[v]})" if k == "cell" and v in CELL_TEXT else "") for k, v in shown]
+    # NAME_lower and NAME_upper, a proved enclosure of NAME, are shown on NAME's line
+    bounds = {k for k in label.values for end in ("_lower", "_upper") if k.endswith(end) and k[: -len(end)] in label.values}
+    shown = [(k, v) for k, v in label.values.items() if k != label.provenance and k not in bounds]
+    lines += [f"{k} = {_value(v)}" + (f" ({CELL_TEXT[v]})" if k == "cell" and v in CELL_TEXT else "")
+              + (f" (proved in [{_value(label.values[k + '_lower'])}, {_value(label.values[k + '_upper'])}])" if k + "_lower" in bounds else "")
+              for k, v in shown]
     if label.provenance is not None:
         how = label.values[label.provenance]
         # How the point was decided qualifies its verdict (stability, else the label: the critical node), not
@@ -85,6 +89,8 @@ CELL_TEXT = {  # what the cell flag says about the requested point, which lies i
 
 
 def _value(v) -> str:
+    if isinstance(v, float):
+        return f"{v:.8g}"
     return np.array2string(v, precision=8) if isinstance(v, np.ndarray) else str(v)
 
 

@@ -80,7 +80,7 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
     shape = tuple(b - a for a, b in location)
     chunk = _Chunk(scene, location)
     extra = system.dims(scene)
-    out = {v.name: np.empty(shape + tuple(extra[d] for d in v.dims), dtype=v.dtype) for v in system.variables}
+    out = {v.name: np.empty(shape + tuple(extra[d] for d in v.dims), dtype=v.dtype) for v in system.outputs(scene)}
     label = np.zeros(shape, dtype=out[system.label].dtype)
     cell = np.full(shape, NODE_ONLY, dtype=CELL.dtype)
     known = np.zeros(shape, dtype=bool)
@@ -102,6 +102,10 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
 
     if known.any():
         for k, v in system.proved_box(label[known]).items():
+            if k in out:  # an output the scene left out (System.outputs)
+                out[k][known] = v
+        # what the system computes at such nodes given their proved label (cheaper than deciding them)
+        for k, v in (system.at_proved_nodes(scene, chunk.values(np.argwhere(known)), label[known]) or {}).items():
             out[k][known] = v
         out[system.label][known] = label[known]
     # Nodes no box holds: computed, in the order the kernels are quickest on, then their cells classified.
@@ -249,7 +253,7 @@ class _Chunk:
             corners = np.concatenate([nodes[near] + s for s in sides])
             unique, back = np.unique(corners, axis=0, return_inverse=True)
             at = {n: e[unique[:, k]] for k, (n, e) in enumerate(zip(self.names, self.edges))}
-            corner_label = self.system.evaluate(self.scene, at)[self.system.label].reshape(-1)[back.reshape(-1)]
+            corner_label = self.system.evaluate(self.system.labels_only(self.scene), at)[self.system.label].reshape(-1)[back.reshape(-1)]
             changed = np.any(corner_label.reshape(len(sides), -1) != node_label[near][None, :], axis=0)
             cell[near[changed]] = CONTAINS_CHANGE
         # Sub-boxes between the node and the cell's edges, halved while they fail and pay.

@@ -199,10 +199,11 @@ def critical(
     others = tuple(a for d, a in enumerate(scene.grid) if d != index)
     counts = _Counts()
     t0 = time.perf_counter()
+    labels = system.labels_only(scene)  # critical values need the label alone, not the system's other outputs
     with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run:
-        nc = _scan(run, scene, index, progress, chunk_points, counts)
-        boxes = along in system.box_axes(scene)
-        brackets, gaps = _search(run, scene, along, others, _steps(nc, scan), boxes, rtol, atol, chunk_points, counts)
+        nc = _scan(run, labels, index, progress, chunk_points, counts)
+        boxes = along in system.box_axes(labels)
+        brackets, gaps = _search(run, labels, along, others, _steps(nc, scan), boxes, rtol, atol, chunk_points, counts)
     brackets, gaps = _join(brackets, gaps, rtol, atol)
     ds = _dataset(system, scene, along, others, scan, nc, brackets, gaps, _proved(system))
     ds.attrs.update(_attrs(system, along, scan, rtol, atol, counts, boxes))

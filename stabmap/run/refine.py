@@ -218,7 +218,8 @@ class _Evaluator:
         """Every variable on the grid, the points not computed given the values their label implies."""
         rest = ~self.computed
         for k, v in self.system.inferred(self.label[rest]).items():
-            self.arrays[k][rest] = v
+            if k in self.arrays:  # an output the scene left out (System.outputs)
+                self.arrays[k][rest] = v
         self.arrays[CELL.name][...] = np.where(rest, CELL.value("not_proved"), CELL.value("node_only"))
         return self.arrays
 

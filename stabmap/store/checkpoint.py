@@ -52,7 +52,7 @@ class Checkpoint:
         nchunks = int(np.prod([-(-n // c) for n, c in zip(scene.shape, chunks)], dtype=np.int64))
         extra = system.dims(scene)
         lazy = {}
-        for v in system.atlas_variables:
+        for v in system.atlas_outputs(scene):
             sizes = tuple(extra[d] for d in v.dims)
             lazy[v.name] = da.zeros(scene.shape + sizes, chunks=tuple(chunks) + sizes, dtype=v.dtype)
         ds = atlas_dataset(system, scene, lazy)

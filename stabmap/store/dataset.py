@@ -73,7 +73,7 @@ def global_attrs(system, scene, kind: str) -> dict:
 def atlas_dataset(system, scene, arrays: dict) -> xr.Dataset:
     """The atlas Dataset of ``scene`` from one array (numpy or dask) per declared variable, in grid shape."""
     dims = tuple(a.name for a in scene.grid)
-    data = {v.name: (dims + v.dims, arrays[v.name], v.attrs()) for v in system.atlas_variables}
+    data = {v.name: (dims + v.dims, arrays[v.name], v.attrs()) for v in system.atlas_outputs(scene)}
     coords = coordinates(system, scene)
     coords.update({d: (d, values, attrs) for d, (values, attrs) in system.dim_coords(scene).items()})
     return xr.Dataset(data, coords=coords, attrs=global_attrs(system, scene, "stabmap atlas"))
@@ -83,4 +83,4 @@ def empty_arrays(system, scene, shape: tuple[int, ...] | None = None) -> dict[st
     """Uninitialised arrays of every variable for ``shape`` (default: the grid's)."""
     shape = scene.shape if shape is None else shape
     extra = system.dims(scene)
-    return {v.name: np.empty(shape + tuple(extra[d] for d in v.dims), dtype=v.dtype) for v in system.atlas_variables}
+    return {v.name: np.empty(shape + tuple(extra[d] for d in v.dims), dtype=v.dtype) for v in system.atlas_outputs(scene)}

@@ -157,6 +157,11 @@ class System:
         return [("", list(names))] if names else []
 
     # ------------------------------------------------------------------ points
+    def labels_only(self, scene: SceneBase) -> SceneBase:
+        """``scene`` with every optional output off: what a computation that needs the label alone (critical
+        values) evaluates.  Default: the scene itself."""
+        return scene
+
     def dims(self, scene: SceneBase) -> dict[str, int]:
         """Sizes of the dimensions of ``variables`` beyond the grid's."""
         return {}
@@ -214,6 +219,17 @@ class System:
         """
         raise NotImplementedError(f"the {self.name} system proves boxes but does not say what a box-proved node holds")
 
+    def roots(self, scene: SceneBase, values: dict[str, float]) -> tuple[list, str] | None:
+        """Every characteristic root at one point (``stabmap.read.roots``): a list of records with ``value``,
+        ``radius``, ``multiplicity``, ``kind``, ``origin``, ``liquid_share`` and ``growth_rate``, and the rule that
+        decided ``origin``.  None (the default): the system has no such roots."""
+        return None
+
+    def at_proved_nodes(self, scene: SceneBase, values: dict[str, np.ndarray], label: np.ndarray) -> dict[str, np.ndarray] | None:
+        """Variables of ``outputs(scene)`` that the system computes at nodes whose ``label`` a box proof holds (1-D arrays
+        of grid-axis ``values``), over ``proved_box``'s.  None (the default): ``proved_box`` says all."""
+        return None
+
     def inferred(self, label: np.ndarray) -> dict[str, np.ndarray] | None:
         """The other variables of points given ``label`` without being computed (adaptive refinement).
 
@@ -222,6 +238,15 @@ class System:
         return None
 
     # ------------------------------------------------------------------ outputs
+    def outputs(self, scene: SceneBase) -> tuple[Variable, ...]:
+        """The ``variables`` that ``evaluate`` returns and an atlas of ``scene`` stores (default: all of them);
+        a system whose scenes opt in or out of some outputs names those left out here."""
+        return tuple(self.variables)
+
+    def atlas_outputs(self, scene: SceneBase) -> tuple[Variable, ...]:
+        """Every variable of an atlas of ``scene``: its ``outputs`` and ``cell``."""
+        return self.outputs(scene) + (CELL,)
+
     @property
     def atlas_variables(self) -> tuple[Variable, ...]:
         """Every variable of an atlas file: the system's ``variables`` and ``cell`` (``stabmap.run.cells``)."""

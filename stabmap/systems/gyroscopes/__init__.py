@@ -16,7 +16,7 @@ import numpy as np
 
 from ..base import Cost, System
 from . import scene as _scene
-from .outputs import BY_BOX, BY_INFERRED, N_COMPLEX_PAIRS, VARIABLES, stability_from_pairs
+from .outputs import ALL_VARIABLES, BY_BOX, BY_INFERRED, FREQUENCY_VARIABLES, GROWTH_VARIABLES, N_COMPLEX_PAIRS, VARIABLES, stability_from_pairs
 from .scene import Body, Scene
 
 REFERENCES = (
@@ -41,7 +41,7 @@ class Gyroscopes(System):
     name = "gyroscopes"
     title = "chains and trees of Lagrange gyroscopes with liquid-filled cavities"
     references = REFERENCES
-    variables = VARIABLES
+    variables = ALL_VARIABLES
     label = N_COMPLEX_PAIRS.name
     label_symbol = "N_c"
     label_title = "complex root pairs N$_c$"
@@ -88,6 +88,24 @@ class Gyroscopes(System):
         groups += [("joints", joints)] if joints else []
         return groups + [(f"body {k}", bodies[k]) for k in sorted(bodies)]
 
+    def outputs(self, scene: Scene) -> tuple:
+        # the growth rate is on unless the scene turns it off, the frequencies (D values a point) only if it asks
+        return VARIABLES + (GROWTH_VARIABLES if scene.growth_rate else ()) + (FREQUENCY_VARIABLES if scene.frequencies else ())
+
+    def labels_only(self, scene: Scene) -> Scene:
+        import dataclasses
+
+        return dataclasses.replace(scene, growth_rate=False, frequencies=False)
+
+    def dims(self, scene: Scene) -> dict[str, int]:
+        return {"root": scene.degree}
+
+    def dim_coords(self, scene: Scene) -> dict:
+        if not scene.frequencies:
+            return {}
+        return {"root": (np.arange(scene.degree, dtype=np.int32),
+                         {"long_name": "characteristic root, by ascending real part (multiplicity counted)", "units": "1"})}
+
     def fastest_axes(self, scene: Scene) -> tuple[int, ...]:
         # The kernels rebuild the inertia and stiffness matrices only when a point's masses, lengths or
         # stiffnesses differ from the previous point's: runs of points that differ only in spin skip that work.
@@ -106,9 +124,14 @@ class Gyroscopes(System):
         from .points import point_arrays
 
         shape = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()
-        nc, by = decide(point_arrays(scene, values))
-        nc = nc.reshape(shape)
-        return {"n_complex_pairs": nc, "stability": stability_from_pairs(nc), "decided_by": by.reshape(shape)}
+        points = point_arrays(scene, values)
+        nc, by = decide(points)
+        out = {"n_complex_pairs": nc, "stability": stability_from_pairs(nc), "decided_by": by}
+        if scene.growth_rate or scene.frequencies:
+            from .rates import rates
+
+            out.update(rates(points, nc, scene.growth_rate, scene.frequencies))
+        return {k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}
 
     def box_axes(self, scene: Scene) -> set[str]:
         from .boxes import box_axes
@@ -131,7 +154,19 @@ class Gyroscopes(System):
         return prove_boxes(scene, lower, upper, cut=True)
 
     def proved_box(self, label: np.ndarray) -> dict[str, np.ndarray]:
-        return {"stability": stability_from_pairs(label), "decided_by": np.full(np.shape(label), BY_BOX, dtype=np.int8)}
+        from .rates import not_computed
+
+        return {"stability": stability_from_pairs(label), "decided_by": np.full(np.shape(label), BY_BOX, dtype=np.int8),
+                **not_computed(label, proved=True)}
+
+    def at_proved_nodes(self, scene: Scene, values: dict[str, np.ndarray], label: np.ndarray) -> dict[str, np.ndarray] | None:
+        # the box proved N_c at the node; the roots there are cheaper than a decision (docs/rates.md)
+        if not (scene.growth_rate or scene.frequencies):
+            return None
+        from .points import point_arrays
+        from .rates import rates
+
+        return rates(point_arrays(scene, values), label, scene.growth_rate, scene.frequencies)
 
     def class_name(self, value: int) -> str:
         if value < 0:
@@ -141,8 +176,16 @@ class Gyroscopes(System):
         # every class but N_c = 0 is unstable: the legend says so, not only how many pairs (issue 30)
         return f"unstable: {value} complex pair{'s' if value > 1 else ''}"
 
+    def roots(self, scene: Scene, values: dict[str, float]) -> tuple[list, str]:
+        from .modes import RULE, roots_at
+
+        return roots_at(scene, values), RULE
+
     def inferred(self, label: np.ndarray) -> dict[str, np.ndarray]:
-        return {"stability": stability_from_pairs(label), "decided_by": np.full(np.shape(label), BY_INFERRED, dtype=np.int8)}
+        from .rates import not_computed
+
+        return {"stability": stability_from_pairs(label), "decided_by": np.full(np.shape(label), BY_INFERRED, dtype=np.int8),
+                **not_computed(label, proved=False)}
 
 
 SYSTEM = Gyroscopes()

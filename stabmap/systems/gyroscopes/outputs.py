@@ -63,3 +63,80 @@ def stability_from_pairs(nc: np.ndarray) -> np.ndarray:
     """The stability flag from N_c."""
     stable, unstable, degenerate = (STABILITY.value(m) for m in ("stable", "unstable", "degenerate"))
     return np.where(nc < 0, degenerate, np.where(nc == 0, stable, unstable)).astype(np.int8)
+
+
+# ------------------------------------------------------------------ growth rates and frequencies (docs/rates.md)
+_NOT_COMPUTED = ("NaN where growth_rate_method is not_computed or degenerate: a point inferred (--refine) is not "
+                 "evaluated, and its rate is not made up")
+GROWTH_RATE = Variable(
+    "growth_rate",
+    "float32",
+    "largest growth rate of a perturbation: the largest |Im lambda| over the characteristic roots",
+    units="s-1",
+    comment="solutions ~ exp(i lambda t) grow like exp(|Im lambda| t); exactly 0 where every root is proved real "
+    "(n_complex_pairs = 0 proved). Elsewhere the approximation of the root, inside the proved enclosure "
+    f"[growth_rate_lower, growth_rate_upper]. {_NOT_COMPUTED}",
+    fill=float("nan"),
+)
+GROWTH_RATE_LOWER = Variable(
+    "growth_rate_lower", "float32", "proved lower bound of growth_rate", units="s-1",
+    comment=f"rounded down to float32; inclusion disks or exact roots (growth_rate_method). {_NOT_COMPUTED}", fill=float("nan"))
+GROWTH_RATE_UPPER = Variable(
+    "growth_rate_upper", "float32", "proved upper bound of growth_rate", units="s-1",
+    comment=f"rounded up to float32; inclusion disks or exact roots (growth_rate_method). {_NOT_COMPUTED}", fill=float("nan"))
+EFOLDING_TIME = Variable(
+    "efolding_time",
+    "float32",
+    "e-folding time of the fastest growing perturbation, 1 / growth_rate",
+    units="s",
+    comment="+inf where growth_rate is 0 (every root real: no perturbation grows); the proved enclosure is "
+    f"[1 / growth_rate_upper, 1 / growth_rate_lower]. {_NOT_COMPUTED}",
+    fill=float("nan"),
+)
+GROWTH_RATE_METHOD = Variable(
+    "growth_rate_method",
+    "int8",
+    "how growth_rate and its bounds were obtained",
+    comment="all_roots_real: n_complex_pairs = 0 is proved, so the rate is exactly 0; "
+    "inclusion_disks: Braess-Hadeler inclusion disks around every root in double-double interval arithmetic; "
+    "exact_arb_roots: the exact rational polynomial's roots isolated by FLINT/Arb (where the disks were too wide); "
+    "not_computed: the point was inferred (--refine), not computed; a point proved over a box has its rate computed "
+    "at the node from its proved label; "
+    "degenerate: p is identically zero",
+    flags=((0, "all_roots_real"), (1, "inclusion_disks"), (2, "exact_arb_roots"), (3, "not_computed"), (4, "degenerate")),
+)
+FREQUENCY = Variable(
+    "frequency",
+    "float64",
+    "real part of each characteristic root: the frequency of its mode in the non-spinning frame",
+    units="rad s-1",
+    comment="every root of p(lambda) with multiplicity, ascending; a real root is a mode's frequency (lambda < 0: "
+    "prograde), a complex pair's two roots share their real part. For one top without liquid the two roots are the "
+    "nutation (larger |lambda|) and precession frequencies. NaN beyond the degree of p and where not computed "
+    "(inferred or degenerate points). Opt-in: the scene key frequencies = true",
+    dims=("root",),
+    fill=float("nan"),
+)
+FREQUENCY_RADIUS = Variable(
+    "frequency_radius",
+    "float64",
+    "proved radius around frequency",
+    units="rad s-1",
+    comment="the root lies within this distance of frequency + i Im(lambda) in the complex plane, so its real part "
+    "lies in [frequency - frequency_radius, frequency + frequency_radius]; where disks overlap, every root of the "
+    "group lies in each member's disk. Opt-in with frequency",
+    dims=("root",),
+    fill=float("nan"),
+)
+ROOT_KIND = Variable(
+    "root_kind",
+    "int8",
+    "what is proved about each characteristic root",
+    comment="real: proved real; complex: proved non-real (one of a conjugate pair); not_separated: its inclusion disks "
+    "meet the real axis without proving it real; none: padding beyond the degree of p, or not computed. Opt-in with frequency",
+    dims=("root",),
+    flags=((-1, "none"), (0, "real"), (1, "complex"), (2, "not_separated")),
+)
+GROWTH_VARIABLES = (GROWTH_RATE, GROWTH_RATE_LOWER, GROWTH_RATE_UPPER, EFOLDING_TIME, GROWTH_RATE_METHOD)
+FREQUENCY_VARIABLES = (FREQUENCY, FREQUENCY_RADIUS, ROOT_KIND)
+ALL_VARIABLES = VARIABLES + GROWTH_VARIABLES + FREQUENCY_VARIABLES

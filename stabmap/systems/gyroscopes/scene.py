@@ -27,7 +27,7 @@ from .topology import Topology
 SUPPORTS = ("fixed", "free")
 DEFAULT_G = 9.81
 _G_FREE = 'g: gravity exerts no torque about a free system\'s centre of mass and would be ignored; remove g or use support = "fixed"'
-_TOP_KEYS = {"title", "support", "g", "omega", "joints", "K_0", "M_alpha", "hold", "topology", "bodies", "grid"}
+_TOP_KEYS = {"title", "support", "g", "omega", "joints", "K_0", "M_alpha", "hold", "topology", "bodies", "grid", "growth_rate", "frequencies"}
 _TOPOLOGY_KEYS = {"parent", "at"}
 _BODY_KEYS = {"m", "A", "C", "c", "s", "omega", "fluid", "cavity"}
 _FLUID_KEYS = {"E", "kappa"}
@@ -74,6 +74,8 @@ class Scene(SceneBase):
     topology: Topology | None = None  # None: a chain
     M_alpha: float | None = None  # aerodynamic overturning moment on body 1 about its centre of mass [N m/rad]
     hold: Hold = field(default_factory=Hold)  # what the ratio axes (S_g, C_over_A_k, aspect_k) hold
+    growth_rate: bool = True  # store growth_rate and its kin per point (docs/rates.md)
+    frequencies: bool = False  # store every root's real part on a ``root`` dimension (docs/rates.md)
 
     def __post_init__(self):
         _validate(self)
@@ -152,6 +154,10 @@ class Scene(SceneBase):
         out["bodies"] = bodies
         if self.grid:
             out["grid"] = {a.name: a.to_dict() for a in self.grid}
+        if not self.growth_rate:
+            out["growth_rate"] = False
+        if self.frequencies:
+            out["frequencies"] = True
         return out
 
 
@@ -174,7 +180,7 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
     grid = parse_axes(data.get("grid", {}), lambda name: _axis_name(name, n, support, tree_flag).parameter)
     if support == "free" and "g" in data:
         raise StabmapError(_G_FREE)
-    scalars = {k: data[k] for k in ("support", "omega", "g", "K_0", "M_alpha", "title") if k in data}
+    scalars = {k: data[k] for k in ("support", "omega", "g", "K_0", "M_alpha", "title", "growth_rate", "frequencies") if k in data}
     if "hold" in data:
         scalars["hold"] = ratios.parse_hold(data["hold"])
     return Scene(bodies=bodies, joints=tuple(joints), grid=grid, topology=tree, **scalars)
@@ -236,6 +242,9 @@ def _validate(scene: Scene) -> None:
     put("bodies", tuple(_checked_body(b, k + 1, tree is not None) for k, b in enumerate(scene.bodies)))
     if not isinstance(scene.title, str):
         raise StabmapError(f"title must be a string, got {scene.title!r}")
+    for key in ("growth_rate", "frequencies"):
+        if not isinstance(getattr(scene, key), bool):
+            raise StabmapError(f"{key} must be true or false (whether the atlas stores it; docs/rates.md), got {getattr(scene, key)!r}")
     if scene.omega is not None:
         put("omega", check_value("omega", scene.omega, GLOBAL["omega"]))
     put("g", check_value("g", scene.g, GLOBAL["g"]))

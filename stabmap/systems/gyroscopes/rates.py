@@ -1,0 +1,148 @@
+"""Growth rates, e-folding times and mode frequencies of a block of points, with proved enclosures (docs/rates.md).
+
+The kernel ``roots_block`` encloses every root by inclusion disks; where they are too wide to bound the growth rate
+to ``REL`` (repeated or clustered roots) the point's exact rational polynomial is solved by FLINT/Arb instead
+(``growth_rate_method`` = exact_arb_roots says where, and so how often).  Labels are taken as given: a point whose
+N_c = 0 is proved has growth rate exactly 0, and no root of it is computed unless its frequencies are asked for.
+"""
+
+from __future__ import annotations
+
+import flint
+import numpy as np
+
+from ...kernels import NONREAL, REAL, roots_block
+from . import exact
+from .decide import kernel_args
+from .outputs import EFOLDING_TIME, FREQUENCY, FREQUENCY_RADIUS, GROWTH_RATE, GROWTH_RATE_LOWER, GROWTH_RATE_METHOD, GROWTH_RATE_UPPER, ROOT_KIND
+from .points import PointArrays
+
+REL = 1e-6  # a disk enclosure of the growth rate wider than this, relative, goes to exact arithmetic
+ALL_REAL, DISKS, EXACT, NOT_COMPUTED, DEGENERATE = (
+    GROWTH_RATE_METHOD.value(m) for m in ("all_roots_real", "inclusion_disks", "exact_arb_roots", "not_computed", "degenerate"))
+
+
+def rates(points: PointArrays, nc: np.ndarray, growth: bool = True, frequencies: bool = False) -> dict[str, np.ndarray]:
+    """The growth variables (``growth``) and the frequency variables (``frequencies``) of every point, flat.
+
+    ``nc``: the points' proved N_c (-1: p identically zero).  Frequencies are computed at every point, the growth
+    rate's roots only where N_c > 0.
+    """
+    nc = np.asarray(nc).reshape(-1)
+    npts, D = nc.size, int((points.nmodes + 2).sum())
+    lower, upper, best = (np.full(npts, np.nan) for _ in range(3))
+    method = np.full(npts, NOT_COMPUTED, dtype=np.int8)
+    method[nc < 0] = DEGENERATE
+    method[nc == 0] = ALL_REAL
+    lower[nc == 0] = upper[nc == 0] = best[nc == 0] = 0.0
+    freq, radius = np.full((npts, D), np.nan), np.full((npts, D), np.nan)
+    kind = np.full((npts, D), -1, dtype=np.int8)
+    todo = np.flatnonzero(nc >= 0 if frequencies else (nc > 0 if growth else np.zeros(npts, bool)))
+    if todo.size:
+        z, r, k, rate, status = _roots(_take(points, todo), D)
+        unstable = nc[todo] > 0
+        wide = (status != 0) | (unstable & ((rate[:, 1] <= 0.0) | (rate[:, 2] - rate[:, 1] > REL * rate[:, 2])))
+        for i in np.flatnonzero(wide):
+            z[i], r[i], k[i], rate[i] = exact_roots(points, todo[i], D)
+        k[~unstable] = np.where(k[~unstable] >= 0, REAL, -1)  # N_c = 0 is proved: every root is real
+        at = todo[unstable]
+        lower[at], upper[at], best[at] = rate[unstable, 1], rate[unstable, 2], rate[unstable, 0]
+        method[at] = np.where(wide[unstable], EXACT, DISKS)
+        order = np.argsort(z.real, axis=1)  # NaN (padding) last
+        freq[todo] = np.take_along_axis(z.real, order, 1)
+        radius[todo] = np.take_along_axis(r, order, 1)
+        kind[todo] = np.take_along_axis(k, order, 1)
+    out = {}
+    if growth:
+        lo32, hi32 = _outward(lower, upper)
+        rate32 = np.clip(best.astype(np.float32), lo32, hi32)
+        with np.errstate(divide="ignore"):
+            efold = np.where(rate32 == 0, np.float32(np.inf), np.float32(1) / rate32).astype(np.float32)
+        out.update({GROWTH_RATE.name: rate32, GROWTH_RATE_LOWER.name: lo32, GROWTH_RATE_UPPER.name: hi32,
+                    EFOLDING_TIME.name: efold, GROWTH_RATE_METHOD.name: method})
+    if frequencies:
+        out.update({FREQUENCY.name: freq, FREQUENCY_RADIUS.name: radius, ROOT_KIND.name: kind})
+    return out
+
+
+def not_computed(label: np.ndarray, proved: bool) -> dict[str, np.ndarray]:
+    """The rate variables of points not evaluated one by one: 0 where N_c = 0 is ``proved``, flagged NaN elsewhere
+    (inferred points; a box-proved node's NaN are then replaced by ``rates`` at the node: ``at_proved_nodes``).
+
+    The frequency variables come as (k, 1) columns of fill, which broadcast over the ``root`` dimension.
+    """
+    label = np.asarray(label).reshape(-1)
+    zero = (label == 0) if proved else np.zeros(label.shape, bool)
+    rate = np.where(zero, np.float32(0), np.float32(np.nan)).astype(np.float32)
+    method = np.where(zero, ALL_REAL, np.where(label < 0, DEGENERATE, NOT_COMPUTED)).astype(np.int8)
+    efold = np.where(zero, np.float32(np.inf), np.float32(np.nan)).astype(np.float32)
+    column = np.full((label.size, 1), np.nan)
+    return {GROWTH_RATE.name: rate, GROWTH_RATE_LOWER.name: rate.copy(), GROWTH_RATE_UPPER.name: rate.copy(),
+            EFOLDING_TIME.name: efold, GROWTH_RATE_METHOD.name: method,
+            FREQUENCY.name: column, FREQUENCY_RADIUS.name: column.copy(), ROOT_KIND.name: np.full((label.size, 1), -1, np.int8)}
+
+
+def exact_roots(points: PointArrays, p: int, D: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Roots of point ``p`` from its exact polynomial (FLINT/Arb): (centres, radii, kinds, (estimate, lower, upper)).
+
+    Arb isolates every root with certified error bounds and returns the real ones with an imaginary part that is
+    exactly zero, the others with one that excludes zero; the bounds below are its endpoints rounded outward.
+    """
+    z, r = np.full(D, complex(np.nan, np.nan)), np.full(D, np.nan)
+    k = np.full(D, -1, dtype=np.int8)
+    rate = np.zeros(3)
+    poly = exact.char_poly(points.body[p], points.joint[p], points.g[p], points.E[p], points.kappa[p], points.nmodes,
+                           points.free, points.parent, points.at[p])
+    if poly == 0:
+        return z, r, k, np.full(3, np.nan)
+    i = 0
+    for root, mult in poly.numer().complex_roots():
+        im = abs(root.imag)
+        for _ in range(mult):
+            z[i] = complex(float(root.real.mid()), float(root.imag.mid()))
+            # the arb radii, and the rounding of its midpoints to the floats stored
+            spill = (abs(root.real.mid()) + abs(root.imag.mid())) * flint.arb(2.0**-52)
+            r[i] = _up(flint.arb(root.real.rad()) + flint.arb(root.imag.rad()) + spill)
+            k[i] = REAL if root.imag.is_zero() else NONREAL
+            i += 1
+        rate[0] = max(rate[0], float(im.mid()))
+        rate[2] = max(rate[2], _up(im))
+        if not root.imag.is_zero():
+            rate[1] = max(rate[1], max(0.0, _down(im)))
+    return z, r, k, rate
+
+
+def _up(x: flint.arb) -> float:
+    return float(np.nextafter(float(x.upper()), np.inf))
+
+
+def _down(x: flint.arb) -> float:
+    return float(np.nextafter(float(x.lower()), -np.inf))
+
+
+def _outward(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """float32 bounds that hold the float64 ones: each rounded away from the enclosed value where float32 rounds in."""
+    lo, hi = lower.astype(np.float32), upper.astype(np.float32)
+    lo = np.where(lo.astype(np.float64) > lower, np.nextafter(lo, np.float32(-np.inf)), lo)
+    hi = np.where(hi.astype(np.float64) < upper, np.nextafter(hi, np.float32(np.inf)), hi)
+    return np.maximum(lo, np.float32(0)), hi
+
+
+def _roots(points: PointArrays, D: int):
+    npts = points.body.shape[0]
+    z = np.empty((npts, D), np.complex128)
+    r = np.empty((npts, D))
+    k = np.empty((npts, D), np.int8)
+    rate = np.empty((npts, 3))
+    status = np.empty(npts, np.int8)
+    roots_block(*kernel_args(points), z, r, k, rate, status)
+    return z, r, k, rate, status
+
+
+def _take(points: PointArrays, index: np.ndarray) -> PointArrays:
+    """The points ``index`` of a block, so that the kernel's reuse of the previous point's matrices stays valid."""
+    return PointArrays(points.body[index], points.joint[index], points.g[index], points.E[index], points.kappa[index], points.nmodes,
+                       points.free, points.parent, points.at[index])
+
+
+__all__ = ["rates", "not_computed", "exact_roots"]
