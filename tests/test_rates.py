@@ -277,3 +277,20 @@ def test_query_roots_cli(tmp_path, capsys):
     assert stabmap.open_atlas(path).stabmap.roots(omega=20.0).roots[0].kind == "real"
     assert main(["query", str(path), "--roots", "--fraction"]) == 2
     assert "one question at a time" in capsys.readouterr().err
+
+
+def test_info_gives_the_largest_growth_rate_and_queries_take_rpm(tmp_path, capsys):
+    path = tmp_path / "top.nc"
+    stabmap.write_atlas(stabmap.compute_atlas(top(), progress=False, threads=1), path)
+    # the grid's largest rate is at its slowest spin, |omega| = 0 being a grid value: sqrt(m c g / A') there
+    grid = np.linspace(-40.0, 40.0, 33)
+    want = max(float(mpmath.im(top_roots(w)[1])) for w in grid)
+    assert main(["info", str(path)]) == 0
+    line = next(s for s in capsys.readouterr().out.splitlines() if "growth rate:" in s)
+    shown = float(line.split("largest ")[1].split()[0])
+    assert abs(shown - want) <= 1e-5 * want
+    assert "all roots real" in line and "inclusion disks" in line
+    # a spin rate in rpm reaches the point itself: 5 rad/s = 150/pi rpm
+    assert main(["query", str(path), f"omega={5 * 60 / (2 * np.pi)!r} rpm", "--roots"]) == 0
+    z = top_roots(5.0)[1]
+    assert f"{float(mpmath.im(z)):.12g}i" in capsys.readouterr().out

@@ -129,6 +129,10 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
     lines += wrapped(f"{system.label} ({system.label_symbol}): ", [f"{meaning(k)}: {v}" for k, v in s[system.label].items()])
     if system.provenance in s:
         lines += wrapped("decided by: ", [f"{k.replace('_', ' ')} {v}" for k, v in s[system.provenance].items() if v])
+    if "growth_rate" in s:
+        g = s["growth_rate"]
+        top = "none grows" if not g["max"] > 0 else f"largest {g['max']:.6g} s-1 (proved <= {g['max_upper']:.6g})"
+        lines += wrapped("growth rate: ", [top, *(f"{m.replace('_', ' ')} {n}" for m, n in g["method"].items() if n)])
     if "cell" in s:
         share = s["cell_volume"]
         lines += wrapped("cells: ", [f"{m.replace('_', ' ')} {n}" for m, n in s["cell"].items() if n])

@@ -15,6 +15,7 @@ import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError
+from ..scene.units import in_si
 
 
 @dataclass(frozen=True)
@@ -38,7 +39,7 @@ class Roots:
         return max((r.growth_rate for r in self.roots), default=0.0)
 
     def text(self) -> str:
-        at = ", ".join(f"{k} = {v:g}{' ' + self.units[k] if self.units.get(k) else ''}" for k, v in self.point.items())
+        at = ", ".join(f"{k} = {v:g}{' ' + self.units[k] if self.units.get(k) not in (None, '', '1') else ''}" for k, v in self.point.items())
         lines = [f"{self.title}: roots of p(lambda) at {at} (computed at this point; solutions ~ exp(i lambda t))" if at else
                  f"{self.title}: roots of p(lambda) (solutions ~ exp(i lambda t))"]
         nc = self.n_complex_pairs
@@ -87,7 +88,7 @@ def roots(source, /, **point: float) -> Roots:
     values = {}
     for k, v in point.items():
         try:
-            values[k] = float(v)
+            values[k] = float(in_si(k, v, system.parameter(scene, k).units))  # "14000 rpm" -> rad/s
         except (TypeError, ValueError):
             raise StabmapError(f"{k} must be a number, got {v!r}") from None
     found = system.roots(scene, values)
