@@ -116,7 +116,7 @@ def test_critical_from_the_command_line_finds_the_hinge_boundary(tmp_path, capsy
 
 def test_the_critical_plot_draws_each_stretch_in_its_class_and_never_calls_absent_unstable():
     # Hinge along h2/h1: stable below sqrt 2, unstable to 2, degenerate at 2, no equilibrium above (docs/closed.md).
-    from stabmap.read.plot import _ABSENT, _STABLE, _UNSTABLE, critical_figure
+    from stabmap.read.plot import ABSENT_COLOUR, STABLE_COLOUR, UNSTABLE_COLOUR, critical_figure
     from stabmap.run.critical import critical
 
     scene = stabmap.loads_scene(HINGE)
@@ -129,9 +129,9 @@ def test_the_critical_plot_draws_each_stretch_in_its_class_and_never_calls_absen
         xs = np.concatenate([p.vertices[:, 0] for p in coll.get_paths()])
         spans[matplotlib.colors.to_hex(coll.get_facecolor()[0]).upper()] = (xs.min(), xs.max())
     lo, hi = (float(v) for v in ds.attrs["critical_scan_range"])
-    assert spans[_STABLE.upper()] == pytest.approx((lo, math.sqrt(2)), abs=1e-9)
-    assert spans[_UNSTABLE[0].upper()] == pytest.approx((math.sqrt(2), 2.0), abs=1e-9)
-    assert spans[_ABSENT.upper()] == pytest.approx((2.0, hi), abs=1e-9)  # white here means no equilibrium
+    assert spans[STABLE_COLOUR.upper()] == pytest.approx((lo, math.sqrt(2)), abs=1e-9)
+    assert spans[UNSTABLE_COLOUR[0].upper()] == pytest.approx((math.sqrt(2), 2.0), abs=1e-9)
+    assert spans[ABSENT_COLOUR.upper()] == pytest.approx((2.0, hi), abs=1e-9)  # white here means no equilibrium
     legend = [t.get_text() for t in fig.legends[0].get_texts()]
     assert "absent (no equilibrium)" in legend and "unstable" in legend
     assert "unstable" not in ax.get_title()  # no "white: unstable"

@@ -131,7 +131,7 @@ def test_closed_chain_flags_take_the_colours_of_their_meanings():
 
 def test_a_variable_without_classes_is_a_clear_error(dry):
     with pytest.raises(StabmapError, match=r"style\('stabilty'\): no such variable in this atlas; its class variables are: "
-                                           r"n_complex_pairs, stability, decided_by, cell"):
+                                           r"n_complex_pairs, stability, decided_by, growth_rate_method, cell"):
         dry.stabmap.style("stabilty")
     with pytest.raises(StabmapError, match=r"omega_bounds: stabmap's colours are for class variables.*ds.omega_bounds.plot\(\)"):
         dry.omega_bounds.stabmap.style()

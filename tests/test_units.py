@@ -52,9 +52,11 @@ def maievskii_stable(omega: float, c: float) -> bool:
 
 
 def exact_si(number: str, per_unit) -> float:
-    """``number`` times ``per_unit`` (an mpmath expression) rounded once to a double."""
+    """``number`` times ``per_unit`` rounded once to a double: ``per_unit`` is "rpm" or "Hz" (evaluated here at 50
+    digits, whatever mpmath's global precision another test module left), or an exact number."""
     with mp.workdps(50):
-        return float(mp.mpf(number) * per_unit)
+        factor = {"rpm": lambda: 2 * mp.pi / 60, "Hz": lambda: 2 * mp.pi}.get(per_unit, lambda: per_unit)()
+        return float(mp.mpf(number) * factor)
 
 
 # ------------------------------------------------------------------------------------------------ conversions
@@ -74,13 +76,13 @@ def test_scene_values_in_rpm_and_hz_are_stored_in_rad_per_s():
     text = TOP.format(start='"50 rpm"', stop='"200 rpm"').replace("c = 0.1\n", 'c = 0.1\ns = 0.3\nomega = "5 Hz"\n', 1)
     text = text.replace("[grid]", '[[bodies]]\nm = 1.0\nA = 0.02\nC = 0.03\nc = 0.1\n[grid]')
     s = loads_scene('omega = "14000 rpm"\n' + text)
-    assert s.omega == pytest.approx(exact_si("14000", 2 * mp.pi / 60), rel=2.3e-16)
-    assert s.bodies[0].omega == pytest.approx(exact_si("5", 2 * mp.pi), rel=2.3e-16)
+    assert s.omega == pytest.approx(exact_si("14000", "rpm"), rel=2.3e-16)
+    assert s.bodies[0].omega == pytest.approx(exact_si("5", "Hz"), rel=2.3e-16)
     assert s.bodies[1].omega is None
     omega = s.grid[0]
     assert (omega.display_units, omega.scale) == ("rpm", "linear")
-    assert omega.values[0] == pytest.approx(exact_si("50", 2 * mp.pi / 60), rel=2.3e-16)
-    assert omega.values[-1] == pytest.approx(exact_si("200", 2 * mp.pi / 60), rel=2.3e-16)
+    assert omega.values[0] == pytest.approx(exact_si("50", "rpm"), rel=2.3e-16)
+    assert omega.values[-1] == pytest.approx(exact_si("200", "rpm"), rel=2.3e-16)
     # the TOML written back holds rad/s and the display unit, and reads back to the same axis
     back = loads_scene(s.to_toml())
     assert back.grid == s.grid and back.omega == s.omega and back.bodies[0].omega == s.bodies[0].omega
@@ -90,7 +92,7 @@ def test_values_lists_and_hz_axes():
     s = loads_scene(TOP.format(start=0, stop=1, num=31).replace(
         "omega = { start = 0, stop = 1, num = 31 }", 'omega = { values = ["1 Hz", "2 Hz", "4 Hz"] }'))
     assert s.grid[0].display_units == "Hz" and s.grid[0].scale == "values"
-    np.testing.assert_allclose(s.grid[0].values, [exact_si(v, 2 * mp.pi) for v in "124"], rtol=2.3e-16)
+    np.testing.assert_allclose(s.grid[0].values, [exact_si(v, "Hz") for v in "124"], rtol=2.3e-16)
     plain = loads_scene(TOP.format(start='"5 rad/s"', stop='"20 rad/s"'))  # rad/s: the stored unit, nothing to show
     assert plain.grid[0].display_units == "" and plain.grid[0].values[0] == 5.0
 
@@ -99,8 +101,8 @@ def test_reactions_angular_velocity_in_rpm():
     text = resources.files("stabmap.examples").joinpath("reactions-spinning-stage.toml").read_text()
     s = loads_scene(text.replace("omega = [0.0, 0.0, 10.0]", 'omega = [0.0, 0.0, "600 rpm"]')
                     .replace("omega_z = { start = 0.0, stop = 30.0, num = 121 }", 'omega_z = { start = "0 Hz", stop = "4 Hz", num = 5 }'))
-    assert s.body.omega[2] == pytest.approx(exact_si("600", 2 * mp.pi / 60), rel=2.3e-16)
-    assert s.grid[0].display_units == "Hz" and s.grid[0].values[-1] == pytest.approx(exact_si("4", 2 * mp.pi), rel=2.3e-16)
+    assert s.body.omega[2] == pytest.approx(exact_si("600", "rpm"), rel=2.3e-16)
+    assert s.grid[0].display_units == "Hz" and s.grid[0].values[-1] == pytest.approx(exact_si("4", "Hz"), rel=2.3e-16)
 
 
 @pytest.mark.parametrize("change, message", [
@@ -160,15 +162,16 @@ def test_info_shows_the_axis_in_its_display_unit(rpm_file):
 def test_cli_queries_in_rpm(rpm_file, in_rpm, capsys):
     omega = in_rpm["omega"].values
     assert main(["query", str(rpm_file), "omega=110 rpm", "c_1=0.1"]) == 0
-    nearest = omega[np.argmin(np.abs(omega - exact_si("110", 2 * mp.pi / 60)))]
+    nearest = omega[np.argmin(np.abs(omega - exact_si("110", "rpm")))]
     out = capsys.readouterr().out
     assert f"nearest grid point {nearest:.8g} rad s-1" in out
     assert ("n_complex_pairs = 0" in out) == maievskii_stable(nearest, 0.1)
     # a range with one unit for both ends, and the same range with a unit on each
-    lo, hi = exact_si("100", 2 * mp.pi / 60), exact_si("2.5", 2 * mp.pi)
+    # (ends between grid values, 5 rpm apart: which side a grid value falls on does not hang on a rounding)
+    lo, hi = exact_si("102.5", "rpm"), exact_si("152.5", "rpm")
     inside = (omega >= lo) & (omega <= hi)
     stable = sum(maievskii_stable(w, c) for w in omega[inside] for c in C1)
-    for item in ("omega=100:150rpm", "omega=100 rpm:2.5 Hz"):
+    for item in ("omega=102.5:152.5rpm", "omega=102.5 rpm:2.5 Hz"):
         status = main(["query", str(rpm_file), "--fraction", item, "--json"])
         out, err = capsys.readouterr()
         if item.endswith("Hz"):

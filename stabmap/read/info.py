@@ -10,6 +10,7 @@ import xarray as xr
 from .. import systems
 from ..errors import StabmapError
 from ..scene import units
+from ..scene.units import unit_suffix
 from .summary import summary
 
 
@@ -19,12 +20,6 @@ WIDTH = 100  # characters a line of ``stabmap info`` may take
 def plural(n: int, word: str, many: str | None = None) -> str:
     """``1 point``, ``2 points`` (``many``: an irregular plural, ``body`` -> ``bodies``)."""
     return f"{n} {word if n == 1 else (many or word + 's')}"
-
-
-def unit_suffix(units) -> str:
-    """``" kg"`` after a number on the terminal; ``""`` for no units or the dimensionless CF ``"1"``."""
-    units = str(units or "")
-    return "" if units in ("", "1") else f" {units}"
 
 
 def wrapped(head: str, items: list[str], indent: str = "  ", width: int = WIDTH, whole: bool = False) -> list[str]:

@@ -45,18 +45,19 @@ from ..store.variables import CELL, INFERRED
 from .areas import AreaShares, area_shares
 from .blocks import block_factors, reduce_blocks
 from ..scene import units
-from .info import fixed_parameters, scene_notes, unit_suffix
+from ..scene.units import unit_suffix
+from .info import fixed_parameters, scene_notes
 
 MAX_PANELS = 12  # default limit of small multiples
 _LEGEND_WIDTH = 2.5  # [inch] beside small multiples
 
 # Okabe-Ito (colour-blind safe), then Paul Tol's muted colours: stable gets the calm blue, unstable counts get
 # warm colours in order of N_c, so a class has the same colour in every figure.
-_STABLE = "#56B4E9"
-_UNSTABLE = ["#F0E442", "#E69F00", "#D55E00", "#CC79A7", "#882255", "#332288", "#117733", "#44AA99", "#999933", "#AA4499"]
-_DEGENERATE = "#BBBBBB"
-_ABSENT = "#FFFFFF"  # nothing to decide (System.absent_label): left blank
-_UNDECIDED = "#707070"  # not proved (System.undecided_label): darker than degenerate, hatched like it
+STABLE_COLOUR = "#56B4E9"
+UNSTABLE_COLOUR = ["#F0E442", "#E69F00", "#D55E00", "#CC79A7", "#882255", "#332288", "#117733", "#44AA99", "#999933", "#AA4499"]
+DEGENERATE_COLOUR = "#BBBBBB"
+ABSENT_COLOUR = "#FFFFFF"  # nothing to decide (System.absent_label): left blank
+UNDECIDED_COLOUR = "#707070"  # not proved (System.undecided_label): darker than degenerate, hatched like it
 _BOUNDARY = "#000000"
 _CLASS_EDGE = "#333333"
 _HATCH_INFERRED = "////"
@@ -81,16 +82,16 @@ def colour(value: int, stable: int | None = 0, absent: int | None = None, undeci
     """The colour of the label ``value`` (``absent``: white; ``undecided``: dark grey; other negatives: degenerate;
     ``stable``: the stable class) in every figure."""
     if absent is not None and value == absent:
-        return _ABSENT
+        return ABSENT_COLOUR
     if undecided is not None and value == undecided:
-        return _UNDECIDED
+        return UNDECIDED_COLOUR
     if value < 0:
-        return _DEGENERATE
+        return DEGENERATE_COLOUR
     if stable is None:  # classes without a stable one (e.g. the critical node): one palette, blue first
-        return ([_STABLE] + _UNSTABLE)[value % (len(_UNSTABLE) + 1)]
+        return ([STABLE_COLOUR] + UNSTABLE_COLOUR)[value % (len(UNSTABLE_COLOUR) + 1)]
     if value == stable:
-        return _STABLE
-    return _UNSTABLE[(value - 1 if stable is not None and value > stable else value) % len(_UNSTABLE)]
+        return STABLE_COLOUR
+    return UNSTABLE_COLOUR[(value - 1 if stable is not None and value > stable else value) % len(UNSTABLE_COLOUR)]
 
 
 def class_label(value: int, system=None) -> str:

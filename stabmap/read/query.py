@@ -173,7 +173,7 @@ def _not_an_axis(ds: xr.Dataset, name: str, dims: list[str], role: str = "") -> 
 
 
 def _number(name: str, value, units: str = "") -> float:
-    if isinstance(value, str) and not _plain(value) and looks_like_rate(value):
+    if isinstance(value, str) and not is_plain_number(value) and looks_like_rate(value):
         value = in_si(name, value, units)  # a spin rate may carry its unit: "14000 rpm"
     try:
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, str, np.integer, np.floating)):
@@ -186,7 +186,7 @@ def _number(name: str, value, units: str = "") -> float:
     return value
 
 
-def _plain(text: str) -> bool:
+def is_plain_number(text: str) -> bool:
     try:
         float(text)
     except ValueError:
@@ -194,7 +194,7 @@ def _plain(text: str) -> bool:
     return True
 
 
-def _request(name: str, value, units: str = "") -> float | tuple[float | None, float | None]:
+def requested_value(name: str, value, units: str = "") -> float | tuple[float | None, float | None]:
     """A number, or a range (lo, hi) with lo <= hi (None: unbounded), from a user's value."""
     if isinstance(value, slice):
         if value.step is not None:
@@ -231,7 +231,7 @@ def select(ds: xr.Dataset, sel: dict, *, along: str | None = None) -> tuple[xr.D
         if name not in dims:
             raise _not_an_axis(ds, name, dims)
         units = str(ds[name].attrs.get("units", ""))
-        requested = _request(name, value, units)
+        requested = requested_value(name, value, units)
         grid = np.asarray(ds[name].values, dtype=np.float64)
         if isinstance(requested, tuple):
             lo, hi = requested
@@ -603,7 +603,7 @@ def _end(text: str, where: str) -> float | str | None:
     by the axis's units); an unknown unit a StabmapError naming ``where``, anything else a ValueError."""
     if not text:
         return None
-    if _plain(text):
+    if is_plain_number(text):
         return float(text)
     if not looks_like_rate(text):
         raise ValueError(text)

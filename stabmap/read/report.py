@@ -12,7 +12,7 @@ import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError
-from .info import unit_suffix
+from ..scene.units import unit_suffix
 from .query import CRITICAL_HINT, Label, StableFraction
 
 FORMATS = ("text", "csv", "json")
@@ -44,7 +44,7 @@ def render(result, fmt: str = "text", *, limit: int = 40, atlas: xr.Dataset | No
         head["rows"] = frame.to_dict(orient="records")
         if "undecided_lower" in result:
             head["undecided"] = [[float(a), float(b)] for a, b in zip(result["undecided_lower"].values, result["undecided_upper"].values)]
-        return _json(head)
+        return json_text(head)
     return (_boundaries_text if kind == "boundaries" else _smallest_text)(result, frame, limit)
 
 
@@ -95,7 +95,7 @@ def _value(v) -> str:
 
 
 def _label_record(label: Label) -> dict:
-    return {**label.grid_point, **{k: _plain(v) for k, v in label.values.items()}}
+    return {**label.grid_point, **{k: plain_value(v) for k, v in label.values.items()}}
 
 
 def _label_csv(label: Label, atlas) -> str:
@@ -103,7 +103,7 @@ def _label_csv(label: Label, atlas) -> str:
 
 
 def _label_json(label: Label, atlas) -> str:
-    return _json({
+    return json_text({
         "stabmap_query": "label_at", "requested": label.requested, "grid_point": label.grid_point,
         "outside": list(label.outside), **label.values, "inferred": label.inferred,
     })
@@ -149,7 +149,7 @@ def _fraction_json(f: StableFraction) -> str:
                "grid_lo": a.bounds[0], "grid_hi": a.bounds[1], "grid_values": len(a.values), "outside": a.outside}
         for name, a in f.axes.items()
     }
-    return _json(out)
+    return json_text(out)
 
 
 def _fixed_axes(result: xr.Dataset) -> list[str]:
@@ -175,7 +175,7 @@ def _frame(result: xr.Dataset):
     return frame[axes + [c for c in frame.columns if c not in axes]]
 
 
-def _g(v) -> str:
+def short_number(v) -> str:
     if isinstance(v, (bool, np.bool_)):
         return "yes" if v else "no"
     if isinstance(v, (float, np.floating)):
@@ -183,7 +183,7 @@ def _g(v) -> str:
     return str(v)
 
 
-def _table(header: list[str], rows: list[list[str]]) -> list[str]:
+def text_table(header: list[str], rows: list[list[str]]) -> list[str]:
     widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(header)]
     return ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in [header, *rows]]
 
@@ -193,7 +193,7 @@ def _head(result: xr.Dataset) -> list[str]:
     return lines
 
 
-def _more(n: int, limit: int) -> list[str]:
+def more_rows_line(n: int, limit: int) -> list[str]:
     return [f"... and {n - limit} more rows (--limit 0 shows all; --csv or --json for every row)"] if limit and n > limit else []
 
 
@@ -218,12 +218,12 @@ def _boundaries_text(b: xr.Dataset, frame, limit: int) -> str:
         nb = f"{r[lab + '_below']}" + ("*" if r["inferred_below"] else "")
         na = f"{r[lab + '_above']}" + ("*" if r["inferred_above"] else "")
         star |= bool(r["inferred_below"] or r["inferred_above"])
-        rows.append([_g(r[d]) for d in others] + [_g(r["boundary_lower"]), _g(r["boundary_upper"]), nb, na])
+        rows.append([short_number(r[d]) for d in others] + [short_number(r["boundary_lower"]), short_number(r["boundary_upper"]), nb, na])
     if rows:
-        lines += _table(header, rows)
+        lines += text_table(header, rows)
     else:
         lines.append(f"{sym} does not change between neighbouring grid values of {along} anywhere in this selection")
-    lines += _more(len(frame), limit)
+    lines += more_rows_line(len(frame), limit)
     if star:
         lines.append("* not computed: inferred from the agreeing corners of its grid cell (docs/refine.md)")
     if b.attrs.get("located"):
@@ -263,14 +263,14 @@ def _smallest_text(s: xr.Dataset, frame, limit: int) -> str:
         if np.isnan(r["smallest_stable"]):
             first, below, ncb = "none", "-", "-"
         else:
-            first = _g(r["smallest_stable"]) + ("*" if r["inferred"] else "")
-            below = _g(r["unstable_below"]) if not np.isnan(r["unstable_below"]) else "(scan start)"
+            first = short_number(r["smallest_stable"]) + ("*" if r["inferred"] else "")
+            below = short_number(r["unstable_below"]) if not np.isnan(r["unstable_below"]) else "(scan start)"
             below_label = r[lab + "_below"]
             ncb = f"{below_label}" + ("*" if r["inferred_below"] else "") if below_label != s.attrs["label_fill"] else "-"
         star |= bool(r["inferred"] or r["inferred_below"])
-        rows.append([_g(r[d]) for d in others] + [first, below, ncb, _g(r["stable_to_scan_end"]) if first != "none" else "-"])
-    lines += _table(header, rows)
-    lines += _more(len(frame), limit)
+        rows.append([short_number(r[d]) for d in others] + [first, below, ncb, short_number(r["stable_to_scan_end"]) if first != "none" else "-"])
+    lines += text_table(header, rows)
+    lines += more_rows_line(len(frame), limit)
     if star:
         lines.append("* not computed: inferred from the agreeing corners of its grid cell (docs/refine.md)")
     if s.attrs.get("located"):
@@ -289,13 +289,13 @@ def _smallest_text(s: xr.Dataset, frame, limit: int) -> str:
     return "\n".join(lines)
 
 
-def _plain(v):
+def plain_value(v):
     if isinstance(v, np.ndarray):  # a variable with dimensions beyond the grid's (e.g. reactions per node)
-        return _plain(v.tolist())
+        return plain_value(v.tolist())
     if isinstance(v, dict):
-        return {str(k): _plain(x) for k, x in v.items()}
+        return {str(k): plain_value(x) for k, x in v.items()}
     if isinstance(v, (list, tuple)):
-        return [_plain(x) for x in v]
+        return [plain_value(x) for x in v]
     if isinstance(v, (bool, np.bool_)):
         return bool(v)
     if isinstance(v, (int, np.integer)):
@@ -305,8 +305,8 @@ def _plain(v):
     return v
 
 
-def _json(obj) -> str:
-    return json.dumps(_plain(obj), indent=1)
+def json_text(obj) -> str:
+    return json.dumps(plain_value(obj), indent=1)
 
 
 def _csv(rows: list[dict]) -> str:

@@ -15,7 +15,7 @@ import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError
-from ..scene.units import in_si
+from ..scene.units import in_si, unit_suffix
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,7 @@ class Roots:
         return max((r.growth_rate for r in self.roots), default=0.0)
 
     def text(self) -> str:
-        at = ", ".join(f"{k} = {v:g}{' ' + self.units[k] if self.units.get(k) not in (None, '', '1') else ''}" for k, v in self.point.items())
+        at = ", ".join(f"{k} = {v:g}{unit_suffix(self.units.get(k))}" for k, v in self.point.items())
         lines = [f"{self.title}: roots of p(lambda) at {at} (computed at this point; solutions ~ exp(i lambda t))" if at else
                  f"{self.title}: roots of p(lambda) (solutions ~ exp(i lambda t))"]
         nc = self.n_complex_pairs

@@ -238,7 +238,7 @@ def critical_summary(ds: xr.Dataset) -> dict:
 def select_lines(ds: xr.Dataset, sel: dict) -> xr.Dataset:
     """The lines of a critical-values Dataset that ``sel`` selects: ``{axis: number}`` keeps the grid value nearest
     to it, ``{axis: (lo, hi)}`` (None: open) the grid values in [lo, hi]; every axis stays a dimension."""
-    from .query import _request
+    from .query import requested_value
 
     along = check_critical(ds, "a selection of critical values")
     dims = list(ds["n_stable_intervals"].dims)
@@ -247,7 +247,7 @@ def select_lines(ds: xr.Dataset, sel: dict) -> xr.Dataset:
         if name not in dims:
             what = "the scanned axis: every stable interval along it is listed" if name == along else "not a grid axis of this file"
             raise StabmapError(f"{name}: {what}; select the lines by their other axes: {', '.join(dims) or '(none: one line)'}")
-        requested = _request(name, value)
+        requested = requested_value(name, value)
         grid = np.asarray(ds[name].values, dtype=np.float64)
         if isinstance(requested, tuple):
             lo, hi = (-np.inf if requested[0] is None else requested[0]), (np.inf if requested[1] is None else requested[1])
@@ -267,7 +267,7 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
     CSV and JSON hold every row; their headers carry the units (``omega_lower [rad s-1]``), NaN and the fields that
     do not apply to a row are empty (JSON ``null``). ``limit`` caps the rows of the text (0: all).
     """
-    from .report import FORMATS, _g, _json, _more, _plain, _table
+    from .report import FORMATS, short_number, json_text, more_rows_line, plain_value, text_table
 
     if fmt not in FORMATS:
         raise StabmapError(f"format {fmt!r}: choose one of {', '.join(FORMATS)}")
@@ -281,10 +281,10 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
         return buf.getvalue().rstrip("\n")
     s = critical_summary(ds)
     if fmt == "json":
-        rows = [{k: (None if v is pd.NA else _plain(v)) for k, v in r.items()} for r in table.to_dict(orient="records")]
+        rows = [{k: (None if v is pd.NA else plain_value(v)) for k, v in r.items()} for r in table.to_dict(orient="records")]
         head = {"stabmap_query": "critical_values", "along": along, "along_units": s["units"], "label": lab,
                 "comment": ds.attrs.get("comment", ""), "units": {k: v for k, v in units.items() if v}, "rows": rows}
-        return _json(head)
+        return json_text(head)
     system = systems.of_atlas(ds.attrs)
     sym = system.label_symbol
     dims = [c for c in table.columns if c in ds.dims and c in ds.coords]
@@ -304,9 +304,9 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
         else:
             note = f"nothing stable from {s['scan_range'][0]:.8g} to {s['scan_range'][1]:.8g}"
         ends = [r[f"{along}_lower"], r[f"{along}_upper"]]
-        rows.append([_g(r[d]) for d in dims] + [kind.replace("_", " "), *(f"{v:.10g}" if v == v else "-" for v in ends), note])
-    lines += _table(header, rows) if rows else ["(no rows)"]
-    lines += _more(len(table), limit)
+        rows.append([short_number(r[d]) for d in dims] + [kind.replace("_", " "), *(f"{v:.10g}" if v == v else "-" for v in ends), note])
+    lines += text_table(header, rows) if rows else ["(no rows)"]
+    lines += more_rows_line(len(table), limit)
     lines.append("Stable ends are proved stable, and the boundary lies between each end and the proved-unstable value just "
                  f"outside it (--csv: {along}_lower_outer, {along}_upper_outer); a boundary row is that bracket (docs/critical.md).")
     return "\n".join(lines)

@@ -87,3 +87,9 @@ def check_display(where: str, unit) -> str:
         raise StabmapError(f"{where} = {unit!r}: a spin-rate axis is shown in rpm or Hz (or rad/s, the stored unit)")
     name = UNITS[unit.lower()][0]
     return "" if name == "rad/s" else name
+
+
+def unit_suffix(units) -> str:
+    """``" kg"`` after a number on the terminal; ``""`` for no units or the dimensionless CF ``"1"``."""
+    units = str(units or "")
+    return "" if units in ("", "1") else f" {units}"
