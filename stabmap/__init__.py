@@ -46,7 +46,7 @@ _API = {
     "smallest_stable": "stabmap.read.query",
     "stable_fraction": "stabmap.read.query",
     "summary": "stabmap.read.summary",
-    "write_atlas": "stabmap.store.subset",
+    "write_atlas": "stabmap.read.subset",
 }
 _MODULES = {"cavity": "stabmap.systems.gyroscopes.cavity", "closed": "stabmap.closed", "reactions": "stabmap.reactions"}
 

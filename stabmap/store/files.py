@@ -86,7 +86,7 @@ def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
 
     The data go to a temporary file in the same directory, renamed over
     ``path`` only when complete, so a failure or Ctrl-C never leaves a partial file.  ``ds`` is written as it is:
-    ``stabmap.write_atlas`` (``stabmap.store.subset.write_atlas``) also rewrites the stored scene of a part of
+    ``stabmap.write_atlas`` (``stabmap.read.subset.write_atlas``) also rewrites the stored scene of a part of
     an atlas (``ds.sel(...)``) to the part's grid.
     """
     path = check_writable(path)

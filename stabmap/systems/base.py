@@ -44,7 +44,7 @@ class SceneBase:
         raise NotImplementedError
 
     def with_grid(self, grid: tuple[Axis, ...]) -> "SceneBase":
-        """The same scene on ``grid`` (a subset of its own, ``store.subset``), with every choice this scene made from
+        """The same scene on ``grid`` (a subset of its own, ``read.subset``), with every choice this scene made from
         its grid kept as it is, so that each point is decided as before."""
         return replace(self, grid=tuple(grid))
 

@@ -22,7 +22,7 @@ from ..scene.grid import Axis, parse_axes
 from ..scene.text import parse
 from ..scene.values import Parameter
 from ..systems import loads_scene
-from . import files
+from ..store import files
 
 
 def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
