@@ -22,7 +22,7 @@ import numpy as np
 from . import dd
 from .block import LAPLACE_MAX
 from .charpoly import allocate, charpoly_point, same_structure
-from .inclusion import POLISH_SWEEPS, aberth, disk_radii, polish, snap_real, approximate, find_root
+from .inclusion import approximate, disk_radii, find_root
 from .options import kernel
 from .scaling import nonzero_span, rescale, root_scale
 
@@ -61,26 +61,20 @@ def roots_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_z, out_r
     R = np.empty(D)
     group = np.empty(D, np.int64)
     flags = np.empty(D, np.bool_)
-    # The previous point's approximations start the next point's iteration: neighbouring grid points have nearby
-    # roots, so a few sweeps replace Bini's start (they prove nothing either way; the disks do).
-    last = np.zeros(3, np.int64)  # (usable, degree, scale exponent) of the approximations left in z
+    # Every point starts from Bini's circles, not from its neighbour's roots: a warm start is faster, but a point's
+    # enclosure would then depend on which points shared its block, and a cluster's atlas (or a resumed one) would
+    # differ in the last bits from the local one.
     for p in range(npts):
         out_status[p] = ROOTS_FAILED
         if not laplace:
             continue
         charpoly_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, same_structure(body, joint, at, g, p))
-        out_status[p] = _point(c, X, a, z, R, group, flags, out_z[p], out_r[p], out_kind[p], out_rate[p], last)
+        out_status[p] = _point(c, X, a, z, R, group, flags, out_z[p], out_r[p], out_kind[p], out_rate[p])
 
 
 @kernel
-def _point(c, X, a, z, R, group, flags, oz, orad, okind, orate, last):
-    """One point's roots from its coefficient enclosure c (ascending, (hi, lo, rad)); see ``roots_block``.
-
-    ``last``: (usable, degree, scale exponent) of the approximations z holds on entry; updated on exit.
-    """
-    warm = last[0] == 1
-    last[0] = 0
-    D = c.shape[0] - 1
+def _point(c, X, a, z, R, group, flags, oz, orad, okind, orate):
+    """One point's roots from its coefficient enclosure c (ascending, (hi, lo, rad)); see ``roots_block``."""
     oz[:] = complex(np.nan, np.nan)
     orad[:] = np.nan
     okind[:] = -1
@@ -104,15 +98,6 @@ def _point(c, X, a, z, R, group, flags, oz, orad, okind, orate, last):
         R[0] = 0.0
         if not disk_radii(X, 1, z, R):
             return ROOTS_FAILED
-    elif warm and last[1] == d:
-        # float Aberth sweeps from the last roots; the double-double polish only where the disks overlap, and
-        # Bini's start where they still do (a warm start may just not have converged)
-        if not (_warm(X, d, a, z, flags, last[2] - shift) and disk_radii(X, d, z, R) and _separated(z, R, d)):
-            polish(X, d, z, POLISH_SWEEPS)
-            snap_real(X, d, z)
-            if not (disk_radii(X, d, z, R) and _separated(z, R, d)):
-                if not (approximate(X, d, a, z, flags) and disk_radii(X, d, z, R)):
-                    return ROOTS_FAILED
     elif not (approximate(X, d, a, z, flags) and disk_radii(X, d, z, R)):
         return ROOTS_FAILED
 
@@ -158,37 +143,4 @@ def _point(c, X, a, z, R, group, flags, oz, orad, okind, orate, last):
         if not meets:
             lower = max(lower, low_i)
     orate[0], orate[1], orate[2] = min(max(best, lower), upper), lower, upper
-    if d > 1:  # z now holds the roots in lambda itself (scale exponent 0): the next point may start from them
-        last[0], last[1], last[2] = 1, d, 0
     return ROOTS_OK
-
-
-@kernel
-def _separated(z, R, d):
-    """True if no two disks meet (the test of the grouping below)."""
-    for i in range(d):
-        for j in range(i + 1, d):
-            if abs(z[i] - z[j]) * (1.0 - 4.0 * dd.U) <= (R[i] + R[j]) * (1.0 + 2.0 * dd.U):
-                return False
-    return True
-
-
-@kernel
-def _warm(X, d, a, z, flags, e):
-    """``inclusion.approximate`` started from z times 2**e instead of Bini's circles, without its double-double
-    polish (well separated roots need none for their disks); False if that start fails."""
-    for k in range(d + 1):
-        a[k] = X[k, 0]
-    for i in range(d):
-        z[i] = complex(math.ldexp(z[i].real, e), math.ldexp(z[i].imag, e))
-        if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
-            return False
-        for j in range(i):
-            if z[i] == z[j]:  # Aberth's step divides by z_i - z_j
-                return False
-    aberth(a, d, z, flags)
-    for i in range(d):
-        if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
-            return False
-    snap_real(X, d, z)
-    return True
