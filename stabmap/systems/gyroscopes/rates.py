@@ -69,17 +69,18 @@ def not_computed(label: np.ndarray, proved: bool) -> dict[str, np.ndarray]:
     """The rate variables of points not evaluated one by one: 0 where N_c = 0 is ``proved``, flagged NaN elsewhere
     (inferred points; a box-proved node's NaN are then replaced by ``rates`` at the node: ``at_proved_nodes``).
 
-    The frequency variables come as (k, 1) columns of fill, which broadcast over the ``root`` dimension.
+    Each has the label's shape; the frequency variables come as the label's shape plus a last axis of 1, a fill that
+    broadcasts over the ``root`` dimension.
     """
-    label = np.asarray(label).reshape(-1)
+    label = np.asarray(label)
     zero = (label == 0) if proved else np.zeros(label.shape, bool)
     rate = np.where(zero, np.float32(0), np.float32(np.nan)).astype(np.float32)
     method = np.where(zero, ALL_REAL, np.where(label < 0, DEGENERATE, NOT_COMPUTED)).astype(np.int8)
     efold = np.where(zero, np.float32(np.inf), np.float32(np.nan)).astype(np.float32)
-    column = np.full((label.size, 1), np.nan)
+    column = np.full(label.shape + (1,), np.nan)
     return {GROWTH_RATE.name: rate, GROWTH_RATE_LOWER.name: rate.copy(), GROWTH_RATE_UPPER.name: rate.copy(),
             EFOLDING_TIME.name: efold, GROWTH_RATE_METHOD.name: method,
-            FREQUENCY.name: column, FREQUENCY_RADIUS.name: column.copy(), ROOT_KIND.name: np.full((label.size, 1), -1, np.int8)}
+            FREQUENCY.name: column, FREQUENCY_RADIUS.name: column.copy(), ROOT_KIND.name: np.full(label.shape + (1,), -1, np.int8)}
 
 
 def exact_roots(points: PointArrays, p: int, D: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
