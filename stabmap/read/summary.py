@@ -59,24 +59,23 @@ def summary(ds: xr.Dataset) -> dict:
         cells = _counts(ds[CELL.name].data)
         out[CELL.name] = {m: cells.get(v, 0) for v, m in CELL.flags}
         out["cell_volume"] = volume_shares(ds)
-    if "growth_rate" in ds and "growth_rate_method" in ds:
-        out["growth_rate"] = growth_rates(ds)
+    if "growth_rate" in ds:
+        out["growth_rate"] = growth_rates(ds, system)
     return out
 
 
-def growth_rates(ds: xr.Dataset) -> dict:
+def growth_rates(ds: xr.Dataset, system) -> dict:
     """The largest growth rate of the atlas with its proved upper bound, and how the rates were obtained (counts by
-    ``growth_rate_method``'s meanings); NaN points (inferred, degenerate) are left out of the maxima."""
-    from .blocks import as_dask, compute
-
+    ``growth_rate_method``'s meanings); NaN points (inferred, degenerate) are left out of the maxima.  The rate's
+    variables are written together (``System.outputs``)."""
     import dask.array as da
 
-    top, top_upper = compute(*(da.nanmax(as_dask(ds[k if k in ds else "growth_rate"].data)) for k in ("growth_rate", "growth_rate_upper")))
-    flags = ds["growth_rate_method"].attrs
-    values = np.atleast_1d(flags.get("flag_values", []))
-    meanings = str(flags.get("flag_meanings", "")).split()
+    from .blocks import as_dask, compute
+
+    top, top_upper = compute(*(da.nanmax(as_dask(ds[k].data)) for k in ("growth_rate", "growth_rate_upper")))
     by = _counts(ds["growth_rate_method"].data)
-    return {"max": float(top), "max_upper": float(top_upper), "method": {m: by.get(int(v), 0) for v, m in zip(values, meanings)}}
+    return {"max": float(top), "max_upper": float(top_upper),
+            "method": {m: by.get(v, 0) for v, m in system.variable("growth_rate_method").flags}}
 
 
 def cell_sizes(ds: xr.Dataset, dim: str) -> np.ndarray:

@@ -44,10 +44,7 @@ class BoxArrays:
     rat: np.ndarray  # (npts, n)
 
     def take(self, rows: np.ndarray) -> BoxArrays:
-        m = self.mid
-        mid = PointArrays(body=m.body[rows], joint=m.joint[rows], g=m.g[rows], E=m.E[rows], kappa=m.kappa[rows],
-                          nmodes=m.nmodes, free=m.free, parent=m.parent, at=m.at[rows])
-        return BoxArrays(mid, self.rbody[rows], self.rjoint[rows], self.rg[rows], self.rat[rows])
+        return BoxArrays(self.mid.take(rows), self.rbody[rows], self.rjoint[rows], self.rg[rows], self.rat[rows])
 
     def kernel_args(self):
         m = self.mid

@@ -42,6 +42,11 @@ class PointArrays:
     def kernel_args(self):
         return self.body, self.joint, self.g, self.E, self.kappa, self.nmodes, self.free, self.parent, self.at
 
+    def take(self, rows: np.ndarray) -> PointArrays:
+        """The points ``rows`` of this block, in that order (the per-point arrays indexed, the shared ones kept)."""
+        return PointArrays(self.body[rows], self.joint[rows], self.g[rows], self.E[rows], self.kappa[rows], self.nmodes,
+                           self.free, self.parent, self.at[rows])
+
 
 def chain_positions(body: np.ndarray) -> np.ndarray:
     """Joint positions ``at`` (..., n) of a chain from the bodies' s: at_k = s_{k-1}, at_0 = 0."""

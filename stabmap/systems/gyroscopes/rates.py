@@ -39,7 +39,7 @@ def rates(points: PointArrays, nc: np.ndarray, growth: bool = True, frequencies:
     kind = np.full((npts, D), -1, dtype=np.int8)
     todo = np.flatnonzero(nc >= 0 if frequencies else (nc > 0 if growth else np.zeros(npts, bool)))
     if todo.size:
-        z, r, k, rate, status = _roots(_take(points, todo), D)
+        z, r, k, rate, status = _roots(points.take(todo), D)
         unstable = nc[todo] > 0
         wide = (status != 0) | (unstable & ((rate[:, 1] <= 0.0) | (rate[:, 2] - rate[:, 1] > REL * rate[:, 2])))
         for i in np.flatnonzero(wide):
@@ -138,12 +138,6 @@ def _roots(points: PointArrays, D: int):
     status = np.empty(npts, np.int8)
     roots_block(*kernel_args(points), z, r, k, rate, status)
     return z, r, k, rate, status
-
-
-def _take(points: PointArrays, index: np.ndarray) -> PointArrays:
-    """The points ``index`` of a block, so that the kernel's reuse of the previous point's matrices stays valid."""
-    return PointArrays(points.body[index], points.joint[index], points.g[index], points.E[index], points.kappa[index], points.nmodes,
-                       points.free, points.parent, points.at[index])
 
 
 __all__ = ["rates", "not_computed", "exact_roots"]
