@@ -129,7 +129,7 @@ def _aberth_step(z, d, i, p, dp):
 
 
 @kernel
-def polish(X, d, z, sweeps):
+def _polish(X, d, z, sweeps):
     """Aberth sweeps with p and p' in double-double until no approximation moves by more than 2**-50 of itself.
 
     The float iteration resolves a cluster of k roots only to about u**(1/k) of
@@ -150,7 +150,7 @@ def polish(X, d, z, sweeps):
 
 
 @kernel
-def aberth(a, d, z, done):
+def _aberth(a, d, z, done):
     """Aberth-Ehrlich iteration on the float polynomial a (ascending, degree d), in place."""
     done[:d] = False
     for _ in range(MAX_ITER):
@@ -173,7 +173,7 @@ def aberth(a, d, z, done):
 
 
 @kernel
-def snap_real(X, d, z):
+def _snap_real(X, d, z):
     """Put approximations of simple real roots exactly on the real axis (then Newton-polish them).
 
     A disk can certify a real root only if its centre is real.  An approximation
@@ -253,12 +253,12 @@ def approximate(X, d, a, z, flags):
     if a[0] == 0.0 or a[d] == 0.0:
         return False
     _start(a, d, z)
-    aberth(a, d, z, flags)
+    _aberth(a, d, z, flags)
     for i in range(d):
         if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
             return False
-    polish(X, d, z, POLISH_SWEEPS)
-    snap_real(X, d, z)
+    _polish(X, d, z, POLISH_SWEEPS)
+    _snap_real(X, d, z)
     return True
 
 
