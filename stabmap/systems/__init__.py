@@ -18,6 +18,7 @@ SYSTEMS = {
     "gyroscopes": "stabmap.systems.gyroscopes",
     "closed": "stabmap.systems.closed",
     "reactions": "stabmap.systems.reactions",
+    "viscous": "stabmap.systems.viscous",
 }
 DEFAULT = "gyroscopes"  # scene files and atlases from before the ``system`` key
 

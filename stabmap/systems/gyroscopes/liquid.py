@@ -6,6 +6,10 @@ modes from ``stabmap.cavity``; their radius, half_height and density may be
 grid axes (``radius_k``, ``half_height_k``, ``density_k``). A table gives the
 modes directly. ``apply`` turns the cavity into the kernels' per-point E, kappa
 and body columns.
+
+A cavity with a ``viscosity`` holds a highly viscous liquid instead (docs/viscous.md): it has no modes, the
+liquid moves with the body to zeroth order, and its shape enters through Chernousko's tensor (``stokes``), or
+a table gives that tensor directly (``tensor = [P_t, P_a]``).
 """
 
 from __future__ import annotations
@@ -24,10 +28,12 @@ from . import cavity
 from .parameters import CAVITY
 
 _KEYS = {
-    "spheroid": {"shape", "radius", "half_height", "density", "modes", "mode_tolerance", "tail", "liquid_in_body", "centre"},
-    "cylinder": {"shape", "radius", "half_height", "density", "modes", "mode_tolerance", "tail", "liquid_in_body", "centre"},
-    "table": {"shape", "E", "kappa", "lambda_over_omega", "file", "inertia", "deficit"},
+    "spheroid": {"shape", "radius", "half_height", "density", "modes", "mode_tolerance", "tail", "liquid_in_body", "centre", "viscosity"},
+    "cylinder": {"shape", "radius", "half_height", "density", "modes", "mode_tolerance", "tail", "liquid_in_body", "centre", "viscosity"},
+    "table": {"shape", "E", "kappa", "lambda_over_omega", "file", "inertia", "deficit", "tensor", "radius", "density", "viscosity"},
 }
+_MODE_KEYS = {"modes", "mode_tolerance", "tail"}  # an ideal liquid's; a viscous one has no modes
+_TENSOR_KEYS = {"shape", "tensor", "radius", "density", "viscosity"}
 AUTO = "auto"
 # modes = "auto" keeps the fewest modes whose lumped tail is at most this share of the body's A at every grid point
 # (docs/cavities.md, "Choosing N"): 8 modes at the truncation study's worst aspect ratio (scripts/bench_truncation.py).
@@ -59,6 +65,8 @@ class Cavity:
     kappa: tuple[float, ...] = ()  # table
     inertia: float | None = None  # table: the frozen liquid's transverse inertia, bounds sum(E)
     deficit: float | None = None  # table: J_rigid - J_Zh; with it the tail is deficit - sum(E)
+    viscosity: float | None = None  # kinematic [m^2 s^-1]: a viscous liquid (docs/viscous.md); None: ideal
+    tensor: tuple[float, float] | None = None  # viscous table: Chernousko's (P_t, P_a) [m^7] given directly
     # Set by the scene from its grid (``choose``): the modes kept, and the largest tail / A and tail / sum(E) over the grid.
     kept: int = field(default=0, compare=False)
     tail_over_A: float = field(default=math.nan, compare=False, repr=False)
@@ -68,8 +76,19 @@ class Cavity:
     def geometric(self) -> bool:
         return self.shape != "table"
 
+    @property
+    def viscous(self) -> bool:
+        return self.viscosity is not None
+
     def to_dict(self) -> dict:
         """The ``cavity`` table of the body in a scene file."""
+        if self.viscous:
+            keys = ("shape", "radius", "half_height", "density", "viscosity", "liquid_in_body") if self.geometric else \
+                ("shape", "tensor", "radius", "density", "viscosity")
+            out = {k: list(v) if isinstance(v := getattr(self, k), tuple) else v for k in keys}
+            if self.geometric and not self.liquid_in_body:
+                out["centre"] = self.centre
+            return out
         if not self.geometric:
             out = {"shape": "table", "E": list(self.E), "kappa": list(self.kappa)}
             out.update({k: v for k in ("inertia", "deficit") if (v := getattr(self, k)) is not None})
@@ -92,12 +111,42 @@ def parse(raw, where: str, base_dir: Path | None) -> Cavity:
     unknown = sorted(set(raw) - _KEYS[shape])
     if unknown:
         raise StabmapError(f"{where}: unknown key {unknown[0]!r} for shape {shape!r}; allowed keys are {', '.join(sorted(_KEYS[shape]))}")
+    if "viscosity" in raw:
+        return _viscous(raw, where)
     if shape == "table":
+        if "tensor" in raw:
+            raise StabmapError(f"{where}.tensor is Chernousko's tensor of a viscous liquid; add viscosity [m2 s-1] and density, "
+                               "or give the ideal liquid's modes as E and kappa")
         return _table(raw, where, base_dir)
     for key in ("radius", "half_height", "density"):
         if key not in raw:
             raise StabmapError(f"{where}.{key} is missing [{CAVITY[key].units}]; a {shape} needs radius, half_height and density")
     return Cavity(**raw)
+
+
+def _viscous(raw: dict, where: str) -> Cavity:
+    """A cavity of viscous liquid: a spheroid or cylinder by its sizes, or a table of its tensor."""
+    shape = raw["shape"]
+    if shape == "table":
+        unknown = sorted(set(raw) - _TENSOR_KEYS)
+        if unknown:
+            raise StabmapError(f"{where}.{unknown[0]}: a viscous liquid has no modes; its table gives tensor = [P_t, P_a] [m7], "
+                               f"radius (its length for the Reynolds number), density and viscosity; remove {unknown[0]}")
+        need = ("tensor", "radius", "density")
+    else:
+        modes = sorted(set(raw) & _MODE_KEYS)
+        if modes:
+            raise StabmapError(f"{where}.{modes[0]}: a viscous liquid has no modes (it moves with the body to zeroth order, "
+                               f"docs/viscous.md); remove {modes[0]}, or remove viscosity for an ideal liquid")
+        need = ("radius", "half_height", "density")
+    for key in need:
+        if key not in raw:
+            units = "m7" if key == "tensor" else CAVITY[key].units
+            raise StabmapError(f"{where}.{key} is missing [{units}]; a viscous {shape} cavity needs {', '.join(need)} and viscosity")
+    values = dict(raw)
+    if "tensor" in values:
+        values["tensor"] = tuple(values["tensor"]) if isinstance(values["tensor"], list) else values["tensor"]
+    return Cavity(**values)
 
 
 def _table(raw: dict, where: str, base_dir: Path | None) -> Cavity:
@@ -133,6 +182,8 @@ def check(c: Cavity, where: str) -> Cavity:
         raise StabmapError(f"{where} must be a Cavity, got {c!r}")
     if c.shape not in _KEYS:
         raise StabmapError(f'{where}.shape must be "spheroid", "cylinder" or "table", got {c.shape!r}')
+    if c.viscous:
+        return _check_viscous(c, where)
     if not c.geometric:
         return _check_table(c, where)
     sizes = {key: check_value(f"{where}.{key}", getattr(c, key), CAVITY[key]) for key in ("radius", "half_height", "density")}
@@ -144,6 +195,28 @@ def check(c: Cavity, where: str) -> Cavity:
         raise StabmapError(f"{where}.centre is used only with liquid_in_body = false (the body's m, A, C, c already place the liquid); remove it")
     centre = check_value(f"{where}.centre", c.centre, CAVITY["centre"])
     return replace(c, modes=modes, mode_tolerance=tolerance, centre=centre, **sizes)
+
+
+def _check_viscous(c: Cavity, where: str) -> Cavity:
+    from .stokes import check_tensor
+
+    nu = check_value(f"{where}.viscosity", c.viscosity, CAVITY["viscosity"])
+    if c.E or c.kappa or (c.modes not in (None, 0)) or c.mode_tolerance is not None:
+        raise StabmapError(f"{where}: a viscous liquid has no modes (docs/viscous.md); remove modes, E and kappa, or remove viscosity")
+    keys = ("radius", "half_height", "density") if c.geometric else ("radius", "density")
+    sizes = {key: check_value(f"{where}.{key}", getattr(c, key), CAVITY[key]) for key in keys}
+    if c.geometric:
+        if not isinstance(c.liquid_in_body, bool):
+            raise StabmapError(f"{where}.liquid_in_body must be true or false, got {c.liquid_in_body!r}")
+        if c.centre and c.liquid_in_body:
+            raise StabmapError(f"{where}.centre is used only with liquid_in_body = false (the body's m, A, C, c already place the liquid); remove it")
+        centre = check_value(f"{where}.centre", c.centre, CAVITY["centre"])
+        return replace(c, viscosity=nu, modes=0, tail=False, centre=centre, **sizes)
+    if c.tensor is None:
+        raise StabmapError(f"{where}.tensor is missing [m7]: give Chernousko's tensor as [P_t, P_a]")
+    if not c.liquid_in_body:
+        raise StabmapError(f"{where}.liquid_in_body = false needs the cavity's shape and sizes; a tensor table's liquid is in m, A, C")
+    return replace(c, viscosity=nu, modes=0, tail=False, tensor=check_tensor(c.tensor, f"{where}.tensor"), **sizes)
 
 
 def _check_modes(c: Cavity, where: str) -> tuple[int | str, float | None]:
@@ -227,7 +300,7 @@ def _read_table(name, where: str, base_dir: Path | None) -> dict:
 
 
 def n_modes(c: Cavity | None) -> int:
-    if c is None:
+    if c is None or c.viscous:
         return 0
     if not c.geometric:
         return len(c.E)
@@ -278,6 +351,9 @@ def tolerance_of(c: Cavity) -> float:
 
 def describe(c: Cavity) -> str:
     """How many modes the cavity keeps and why, in one line (``stabmap info``)."""
+    if c.viscous:
+        what = f"{c.shape} cavity" if c.geometric else f"tensor table P_t = {c.tensor[0]:.4g}, P_a = {c.tensor[1]:.4g} m7"
+        return f"viscous liquid, {what}, \u03bd = {c.viscosity:g} m2 s-1 (no modes: the liquid moves with the body to zeroth order)"
     if not c.geometric:
         return f"table cavity, {len(c.E)} modes" + (", the rest lumped into A (deficit given)" if c.tail else "")
     n = n_modes(c)
@@ -366,6 +442,8 @@ def apply(c: Cavity, body: np.ndarray, sizes: dict[str, np.ndarray]):
     points. The tail is subtracted from A; a liquid not in the body is added to
     m, A, C and moves c.
     """
+    if c.viscous and not c.geometric:
+        return np.zeros(body.shape[:-1] + (0,)), np.ones(body.shape[:-1] + (0,))
     if not c.geometric:
         E = np.broadcast_to(np.array(c.E), body.shape[:-1] + (len(c.E),))
         kappa = np.broadcast_to(np.array(c.kappa), E.shape)
@@ -373,7 +451,7 @@ def apply(c: Cavity, body: np.ndarray, sizes: dict[str, np.ndarray]):
             body[..., 1] -= c.deficit - math.fsum(c.E)
         return E, kappa
     a, h, rho = sizes["radius"], sizes["half_height"], sizes["density"]
-    e, kappa, tail = scaled(c.shape, h / a, n_modes(c))
+    e, kappa, tail = (np.zeros(a.shape + (0,)), np.ones(a.shape + (0,)), 0.0) if c.viscous else scaled(c.shape, h / a, n_modes(c))
     unit = rho * a**5
     if not c.liquid_in_body:
         m_f = cavity.frozen_mass(c.shape, a, h, rho)
@@ -385,6 +463,6 @@ def apply(c: Cavity, body: np.ndarray, sizes: dict[str, np.ndarray]):
         body[..., 1] = A + m * (cm - new_c) ** 2 + J_f + m_f * (c.centre - new_c) ** 2
         body[..., 2] = C + Jz_f
         body[..., 3] = new_c
-    if c.tail:
+    if c.tail and not c.viscous:
         body[..., 1] -= unit * tail
     return unit[..., None] * e, kappa

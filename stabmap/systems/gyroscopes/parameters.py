@@ -29,11 +29,13 @@ CAVITY = {
     "radius": Parameter("a", "m", "radius (equatorial semi-axis) of the cavity of body {k}", 0.0, True),
     "half_height": Parameter("c", "m", "half height of the cavity of body {k} (half a cylinder's length, a spheroid's polar semi-axis)", 0.0, True),
     "density": Parameter("rho", "kg m-3", "density of the liquid in the cavity of body {k}", 0.0, True),
+    # a viscous liquid (docs/viscous.md): kinematic, as the Reynolds number omega a^2 / nu takes it
+    "viscosity": Parameter("nu", "m2 s-1", "kinematic viscosity of the liquid in the cavity of body {k}", 0.0, True),
     "centre": Parameter("z", "m", "height of the cavity centre above the lower joint of body {k}", None, False),
     "E": Parameter("E", "kg m2", "inertia coefficient of a liquid mode", 0.0, True),
     "kappa": Parameter("kappa", "1", "frequency parameter of a liquid mode", None, False),
 }
-SCANNABLE_CAVITY = ("radius", "half_height", "density")
+SCANNABLE_CAVITY = ("radius", "half_height", "density")  # the sizes that give an ideal cavity its modes
 EVERY_BODY = ("m", "A", "C", "c", "s")  # grid axes that set one parameter of every body at once (identical bodies)
 # A projectile (docs/projectile.md): an aerodynamic overturning moment on body 1 about a fixed point at its centre
 # of mass, and the gyroscopic stability factor it gives, S_g = C_1^2 omega_1^2 / (4 A_1 M_alpha).
@@ -51,7 +53,7 @@ GLOBAL = {
     "g": Parameter("g", "m s-2", "gravitational acceleration", None, False),
 }
 
-_NAME = re.compile(r"^(m|A|C|c|s|omega|K|at|radius|half_height|density|C_over_A|aspect)_(\d+)$")
+_NAME = re.compile(r"^(m|A|C|c|s|omega|K|at|radius|half_height|density|viscosity|C_over_A|aspect)_(\d+)$")
 
 
 @dataclass(frozen=True)
@@ -128,7 +130,7 @@ def parse_name(name: str, n_bodies: int, support: str) -> Name:
         raise StabmapError(
             f"unknown parameter name {name!r}; {did_you_mean(name, known)}scannable names are omega, g, "
             "m_k A_k C_k c_k s_k omega_k C_over_A_k (body k = 1..n), radius_k half_height_k density_k aspect_k "
-            "(the cavity of body k), K_k (joint k, K_0 the base), at_k (a tree's joint positions), M_alpha S_g "
+            "viscosity_k (the cavity of body k), K_k (joint k, K_0 the base), at_k (a tree's joint positions), M_alpha S_g "
             "(a projectile), and m A C c s K for every body or joint at once"
         )
     symbol, index = match.group(1), int(match.group(2))

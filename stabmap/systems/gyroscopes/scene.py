@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import ClassVar
 
 import numpy as np
 
@@ -61,8 +60,6 @@ class Scene(SceneBase):
     of body k + 1 with the body it is mounted on.
     """
 
-    system: ClassVar[str] = "gyroscopes"
-
     bodies: tuple[Body, ...]
     support: str = "fixed"
     omega: float | None = None
@@ -79,6 +76,15 @@ class Scene(SceneBase):
 
     def __post_init__(self):
         _validate(self)
+
+    @property
+    def system(self) -> str:
+        """A scene whose liquid is viscous belongs to the ``viscous`` system (docs/viscous.md): its label differs."""
+        return "viscous" if self.viscous else "gyroscopes"
+
+    @property
+    def viscous(self) -> bool:
+        return any(b.cavity is not None and b.cavity.viscous for b in self.bodies)
 
     @property
     def n(self) -> int:
@@ -271,6 +277,7 @@ def _validate(scene: Scene) -> None:
     check_axes(scene.grid, scene.parameter)
     ratios.check(scene)
     _check_omega(scene)
+    _check_one_liquid_model(scene)
     put("bodies", _check_cavities(scene))
 
 
@@ -327,6 +334,32 @@ def _check_omega(scene: Scene) -> None:
         raise StabmapError(f"omega is missing: set the common rate omega, bodies[{k}].omega, or scan omega in [grid]")
 
 
+def _check_one_liquid_model(scene: Scene) -> None:
+    """A scene is either ideal (modes) or viscous (Chernousko's first order): the two models do not combine."""
+    if not scene.viscous:
+        if any(a.name.startswith("viscosity_") for a in scene.grid):
+            axis = next(a.name for a in scene.grid if a.name.startswith("viscosity_"))
+            raise StabmapError(f"grid axis {axis!r}: body {axis.rpartition('_')[2]} has no viscous cavity; add viscosity to its cavity "
+                               "or remove the axis")
+        return
+    for k, b in enumerate(scene.bodies, start=1):
+        ideal = "fluid modes (E, kappa)" if b.E else "an ideal-liquid cavity (no viscosity)" if b.cavity is not None and not b.cavity.viscous else ""
+        if ideal:
+            raise StabmapError(
+                f"bodies[{k}] has {ideal} but another body's cavity holds a viscous liquid: one scene takes one liquid model "
+                f"(docs/viscous.md); give bodies[{k}].cavity a viscosity, or remove viscosity everywhere for the ideal model")
+    if scene.frequencies:
+        raise StabmapError("frequencies: a viscous scene stores the frequency of its slowest-decaying mode (variable frequency); "
+                           "remove frequencies = true")
+    names = {a.name for a in scene.grid}
+    for k, b in enumerate(scene.bodies, start=1):
+        if f"viscosity_{k}" in names and (b.cavity is None or not b.cavity.viscous):
+            raise StabmapError(f"grid axis 'viscosity_{k}': body {k} has no viscous cavity; add one or remove the axis")
+        if b.cavity is not None and not b.cavity.geometric and ({f"half_height_{k}", f"aspect_{k}"} & names):
+            raise StabmapError(f"grid axis of body {k}'s cavity size: its tensor is given as a table, so no size moves it; "
+                               "give the cavity's shape and sizes to scan them")
+
+
 def _check_cavities(scene: Scene) -> tuple[Body, ...]:
     """The bodies, each cavity checked against the grid and its number of modes chosen for it."""
     axes = {a.name: a.array for a in scene.grid}
@@ -335,7 +368,8 @@ def _check_cavities(scene: Scene) -> tuple[Body, ...]:
     for k, b in enumerate(scene.bodies, start=1):
         cav = b.cavity
         for key in SCANNABLE_CAVITY:
-            if f"{key}_{k}" in axes and (cav is None or not cav.geometric):
+            # a viscous table keeps its density and the radius of its Reynolds number scannable
+            if f"{key}_{k}" in axes and (cav is None or not cav.geometric) and not (cav is not None and cav.viscous and key != "half_height"):
                 raise StabmapError(
                     f"grid axis '{key}_{k}': body {k} has no spheroid or cylinder cavity to size; "
                     f'add bodies[{k}].cavity = {{ shape = "cylinder", ... }} or remove the axis'
@@ -349,7 +383,7 @@ def _check_cavities(scene: Scene) -> tuple[Body, ...]:
             values[key] = axes.get(f"{key}_{k}", axes.get(key, np.array([fixed])) if key in EVERY_BODY else np.array([fixed]))
         extremes = {key: (float(v.min()), float(v.max())) for key, v in values.items()}
         liquid.check_body(cav, f"bodies[{k}]", extremes)
-        if cav.geometric:
+        if cav.geometric and not cav.viscous:
             inertia = extremes["A"][0]
             if not cav.liquid_in_body:  # the engine adds the frozen liquid, at least its inertia at the smallest sizes
                 inertia += float(liquid.cavity.frozen_inertia(cav.shape, *(extremes[key][0] for key in SCANNABLE_CAVITY))[0])
@@ -376,9 +410,11 @@ def fixed_values(scene: Scene) -> dict[str, float]:
             out[f"at_{k}"] = scene.topology.at[k - 1]
         if b.omega is not None:
             out[f"omega_{k}"] = b.omega
-        if b.cavity is not None and b.cavity.geometric:
-            for key in SCANNABLE_CAVITY:
+        if b.cavity is not None and (b.cavity.geometric or b.cavity.viscous):
+            for key in SCANNABLE_CAVITY if b.cavity.geometric else ("radius", "density"):
                 out[f"{key}_{k}"] = getattr(b.cavity, key)
+            if b.cavity.viscous:
+                out[f"viscosity_{k}"] = b.cavity.viscosity
     if not scene.free and not ratios.projectile(scene):  # M_alpha takes the base joint's place
         out["K_0"] = scene.K_0
     if scene.M_alpha is not None and "M_alpha" not in names:
