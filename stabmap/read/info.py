@@ -116,7 +116,7 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
         degenerate = f", degenerate: {s['degenerate']}" if s["degenerate"] else ""
         absent = f", absent: {s['absent']}" if s["absent"] else ""
         undecided = f", undecided (not proved): {s['undecided']}" if s["undecided"] else ""
-        lines.append(f"  points: {s['points']}, stable: {s['stable']} ({100 * s['stable_fraction']:.2f} %)" + degenerate + absent + undecided)
+        lines.append(f"  points: {s['points']}, {system.stable_word}: {s['stable']} ({100 * s['stable_fraction']:.2f} %)" + degenerate + absent + undecided)
     else:
         lines.append(f"  points: {s['points']}")
     flags = system.variable(system.label).flags
@@ -126,8 +126,12 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
         lines += wrapped("decided by: ", [f"{k.replace('_', ' ')} {v}" for k, v in s[system.provenance].items() if v])
     if "growth_rate" in s:
         g = s["growth_rate"]
-        top = "none grows" if not g["max"] > 0 else f"largest {g['max']:.6g} s-1 (proved <= {g['max_upper']:.6g})"
+        top = f"largest {g['max']:.6g} s-1 (proved <= {g['max_upper']:.6g})"
+        if not g["max"] > 0:
+            top = "none grows" if g["max"] == 0 else f"every mode decays, the slowest at {g['max']:.6g} s-1 (proved <= {g['max_upper']:.6g})"
         lines += wrapped("growth rate: ", [top, *(f"{m.replace('_', ' ')} {n}" for m, n in g["method"].items() if n)])
+    for line in system.caveats(ds):
+        lines += textwrap.wrap(line, width=WIDTH, initial_indent="  ", subsequent_indent="    ")
     if "cell" in s:
         share = s["cell_volume"]
         lines += wrapped("cells: ", [f"{m.replace('_', ' ')} {n}" for m, n in s["cell"].items() if n])

@@ -654,7 +654,7 @@ def atlas_figure(
                 parts.append(_value_text(ds, plan.row, float(ds[plan.row][r])))
             if stable is not None:
                 parts.append(f"{100 * shares[n].stable:.0f} % of its area proved stable" if shares is not None  # as the title
-                             else f"{100 * blocks.counts.get(stable, 0) / sum(blocks.counts.values()):.0f} % stable")
+                             else f"{100 * blocks.counts.get(stable, 0) / sum(blocks.counts.values()):.0f} % {system.stable_word}")
                 two_lines = plan.row is not None or shares is not None  # the longer text of areas needs its own line
                 ax.set_title("\n".join([", ".join(parts[:-1]), parts[-1]]) if two_lines else f"{parts[0]}  ({parts[1]})", fontsize=9)
             else:  # a system without stability: the panel's coordinates only
@@ -758,7 +758,8 @@ def _title(
     if shares is not None:
         title.append(textwrap.fill(_area_text(shares, part), min(chars, 60)))  # narrower: clear of the legend beside it
     elif stable is not None:
-        title.append(f"{100 * stable / points:.1f} % of {'the ' if part else ''}{points:,} grid points{' shown' if part else ''} stable")
+        word = systems.of_atlas(ds.attrs).stable_word
+        title.append(f"{100 * stable / points:.1f} % of {'the ' if part else ''}{points:,} grid points{' shown' if part else ''} {word}")
     else:
         title.append(f"{points:,} grid points{' shown' if part else ''}")
     if plan.fixed:
@@ -809,15 +810,17 @@ def fixed_caption(ds: xr.Dataset, chars: int) -> str:
     def item(name: str, value: float, units: str) -> str:
         return f"{_symbol(ds, name)} = {value:.6g}" + (f" {_units(units)}" if _units(units) else "")
 
-    groups = fixed_parameters(ds, systems.of_atlas(ds.attrs), item)
+    system = systems.of_atlas(ds.attrs)
+    groups = fixed_parameters(ds, system, item)
+    caveats = [_fill_mathtext(c, chars) for c in system.caveats(ds)]  # e.g. where the model's assumptions fail
     if not groups:
-        return ""
+        return "\n".join(caveats)
     notes = scene_notes(ds.attrs)
     parts = []
     for head, items in groups:
         liquid = [re.sub(r"(?<= )(kg|m|s|rad)(-?\d+)\b", r"\1$^{\2}$", t) for t in notes.get(head, [])]
         parts.append((f"{head}: " if head else "") + ", ".join(items + liquid))
-    return _fill_mathtext("fixed: " + "; ".join(parts), chars)
+    return "\n".join([_fill_mathtext("fixed: " + "; ".join(parts), chars), *caveats])
 
 
 def _fill_mathtext(text: str, chars: int) -> str:

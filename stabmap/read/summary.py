@@ -73,6 +73,8 @@ def growth_rates(ds: xr.Dataset, system) -> dict:
     from .blocks import as_dask, compute
 
     top, top_upper = compute(*(da.nanmax(as_dask(ds[k].data)) for k in ("growth_rate", "growth_rate_upper")))
+    if "growth_rate_method" not in ds:  # a system whose provenance says how the rates were proved (viscous)
+        return {"max": float(top), "max_upper": float(top_upper), "method": {}}
     by = _counts(ds["growth_rate_method"].data)
     return {"max": float(top), "max_upper": float(top_upper),
             "method": {m: by.get(v, 0) for v, m in system.variable("growth_rate_method").flags}}

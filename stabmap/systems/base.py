@@ -87,6 +87,8 @@ class System:
         The (negative) label value of a point where there is nothing to decide, e.g. a family of equilibria
         that does not exist there; summaries count such points apart from the degenerate ones and figures
         leave them white. None: every point has something to decide.
+    stable_word : str
+        What a point of ``stable_label`` is called in titles and summaries (e.g. ``"asymptotically stable"``).
     undecided_label : int or None
         The (negative) label value of a point whose class was not proved (a system that proves its labels
         flags such points instead of guessing); summaries count them apart from the degenerate ones and figures
@@ -113,6 +115,7 @@ class System:
     absent_label: int | None = None
     undecided_label: int | None = None
     proves_labels: bool = True
+    stable_word: str = "stable"  # what ``stable_label`` is called in titles and summaries
     provenance: str | None = None
     symbols: dict[str, str] = {}
 
@@ -146,6 +149,11 @@ class System:
 
     def describe(self, attrs: dict) -> list[str]:
         """Lines that ``stabmap info`` prints about an atlas of this system, from its global attributes."""
+        return []
+
+    def caveats(self, ds) -> list[str]:
+        """What a reader of an atlas of this system must know beyond its counts, one sentence each, for ``stabmap info``
+        and figure captions: e.g. the share of the map where the model's assumptions fail.  Default: none."""
         return []
 
     def fixed_groups(self, names: list[str]) -> list[tuple[str, list[str]]]:

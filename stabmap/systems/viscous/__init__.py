@@ -46,6 +46,7 @@ class Viscous(Gyroscopes):
     label_title = "asymptotic stability"
     stable_label = ASYMPTOTIC_STABILITY.value("asymptotically_stable")
     undecided_label = UNDECIDED
+    stable_word = "asymptotically stable"
     provenance = "decided_by"
     symbols = {**Gyroscopes.symbols, "viscosity": r"\nu"}
     scene_module = _ViscousScenes
@@ -92,6 +93,18 @@ class Viscous(Gyroscopes):
         nan = np.full(label.shape, np.nan, dtype=np.float32)
         return {"decided_by": np.full(label.shape, BY["inferred_from_cell_corners"], dtype=np.int8), "reynolds": nan,
                 **{v.name: nan.copy() for v in GROWTH_VARIABLES}}
+
+    def caveats(self, ds) -> list[str]:
+        out = []
+        if "reynolds" in ds:
+            re_ = ds["reynolds"]
+            outside, total, top = (float(x) for x in ((re_ >= 1).sum(), re_.notnull().sum(), re_.max()))
+            if total:
+                out.append(f"first order in 1/Re (Chernousko): Re = \u03c9a\u00b2/\u03bd >= 1 at {100 * outside / total:.3g} % of the "
+                           f"points (largest Re {top:.3g}), where the model does not hold")
+        if ds.attrs.get("support") == "free":
+            out.append("free support: the \u03bb = 0 roots (tilts of the whole) are neutral; asymptotically stable means up to them")
+        return out
 
     def class_name(self, value: int) -> str:
         names = {-3: "undecided (not proved)", -1: "degenerate (p \u2261 0)", 0: "asymptotically stable", 1: "unstable"}
