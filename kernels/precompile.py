@@ -21,6 +21,7 @@ import numpy as np
 
 from . import options
 from .block import box_block, decide_block, linearise_block, nodes_box_block
+from .firstorder import first_order_block
 from .roots import roots_block
 
 
@@ -43,9 +44,12 @@ def signatures() -> list[tuple]:
     roots = args[:9] + (np.empty((npts, 2), np.complex128), np.empty((npts, 2)), np.empty((npts, 2), np.int8), np.empty((npts, 3)),
                         np.empty(npts, np.int8))
     linear = args[:9] + (np.empty((npts, 2, 2)),)
+    # first_order_block: the viscous cavities' bodies, eps and its radius, the roots of roots_block, and its outputs
+    first = args[:9] + (np.empty(1, np.int64), np.empty((npts, 1)), np.empty((npts, 1))) + roots[9:12] + (
+        np.empty((npts, 2)), np.empty((npts, 2)), np.empty((npts, 2), np.int8))
     return [(decide_block, tuple(numba.typeof(a) for a in args)), (box_block, tuple(numba.typeof(a) for a in box)),
             (nodes_box_block, tuple(numba.typeof(a) for a in nodes)), (roots_block, tuple(numba.typeof(a) for a in roots)),
-            (linearise_block, tuple(numba.typeof(a) for a in linear))]
+            (linearise_block, tuple(numba.typeof(a) for a in linear)), (first_order_block, tuple(numba.typeof(a) for a in first))]
 
 
 def precompile() -> dict:

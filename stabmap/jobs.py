@@ -129,7 +129,7 @@ def _no_checkpoint():
 def summary_line(system, s: dict, evaluated=None) -> str:
     """One line about a finished atlas: points, stable share, who decided, the saving of refinement."""
     if system.stable_label is not None:
-        line = f"{s['points']} points, {100 * s['stable_fraction']:.1f} % stable"
+        line = f"{s['points']} points, {100 * s['stable_fraction']:.1f} % {system.stable_word}"
     else:  # a system without stability: how often each class of its label occurs
         line = f"{s['points']} points; " + ", ".join(f"{system.class_name(v)}: {c}" for v, c in s[system.label].items())
     if system.provenance in s:

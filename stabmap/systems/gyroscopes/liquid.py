@@ -352,8 +352,8 @@ def tolerance_of(c: Cavity) -> float:
 def describe(c: Cavity) -> str:
     """How many modes the cavity keeps and why, in one line (``stabmap info``)."""
     if c.viscous:
-        what = f"{c.shape} cavity" if c.geometric else f"tensor table P_t = {c.tensor[0]:.4g}, P_a = {c.tensor[1]:.4g} m7"
-        return f"viscous liquid, {what}, \u03bd = {c.viscosity:g} m2 s-1 (no modes: the liquid moves with the body to zeroth order)"
+        what = f"a {c.shape}" if c.geometric else f"a tensor table (P_t = {c.tensor[0]:.4g} m7, P_a = {c.tensor[1]:.4g} m7)"
+        return f"viscous liquid in {what}: no modes, Chernousko's first order (docs/viscous.md)"
     if not c.geometric:
         return f"table cavity, {len(c.E)} modes" + (", the rest lumped into A (deficit given)" if c.tail else "")
     n = n_modes(c)

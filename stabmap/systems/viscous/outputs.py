@@ -33,8 +33,9 @@ DECIDED_BY = Variable(
     "FLINT/Arb; multiple_root, zero_rate, zero_root: undecided, because a root of the frozen chain is multiple, a growth "
     "rate's exact enclosure holds 0, or lambda = 0 is a root beyond the structural ones; degenerate: p is identically "
     f"zero; {INFERRED}: not computed (stabmap atlas --refine), the value on which its cell's corners agree",
-    flags=((0, "frozen_chain_unstable"), (1, "first_order_balls"), (2, "first_order_arb"), (3, "multiple_root"),
-           (4, "zero_rate"), (5, "zero_root"), (6, "degenerate"), (7, INFERRED)),
+    # INFERRED takes the gyroscopes' value, so that one number means "inferred" in both systems' atlases
+    flags=((0, "frozen_chain_unstable"), (1, "first_order_balls"), (2, "first_order_arb"), (3, INFERRED),
+           (4, "multiple_root"), (5, "zero_rate"), (6, "zero_root"), (7, "degenerate")),
 )
 GROWTH_RATE = Variable(
     "growth_rate",
