@@ -203,16 +203,17 @@ def examples(show):
 
 
 @cli.command(short_help="Recompute the source papers' results and check them: determinants, closed forms, figures.")
-@click.argument("systems", nargs=-1, metavar="[gyroscopes|closed|reactions]...")
+@click.argument("systems", nargs=-1, metavar="[gyroscopes|closed|reactions|viscous]...")
 @click.option("--out", metavar="DIR", help="write the figures to DIR/<system>/ (default: no figures)")
-@click.option("--quick", is_flag=True, help="gyroscopes: coarse grids (60 x 40) and 3 checked rows per case")
+@click.option("--quick", is_flag=True, help="gyroscopes: coarse grids (60 x 40) and 3 checked rows per case; viscous: 25 points per axis")
 @click.option("--case", "cases", multiple=True, metavar="NAME", help="gyroscopes: only this paper case (repeatable; e.g. paper-n1-fixed-dry)")
 @click.option("--rows", type=int, metavar="N", help="gyroscopes: rows checked per case (default 15, --quick 3)")
 def paper(systems, out, quick, cases, rows):
     """Recompute the papers' cases and check them; exit status 1 on any disagreement (docs/paper-cases.md).
 
     gyroscopes: the cases n = 1, 2, 3 against the printed determinants (exact arithmetic) and closed forms;
-    closed: the families' boundaries along h2/h1 against docs/closed.md; reactions: the square plate's G/4.
+    closed: the families' boundaries along h2/h1 against docs/closed.md; reactions: the square plate's G/4;
+    viscous: the cases n = 1, 2, 3 with a viscous liquid against the Kelvin-Tait-Chetaev criterion.
     """
     from . import paper as papers
 

@@ -260,3 +260,14 @@ def test_atlas_info_query_plot_critical_and_refine_on_a_viscous_scene(tmp_path, 
     assert main(["atlas", str(tmp_path / "top.toml"), "-o", str(tmp_path / "ref.nc"), "--refine", "--coarse-stride", "4"]) == 0
     ref, dense = stabmap.open_atlas(tmp_path / "ref.nc"), stabmap.open_atlas(tmp_path / "top.nc")
     assert np.array_equal(ref.asymptotic_stability.values, dense.asymptotic_stability.values)
+
+
+def test_paper_cases_with_a_viscous_liquid_agree_with_kelvin_tait_chetaev(capsys):
+    assert main(["paper", "viscous", "--quick"]) == 0
+    text = capsys.readouterr().out
+    assert "all agree with the papers" in text and "DISAGREES" not in text
+    rows = [line for line in text.splitlines() if line.startswith("| paper-")]
+    assert len(rows) == 14
+    # each row: | case | points | stable share | undecided | agree | disagree |
+    assert all(int(r.split("|")[6]) == 0 and int(r.split("|")[5]) > 500 for r in rows)
+    assert sum(float(r.split("|")[3].strip(" %")) > 10 for r in rows) >= 5  # both classes occur

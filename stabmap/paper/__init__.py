@@ -7,7 +7,9 @@ with the paper's printed determinants or closed forms, and draws its figures:
   (22), (28)-(32) in exact arithmetic and the closed forms (23), (24), (33), (34) and the split;
 - ``closed``: the hinge and six-body figure-eight families' boundaries along h2/h1, against docs/closed.md
   (docs/closed.md);
-- ``reactions``: the square plate's atlas against G/4 and the paper's closed form (docs/reactions.md).
+- ``reactions``: the square plate's atlas against G/4 and the paper's closed form (docs/reactions.md);
+- ``viscous``: the gyroscopes' cases n = 1, 2, 3 with a viscous liquid, against the Kelvin-Tait-Chetaev criterion
+  in exact arithmetic (docs/viscous.md).
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from pathlib import Path
 
 from ..errors import StabmapError
 
-SYSTEMS = ("gyroscopes", "closed", "reactions")
+SYSTEMS = ("gyroscopes", "closed", "reactions", "viscous")
 
 
 def check(systems=None, *, out: str | Path | None = None, quick: bool = False, cases=None, rows: int | None = None) -> dict:
@@ -49,6 +51,10 @@ def check(systems=None, *, out: str | Path | None = None, quick: bool = False, c
             from . import closed as paper_cases
 
             done = paper_cases.run(out=where)
+        elif name == "viscous":
+            from . import viscous as paper_cases
+
+            done = paper_cases.run(out=where, quick=quick)
         else:
             from . import reactions as paper_cases
 

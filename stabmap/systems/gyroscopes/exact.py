@@ -25,6 +25,14 @@ def char_poly(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=None
     The matrices come from Wittenburg's S and T (``topology``, docs/trees.md), not from
     the kernels' walk along each path.
     """
+    P, degree = char_matrix(body, joint, g, E, kappa, nmodes, free, parent, at)
+    # p has degree <= sum(2 + L_k): interpolate it from that many + 1 exact determinants.
+    return _interpolate([P(flint.fmpq(i)).det() for i in range(degree + 1)])
+
+
+def char_matrix(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=None):
+    """(P, degree): P(x) = diag(Q) Phi at lambda = x as a rational matrix (Phi itself, symmetric, without liquid
+    modes), and the degree bound of its determinant; arguments as for ``char_poly``."""
     n = len(body)
     parent = [k - 1 for k in range(n)] if parent is None else [int(p) for p in parent]
     at = [0.0] + [body[parent[k]][4] for k in range(1, n)] if at is None else at
@@ -83,8 +91,7 @@ def char_poly(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=None
                 out[k, j] = v
         return out
 
-    # p has degree <= sum(2 + L_k): interpolate it from that many + 1 exact determinants.
-    return _interpolate([P(flint.fmpq(i)).det() for i in range(degree + 1)])
+    return P, degree
 
 
 def _interpolate(ys: list) -> flint.fmpq_poly:

@@ -9,6 +9,8 @@ large spurious root that putting the viscous term into the polynomial would crea
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import flint
 import numpy as np
 
@@ -67,11 +69,27 @@ def structural_zeros(points: PointArrays) -> np.ndarray:
     lambda, whatever eps: the joint of body j is ideal (K_j = 0) and, on a fixed support, gravity is off (g = 0).
     A free system's column 0 is always zero (the rigid tilt of the whole).
     """
-    K = points.joint
-    ideal = (K == 0.0)
+    ideal = points.joint == 0.0
     if points.free:
         return 1 + ideal[:, 1:].sum(axis=1)
-    return np.where(points.g == 0.0, ideal.sum(axis=1), 0)
+    out = np.where(points.g == 0.0, ideal.sum(axis=1), 0)
+    for p in np.flatnonzero((points.g != 0.0) & ideal.any(axis=1)):  # gravity too: its first moments, exactly
+        out[p] = _gravity_free_columns(points.body[p], points.at[p], points.parent, ideal[p])
+    return out
+
+
+def _gravity_free_columns(body, at, parent, ideal) -> int:
+    """How many columns j of K T vanish on a fixed support with gravity: K_j = 0 and a_k = 0 exactly for every body
+    k beyond joint j, a_k = m_k c_k + sum over the bodies i mounted on k of at_i times the mass beyond i."""
+    n = len(parent)
+    beyond = [[k] for k in range(n)]  # the bodies whose path to the base passes body k (k included)
+    for k in range(n - 1, 0, -1):  # a regular numbering: children after their parents
+        beyond[parent[k]] += beyond[k]
+    mass = [sum((Fraction(body[i, 0]) for i in beyond[k]), Fraction(0)) for k in range(n)]
+    a = [Fraction(body[k, 0]) * Fraction(body[k, 3]) for k in range(n)]
+    for i in range(1, n):
+        a[parent[i]] += Fraction(at[i]) * mass[i]
+    return sum(1 for j in range(n) if ideal[j] and all(a[k] == 0 for k in beyond[j]))
 
 
 def evaluate(scene, values: dict) -> dict[str, np.ndarray]:
