@@ -1,0 +1,205 @@
+"""The viscous-liquid model (issue 31) against independent references (tests/viscous_reference.py).
+
+Part 1 checks the claimed model itself, Φ_ε(λ) = Φ(λ) − i diag(ε_k λ²(λ + ω_k)) and its first-order growth rate
+σ = −Σ_k ε_k λ₀²(λ₀ + ω_k) cof_kk(Φ(λ₀)) / p′(λ₀), against the vector equations of the heavy top and of the free
+body, a time integration, Chernousko's Stokes solution for the sphere and the full cubic eigenproblem. Part 2
+(at the end) checks stabmap's implementation of it, once stabmap.systems.viscous exists; it skips until then.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import mpmath as mp
+import numpy as np
+import pytest
+import sympy
+
+import reference as ref
+import viscous_reference as vr
+
+# A heavy top in SI units: m, A and C about the fixed point, liquid frozen. ω* = 7.0036 rad/s; Maievskii's
+# ω_M = 6.862 rad/s (below it the roots of p are complex already).
+TOP = dict(A=Fraction(3, 100), C=Fraction(5, 100), m=Fraction(1), g=Fraction(981, 100), c=Fraction(1, 10))
+
+
+def q(x):
+    """An exact Fraction as an mpf."""
+    x = Fraction(x)
+    return mp.mpf(x.numerator) / x.denominator
+
+
+def omega_star(A, C, m, g, c):
+    return mp.sqrt(q(m * g * c / (C - A)))
+
+
+# ---------------------------------------------------------------------------------------------------------
+# The sphere's tensor entry from the Stokes problem
+# ---------------------------------------------------------------------------------------------------------
+
+def test_sphere_tensor_is_the_stokes_solution():
+    """P = 8πa⁷/525: u = (r² − a²)/(10ν)(b × r) solves Stokes with the Euler force, and ρ∫ r × u = −(ρ/ν)P b."""
+    x, y, z, a, nu, rho, r, th, ph = sympy.symbols("x y z a nu rho r theta phi", positive=True)
+    b = sympy.Matrix(sympy.symbols("b1 b2 b3", real=True))
+    R = sympy.Matrix([x, y, z])
+    u = (x**2 + y**2 + z**2 - a**2) / (10 * nu) * b.cross(R)
+    lap = sympy.Matrix([sum(sympy.diff(ui, v, 2) for v in (x, y, z)) for ui in u])
+    # in the body frame at small Re: 0 = −∇p/ρ + ν∇²u − ω̇ × r, with p constant and ω̇ = b
+    assert sympy.simplify(nu * lap - b.cross(R)) == sympy.zeros(3, 1)
+    assert sympy.simplify(sum(sympy.diff(u[i], v) for i, v in enumerate((x, y, z)))) == 0
+    assert sympy.simplify(u.subs(z, sympy.sqrt(a**2 - x**2 - y**2))) == sympy.zeros(3, 1)
+    sph = {x: r * sympy.sin(th) * sympy.cos(ph), y: r * sympy.sin(th) * sympy.sin(ph), z: r * sympy.cos(th)}
+    L = (rho * R.cross(u)).subs(sph) * r**2 * sympy.sin(th)
+    L = L.applyfunc(lambda e: sympy.integrate(sympy.expand(e), (ph, 0, 2 * sympy.pi), (th, 0, sympy.pi), (r, 0, a)))
+    P = sympy.Rational(8, 525) * sympy.pi * a**7
+    assert sympy.simplify(L + rho / nu * P * b) == sympy.zeros(3, 1)
+    assert abs(vr.sphere_P(mp.mpf("0.03")) - mp.mpf(8) * mp.pi * mp.mpf("0.03") ** 7 / 525) < mp.mpf(10) ** -25
+
+
+# ---------------------------------------------------------------------------------------------------------
+# The vector top and the free body
+# ---------------------------------------------------------------------------------------------------------
+
+def test_vector_top_without_liquid_is_maievskii():
+    """At ε → 0 the vector top's exponents are s = ±iλ with A λ² + C ω λ + m g c = 0 (docs/model.md, n = 1)."""
+    A, C, m, g, c = TOP.values()
+    w = Fraction(12)
+    lam = sympy.Symbol("lam")
+    want = sorted(float(v) for v in sympy.solve(A * lam**2 + C * w * lam + m * g * c, lam))
+    eps = Fraction(1, 10**15)
+    rates = vr.vector_top_rates(A, C, m, g, c, w, eps, dps=60)
+    assert all(abs(r) < 1e-9 for r in rates)
+    s = vr._physical_exponents(A, C, m, g, c, w, eps, 60)
+    freqs = sorted({round(float(abs(mp.im(z))), 9) for z in s})
+    assert np.allclose(freqs, sorted(abs(v) for v in want), rtol=1e-12)
+
+
+@pytest.mark.parametrize("top", [TOP, dict(TOP, C=Fraction(9, 100), c=Fraction(2, 10))])
+def test_vector_top_criterion_around_omega_star(top):
+    """(C − A)ω² > m g c ⇔ every bounded mode decays: stable just above ω*, unstable just below (and far below)."""
+    ws = omega_star(**top)
+    eps = Fraction(1, 10**7)
+    for d in ("-0.3", "-0.05", "-0.001", "0.001", "0.05", "1", "5"):
+        w = ws * (1 + mp.mpf(d))
+        rates = vr.vector_top_rates(omega=w, eps=eps, **top)
+        stable = q(top["C"] - top["A"]) * w**2 > q(top["m"] * top["g"] * top["c"])
+        assert (max(rates) < 0) == stable, (d, rates)
+        assert stable == (mp.mpf(d) > 0)
+
+
+@pytest.mark.parametrize("c", [Fraction(-1, 10), Fraction(1, 10)])
+def test_vector_top_criterion_either_sign(c):
+    """The criterion in general: C < A is stable only hanging (c < 0) and slow, ω² < m g c/(C − A)."""
+    top = dict(TOP, A=Fraction(5, 100), C=Fraction(3, 100), c=c)
+    for w in (Fraction(2), Fraction(6), Fraction(7), Fraction(8), Fraction(30)):
+        rates = vr.vector_top_rates(omega=w, eps=Fraction(1, 10**7), **top)
+        stable = (top["C"] - top["A"]) * w**2 > top["m"] * top["g"] * top["c"]
+        assert (max(rates) < 0) == stable, (w, rates)
+    if c < 0:
+        assert (max(vr.vector_top_rates(omega=6, eps=Fraction(1, 10**7), **top)) < 0) != \
+               (max(vr.vector_top_rates(omega=8, eps=Fraction(1, 10**7), **top)) < 0)
+
+
+@pytest.mark.parametrize("w", [Fraction(7), Fraction(15, 2), Fraction(20), Fraction(-20), Fraction(60)])
+def test_vector_top_equals_the_claimed_cubic_and_first_order_rate(w):
+    """The vector top's bounded exponents are the roots of Φ_ε (n = 1) exactly, and σ/ε tends to the formula."""
+    A, C, m, g, c = TOP.values()
+    M, G, K = [[A]], [[C * w]], [[-m * g * c]]
+    first = sorted(s for _, s in vr.first_order_rates_mp(M, G, K, [w], [1]))
+    errs = []
+    for e in (Fraction(1, 10**6), Fraction(1, 10**7), Fraction(1, 10**8)):
+        vec = vr.vector_top_rates(A, C, m, g, c, w, e)
+        cubic = sorted(s for _, _, s in vr.chain_rates_mp(M, G, K, [w], [e]))
+        assert all(abs(p - q) < mp.mpf(10) ** -30 for p, q in zip(vec, cubic))
+        errs.append(max(abs(v / q(e) - f) / abs(f) for v, f in zip(vec, first)))
+    assert errs[2] < 1e-4 and errs[1] < 0.2 * errs[0] and errs[2] < 0.2 * errs[1], errs
+
+
+@pytest.mark.parametrize("A, C", [(Fraction(2, 100), Fraction(3, 100)), (Fraction(3, 100), Fraction(2, 100)),
+                                  (Fraction(5, 100), Fraction(49, 1000))])
+@pytest.mark.parametrize("w", [Fraction(10), Fraction(-35)])
+def test_free_body_major_axis_rule(A, C, w):
+    """A free body spinning about its symmetry axis: the tilt stays neutral, the nutation decays iff C > A.
+
+    The rate also equals the closed form of the claimed formula, σ = ε λ₀² (A − C)/(A C) at λ₀ = −Cω/A.
+    """
+    eps = Fraction(1, 10**8)
+    neutral, nut = sorted(vr.free_body_rate(A, C, w, eps), key=abs)
+    assert abs(neutral) < mp.mpf(10) ** -35
+    assert (nut < 0) == (C > A)
+    lam0 = -C * w / A
+    closed = lam0**2 * (A - C) / (A * C)
+    assert abs(nut / q(eps) - q(closed)) < 1e-4 * abs(float(closed))
+
+
+@pytest.mark.parametrize("args, t_span", [
+    ((1, Fraction(3, 2), 1, 1, 1, 3, Fraction(1, 100)), 80),          # stable: both modes decay
+    ((1, Fraction(3, 2), 1, 1, 1, Fraction(13, 10), Fraction(1, 100)), 20),  # between ω_M and ω*: one grows
+    ((Fraction(3, 2), 1, 1, 0, 0, 3, Fraction(1, 100)), 60),          # free body, C < A: the nutation grows
+])
+def test_time_integration_agrees_with_the_eigenvalues(args, t_span):
+    """solve_ivp on the linear vector ODE, rates fitted from the solution, equal the eigenvalues' rates."""
+    want = [float(v) for v in vr.vector_top_rates(*args)]
+    got = vr.integrate_top(*args, t_span)
+    assert np.allclose(got, want, rtol=1e-6, atol=1e-10), (got, want)
+    if args[3] == 0:
+        assert got[1] > 0 and want[0] == 0
+    else:
+        assert max(got) < 0 if args[5] == 3 else max(got) > 0
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Chains: the first-order formula against the full cubic problem
+# ---------------------------------------------------------------------------------------------------------
+
+BODIES = [dict(m=1, A=0.5, C=0.8, c=0.4, s=1.0), dict(m=0.7, A=0.3, C=0.5, c=0.3, s=0.8),
+          dict(m=0.5, A=0.2, C=0.35, c=0.25)]
+WEIGHTS = [1, Fraction(3, 5), Fraction(17, 10)]
+CHAINS = {
+    ("fixed", 2, "common"): [20, 20], ("fixed", 2, "distinct"): [30, 22],
+    ("fixed", 3, "common"): [20, 20, 20], ("fixed", 3, "distinct"): [30, 22, 40],
+    ("free", 2, "common"): [8, 8], ("free", 2, "distinct"): [15, -9],
+    ("free", 3, "common"): [8, 8, 8], ("free", 3, "distinct"): [5, -3, 7],
+}
+
+
+def chain(support, omegas):
+    bodies = [dict(BODIES[k], omega=omegas[k]) for k in range(len(omegas))]
+    joints = [6.0, 4.0][: len(omegas) - 1]
+    if support == "fixed":
+        return vr.fixed_chain_matrices(bodies, joints), bodies, joints
+    return vr.free_chain_matrices(bodies, joints), bodies, joints
+
+
+@pytest.mark.parametrize("key", list(CHAINS))
+def test_chain_matrices_agree_with_the_sympy_reference(key):
+    """The retyped M, G, K equal tests/reference.py's (another restatement of docs/model.md)."""
+    support, n, _ = key
+    (M, G, K), bodies, joints = chain(support, CHAINS[key])
+    bodies = [dict({"s": 0}, **b) for b in bodies]  # the top body's s is unused; the sympy reference wants a value
+    RM, RG, RK = ref.system_matrices(bodies, support, g=Fraction(981, 100) if support == "fixed" else 0, joints=joints)
+    for X, R in ((M, RM), (G, RG), (K, RK)):
+        assert all(sympy.Rational(X[i][j].numerator, X[i][j].denominator) == R[i, j] for i in range(n) for j in range(n))
+
+
+@pytest.mark.parametrize("key", list(CHAINS))
+def test_chain_rates_converge_to_the_first_order_formula(key):
+    """σ(ε)/ε of the cubic's bounded roots → the claimed σ, with error O(ε); free chains' λ = 0 stays neutral."""
+    support, n, _ = key
+    w = CHAINS[key]
+    (M, G, K), _, _ = chain(support, w)
+    first = vr.first_order_rates_mp(M, G, K, w, WEIGHTS[:n])
+    assert len(first) == 2 * n
+    errs = []
+    for e in (Fraction(1, 10**4), Fraction(1, 10**5), Fraction(1, 10**6)):
+        got = vr.chain_rates_mp(M, G, K, w, [e * q for q in WEIGHTS[:n]])
+        err = 0
+        for (lam0, s1), (r, lam, s) in zip(first, got):
+            assert abs(lam0 - r) < mp.mpf(10) ** -30
+            if abs(lam0) < mp.mpf(10) ** -30:  # the free chain's rigid tilt: exact zero for every ε
+                assert support == "free" and abs(lam) < mp.mpf(10) ** -30
+                continue
+            assert abs(s1) > 1e-3  # the comparison below is relative
+            err = max(err, abs(s / q(e) - s1) / abs(s1))
+        errs.append(err)
+    assert errs[2] < 1e-2 and errs[1] < 0.2 * errs[0] and errs[2] < 0.2 * errs[1], errs
