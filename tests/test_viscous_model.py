@@ -182,6 +182,40 @@ def test_chain_matrices_agree_with_the_sympy_reference(key):
         assert all(sympy.Rational(X[i][j].numerator, X[i][j].denominator) == R[i, j] for i in range(n) for j in range(n))
 
 
+@pytest.mark.parametrize("support, n, omegas, K0", [("fixed", 2, [30, 22], 3.0), ("fixed", 3, [30, 22, 40], 0),
+                                                    ("free", 2, [15, -9], 0), ("free", 3, [5, -3, 7], 0)])
+def test_newton_euler_chain_is_the_claimed_cubic(support, n, omegas, K0):
+    """The chain placed body by body in inertial axes (vector Newton–Euler, its own sympy derivation) has exactly
+    the exponents s = iλ, −iλ̄ of the claimed det Φ_ε(λ) = 0, the n spurious roots included: the liquid term is
+    diagonal, with each body's own ω_k, in fixed and free chains."""
+    bodies = [dict(BODIES[k], omega=omegas[k]) for k in range(n)]
+    joints = [6.0, 4.0][: n - 1]
+    eps = [Fraction(1, 100), Fraction(3, 500), Fraction(17, 1000)][:n]
+    g = Fraction(981, 100) if support == "fixed" else 0
+    if support == "fixed":
+        M, G, K = vr.fixed_chain_matrices(bodies, joints, g=g, K0=K0)
+    else:
+        M, G, K = vr.free_chain_matrices(bodies, joints)
+    with mp.workdps(40):
+        s = vr.vector_chain_exponents(bodies, joints, support, eps, g=g, K0=K0)
+        lam = vr.cubic_roots_mp(M, G, K, omegas, eps)
+        assert len(s) == 6 * n and len(lam) == 3 * n
+        for want in [1j * z for z in lam] + [-1j * mp.conj(z) for z in lam]:
+            j = min(range(len(s)), key=lambda i: abs(s[i] - want))
+            assert abs(s.pop(j) - want) <= mp.mpf(10) ** -30 * (1 + abs(want))
+
+
+def test_the_spurious_root_of_the_top():
+    """The singular perturbation's root: λ = −iA/ε + (C − A)ω/A + O(ε), a growth rate of +A/ε, to be left out."""
+    A, C, m, g, c = TOP.values()
+    w, e = Fraction(20), Fraction(1, 10**7)
+    lam = vr.cubic_roots_mp([[A]], [[C * w]], [[-m * g * c]], [w], [e])
+    with mp.workdps(40):
+        far = max(lam, key=abs)
+        assert abs(far - (-1j * q(A / e) + q((C - A) * w / A))) < 1e-2  # the O(ε) term is 1.4e-3 here
+        assert -mp.im(far) > 0
+
+
 @pytest.mark.parametrize("key", list(CHAINS))
 def test_chain_rates_converge_to_the_first_order_formula(key):
     """σ(ε)/ε of the cubic's bounded roots → the claimed σ, with error O(ε); free chains' λ = 0 stays neutral."""
@@ -203,3 +237,97 @@ def test_chain_rates_converge_to_the_first_order_formula(key):
             err = max(err, abs(s / q(e) - s1) / abs(s1))
         errs.append(err)
     assert errs[2] < 1e-2 and errs[1] < 0.2 * errs[0] and errs[2] < 0.2 * errs[1], errs
+
+
+# ---------------------------------------------------------------------------------------------------------
+# stabmap's implementation (stabmap.systems.viscous): skips until it is merged
+# ---------------------------------------------------------------------------------------------------------
+
+RHO, NU = 1000.0, 1e-3  # [kg m-3], [m2 s-1]: a glycerol-like liquid
+VISCOUS_SCENES = {
+    # one top (A about its centre of mass; about the fixed point 0.03): ω_M = 6.862, ω* = 7.0036 rad/s
+    "top": ("fixed", [dict(m=1.0, A=0.02, C=0.05, c=0.1)], [], [0.03],
+            [5.0, 6.9, 6.98, 7.03, 8.0, 12.0, 25.0, 60.0]),
+    # the rigid chain's roots turn real near 7.1 rad/s; the liquid destabilises it up to about 7.6 rad/s
+    "fixed2": ("fixed", [dict(m=1.0, A=0.02, C=0.1, c=0.1, s=0.25), dict(m=0.5, A=0.01, C=0.04, c=0.08)], [50.0],
+               [0.03, 0.025], [6.0, 7.25, 7.5, 8.0, 9.0, 15.0, 40.0, 120.0]),
+    # body 2 spins about its minor axis (C < A): stable while the joint holds it, unstable at high spin
+    "free2": ("free", [dict(m=1.0, A=0.02, C=0.05, c=0.1, s=0.25), dict(m=0.5, A=0.01, C=0.008, c=0.08)], [20.0],
+              [0.03, 0.025], [1.0, 5.0, 10.0, 20.0, 40.0, 60.0, 80.0, 160.0]),
+}
+
+
+def viscous_toml(support, bodies, joints, radii, omegas):
+    lines = ['title = "viscous reference"', f'support = "{support}"', "omega = 1.0"]
+    if support == "fixed":
+        lines.append("g = 9.81")
+    if joints:
+        lines.append(f"joints = [{', '.join(repr(k) for k in joints)}]")
+    for b, a in zip(bodies, radii):
+        lines.append("[[bodies]]")
+        lines += [f"{k} = {v!r}" for k, v in b.items()]
+        lines.append(f'cavity = {{ shape = "spheroid", radius = {a!r}, half_height = {a!r}, density = {RHO!r}, '
+                     f"viscosity = {NU!r} }}")
+    lines += ["[grid]", f"omega = {{ values = [{', '.join(repr(w) for w in omegas)}] }}"]
+    return "\n".join(lines) + "\n"
+
+
+def viscous_expected(support, bodies, joints, radii, w):
+    """(label, largest first-order rate or None) of one point, from the references alone.
+
+    Complex roots of det Φ: unstable at zeroth order (no rate compared). A free chain's λ = 0 roots are the
+    neutral rigid tilts: their rate is exactly 0 at every ε (chain_rates_mp) and they are left out.
+    """
+    bs = [dict(b, omega=w) for b in bodies]
+    build = vr.fixed_chain_matrices if support == "fixed" else vr.free_chain_matrices
+    M, G, K = build(bs, joints, g=9.81) if support == "fixed" else build(bs, joints)
+    eps = [RHO * vr.sphere_P(a) / NU for a in radii]
+    try:
+        rates = vr.first_order_rates_mp(M, G, K, [w] * len(bs), eps)
+    except ValueError:
+        return "unstable", None
+    top = max(s for lam0, s in rates if abs(lam0) > mp.mpf(10) ** -25)
+    return ("asymptotically_stable" if top < 0 else "unstable"), top
+
+
+@pytest.mark.parametrize("name", list(VISCOUS_SCENES))
+def test_reference_labels_span_the_cases(name):
+    """The scenes below are worth testing: each has both labels, and the top's follow the classical criterion."""
+    support, bodies, joints, radii, omegas = VISCOUS_SCENES[name]
+    labels = [viscous_expected(support, bodies, joints, radii, w)[0] for w in omegas]
+    assert {"asymptotically_stable", "unstable"} <= set(labels)
+    if name == "top":
+        b = bodies[0]
+        A_O = b["A"] + b["m"] * b["c"] ** 2
+        assert labels == ["asymptotically_stable" if (b["C"] - A_O) * w**2 > b["m"] * 9.81 * b["c"] else "unstable"
+                          for w in omegas]
+
+
+def _flag(da):
+    meanings = da.attrs["flag_meanings"].split()
+    values = [int(v) for v in np.atleast_1d(da.attrs["flag_values"])]
+    return [meanings[values.index(int(v))] for v in np.asarray(da.values).ravel()]
+
+
+@pytest.mark.parametrize("name", list(VISCOUS_SCENES))
+def test_stabmap_viscous_atlas_matches_the_references(name):
+    pytest.importorskip("stabmap.systems.viscous")
+    import stabmap
+
+    support, bodies, joints, radii, omegas = VISCOUS_SCENES[name]
+    ds = stabmap.compute_atlas(stabmap.loads_scene(viscous_toml(support, bodies, joints, radii, omegas)),
+                               progress=False, threads=1)
+    st = ds["asymptotic_stability"]
+    assert set(st.attrs["flag_meanings"].split()) == {"asymptotically_stable", "unstable", "undecided"}
+    assert list(ds["omega"].values) == omegas
+    labels = _flag(st)
+    rate, lo, hi = (np.asarray(ds[v].values, dtype=float).ravel()
+                    for v in ("growth_rate", "growth_rate_lower", "growth_rate_upper"))
+    for i, w in enumerate(omegas):
+        want, sigma = viscous_expected(support, bodies, joints, radii, w)
+        assert labels[i] == want, (w, labels[i], want)
+        if sigma is None:  # the rigid chain is already unstable: no first-order rate to compare
+            assert np.isnan(rate[i]) or rate[i] > 0
+            continue
+        assert abs(rate[i] - sigma) <= 1e-9 * abs(sigma), (w, rate[i], sigma)
+        assert lo[i] <= sigma <= hi[i], (w, lo[i], sigma, hi[i])

@@ -41,6 +41,9 @@ __all__ = [
     "vector_top_rates",
     "free_body_rate",
     "integrate_top",
+    "vector_chain_ode",
+    "vector_chain_exponents",
+    "cubic_roots_mp",
     "fixed_chain_matrices",
     "free_chain_matrices",
     "phi_eps",
@@ -240,6 +243,100 @@ def integrate_top(A, C, m, g, c, omega, eps, t_span, samples=4000, tilt=1e-3, me
     return sorted(float(np.real(np.log(u) / h)) for u in mu)
 
 
+@lru_cache(maxsize=None)
+def vector_chain_ode(n, support):
+    """Newton–Euler equations of a chain of n symmetric bodies with viscous cavities, linearised (sympy).
+
+    Independent of docs/model.md's M, G, K, J and of the claimed Φ_ε: every body is placed in inertial axes
+    (z up) by its axis e_k = (x_k, y_k, √(1 − x_k² − y_k²)): O_{k+1} = O_k + s_k e_k, centre of mass
+    r_k = O_k + c_k e_k. O_1 is the fixed point (``"fixed"``) or placed so that the centre of mass of the
+    system stays at the origin (``"free"``, no gravity). The force of body k−1 on body k at O_k is
+    R_k = Σ_{j≥k} m_j (r̈_j + g ẑ) (R_1 is the support's reaction; it vanishes for a free chain). Each body's
+    Euler equation about its own centre of mass:
+
+        d/dt(H_k + λ_k) = (O_k − r_k) × R_k − (O_{k+1} − r_k) × R_{k+1} + τ_k,
+
+    H_k = A_k (e_k × ė_k) + C_k ω_k e_k (A_k about the centre of mass), λ_k = −ε_k Ω̇_k⊥ as in
+    :func:`vector_top_ode`, and τ_k the elastic torques: joint j (stiffness K_j, potential K_j |e_{j+1} − e_j|²/2)
+    acts with K_j e_{j+1} × e_j on body j+1 and the opposite on body j; the base (K_0, potential
+    K_0 |e_1 − ẑ|²/2) with K_0 e_1 × ẑ on body 1.
+
+    Returns
+    -------
+    (B, symbols)
+        B = (B0, B1, B2, B3), 2n×2n sympy matrices with Σ_j B_j q⁽ʲ⁾ = 0, q = (x_1, y_1, …, x_n, y_n); symbols a
+        dict of the parameter symbols: m, A, C, c, s, omega, eps (lists of n), g, K (list of n−1), K0.
+    """
+    t, d = sympy.symbols("t delta", real=True)
+    S = {key: [sympy.Symbol(f"{key}{k + 1}", real=True) for k in range(n)]
+         for key in ("m", "A", "C", "c", "s", "omega", "eps")}
+    S["K"] = [sympy.Symbol(f"K{k + 1}", real=True) for k in range(n - 1)]
+    S["g"], S["K0"] = sympy.symbols("g K0", real=True)
+    g = S["g"] if support == "fixed" else 0
+    X = [(sympy.Function(f"x{k + 1}")(t), sympy.Function(f"y{k + 1}")(t)) for k in range(n)]
+    e = [sympy.Matrix([d * x, d * y, sympy.sqrt(1 - d**2 * (x**2 + y**2))]) for x, y in X]
+    zhat = sympy.Matrix([0, 0, 1])
+    O = [sympy.zeros(3, 1)]
+    for k in range(n):
+        O.append(O[k] + S["s"][k] * e[k])
+    r = [O[k] + S["c"][k] * e[k] for k in range(n)]
+    if support == "free":
+        shift = sum((S["m"][k] * r[k] for k in range(n)), sympy.zeros(3, 1)) / sum(S["m"])
+        O = [o - shift for o in O]
+        r = [p - shift for p in r]
+    acc = [p.diff(t, 2) for p in r]
+    R = [sum((S["m"][j] * (acc[j] + g * zhat) for j in range(k, n)), sympy.zeros(3, 1)) for k in range(n)]
+    R.append(sympy.zeros(3, 1))
+    tau = [sympy.zeros(3, 1) for _ in range(n)]
+    for j in range(n - 1):
+        tau[j + 1] += S["K"][j] * e[j + 1].cross(e[j])
+        tau[j] += S["K"][j] * e[j].cross(e[j + 1])
+    if support == "fixed":
+        tau[0] += S["K0"] * e[0].cross(zhat)
+    eqs = []
+    for k in range(n):
+        ed = e[k].diff(t)
+        W = e[k].cross(ed) + S["omega"][k] * e[k]
+        Wd = W.diff(t)
+        lam = -S["eps"][k] * (Wd - Wd.dot(e[k]) * e[k])
+        H = S["A"][k] * e[k].cross(ed) + S["C"][k] * S["omega"][k] * e[k]
+        rhs = (O[k] - r[k]).cross(R[k]) - (O[k + 1] - r[k]).cross(R[k + 1]) + tau[k]
+        eq = (H + lam).diff(t) - rhs
+        eqs += [eq[0], eq[1]]
+    lin = [sympy.expand(sympy.diff(q, d).subs(d, 0)) for q in eqs]
+    q = [v for pair in X for v in pair]
+    sym = [[sympy.Symbol(f"q{k}_{j}") for k in range(2 * n)] for j in range(4)]
+    for j in (3, 2, 1, 0):
+        for k in range(2 * n):
+            lin = [ex.subs(q[k].diff(t, j) if j else q[k], sym[j][k]) for ex in lin]
+    B = [sympy.Matrix(2 * n, 2 * n, lambda i, k: sympy.diff(lin[i], sym[j][k])) for j in range(4)]
+    for i in range(2 * n):
+        assert sympy.expand(lin[i] - sum(B[j][i, k] * sym[j][k] for j in range(4) for k in range(2 * n))) == 0
+    return tuple(B), S
+
+
+def vector_chain_exponents(bodies, joints, support, eps, g=0, K0=0, dps=40):
+    """All 6n exponents s (motions ∝ e^{st}) of :func:`vector_chain_ode` for the given numbers, in mpmath.
+
+    ``bodies``: dicts with m, A (about the centre of mass), C, c, s (the top body's may be left out), omega;
+    ``eps``: ε_k > 0 [kg m2 s]. Values are taken at their exact binary value.
+    """
+    n = len(bodies)
+    B, S = vector_chain_ode(n, support)
+    sub = {S["g"]: _exact(g), S["K0"]: _exact(K0)}
+    for k, b in enumerate(bodies):
+        for key in ("m", "A", "C", "c", "omega"):
+            sub[S[key][k]] = _exact(b[key])
+        sub[S["s"][k]] = _exact(b.get("s", 0))
+        sub[S["eps"][k]] = _exact(eps[k])
+    for k, Kk in enumerate(joints):
+        sub[S["K"][k]] = _exact(Kk)
+    with mp.workdps(dps):
+        Bm = [mp.matrix([[_mp_rational(Bj[i, k].xreplace(sub)) for k in range(2 * n)] for i in range(2 * n)])
+              for Bj in B]
+        return list(_companion_eigs(Bm))
+
+
 # ---------------------------------------------------------------------------------------------------------
 # 1c: chains, from docs/model.md retyped in fractions
 # ---------------------------------------------------------------------------------------------------------
@@ -343,6 +440,26 @@ def rigid_roots_mp(M, G, K, dps=40):
         return sorted(_companion_eigs([-_mpm(K), _mpm(G), _mpm(M)]), key=lambda z: (mp.re(z), mp.im(z)))
 
 
+def _cubic_coeffs(M, G, K, omega, eps):
+    n = len(M)
+    w = [_mpf(v) for v in omega]
+    e = [_mpf(v) for v in eps]
+    A2 = _mpm(M)
+    A3 = mp.zeros(n, n)
+    for k in range(n):
+        A2[k, k] -= 1j * e[k] * w[k]
+        A3[k, k] = -1j * e[k]
+    return [-_mpm(K), _mpm(G), A2, A3]
+
+
+def cubic_roots_mp(M, G, K, omega, eps, dps=40):
+    """All 3n roots of det Φ_ε(λ) (the claimed model), bounded and spurious, from the block companion."""
+    with mp.workdps(dps):
+        if any(_mpf(e) <= 0 for e in eps):
+            raise ValueError("every eps_k must be positive: the cubic's leading coefficient is -i diag(eps)")
+        return list(_companion_eigs(_cubic_coeffs(M, G, K, omega, eps)))
+
+
 def chain_rates_mp(M, G, K, omega, eps, dps=40):
     """The bounded roots of det Φ_ε = 0 (the full cubic problem) matched to the roots of det Φ.
 
@@ -360,18 +477,7 @@ def chain_rates_mp(M, G, K, omega, eps, dps=40):
     """
     n = len(M)
     with mp.workdps(dps):
-        if any(_mpf(e) <= 0 for e in eps):
-            raise ValueError("every eps_k must be positive: the cubic's leading coefficient is -i diag(eps)")
-        w = [_mpf(v) for v in omega]
-        e = [_mpf(v) for v in eps]
-        A0 = -_mpm(K)
-        A1 = _mpm(G)
-        A2 = _mpm(M)
-        A3 = mp.zeros(n, n)
-        for k in range(n):
-            A2[k, k] -= 1j * e[k] * w[k]
-            A3[k, k] = -1j * e[k]
-        cubic = list(_companion_eigs([A0, A1, A2, A3]))
+        cubic = cubic_roots_mp(M, G, K, omega, eps, dps)
         rigid = rigid_roots_mp(M, G, K, dps)
         out = []
         for r in rigid:
