@@ -340,3 +340,31 @@ def test_stabmap_viscous_atlas_matches_the_references(name):
         assert abs(float(ds["time_constant"].values[i]) * abs(sigma) - 1) <= rtol, w
         re = max(abs(w) * a * a / NU for a in radii)
         assert abs(float(ds["reynolds"].values[i]) - re) <= rtol * re
+
+
+def test_stabmap_viscous_top_at_its_exact_threshold():
+    """A top whose threshold is a double: ω* = 8 exactly (A about the fixed point 3/64, C = 1/16, m g c = 1).
+
+    The classical criterion, in exact rationals, decides every grid value down to 2⁻⁴⁰ from ω*, where the rate
+    is 2e-16 s⁻¹; at ω* itself λ₀ = −ω is a root of p and the liquid term λ²(λ + ω) vanishes there, so the
+    first-order rate is exactly 0 and no label may be claimed: undecided.
+    """
+    pytest.importorskip("stabmap.systems.viscous")
+    import stabmap
+
+    body = dict(m=1.0, A=0.03125, C=0.0625, c=0.125)
+    omegas = [7.5, 8 - 2**-20, 8 - 2**-40, 8.0, 8 + 2**-40, 8 + 2**-20, 8.5]
+    toml = viscous_toml("fixed", [body], [], [0.03], omegas).replace("g = 9.81", "g = 8.0")
+    ds = stabmap.compute_atlas(stabmap.loads_scene(toml), progress=False, threads=1)
+    labels = _flag(ds["asymptotic_stability"])
+    A_O = Fraction(body["A"]) + Fraction(body["m"]) * Fraction(body["c"]) ** 2
+    for i, w in enumerate(omegas):
+        margin = (Fraction(body["C"]) - A_O) * Fraction(w) ** 2 - Fraction(body["m"]) * 8 * Fraction(body["c"])
+        want = "undecided" if margin == 0 else ("asymptotically_stable" if margin > 0 else "unstable")
+        assert labels[i] == want, (w, labels[i], want)
+        if margin != 0:
+            M, G, K = vr.fixed_chain_matrices([dict(body, omega=w)], [], g=8.0)
+            sigma = max(s for _, s in vr.first_order_rates_mp(M, G, K, [w], [RHO * vr.sphere_P(0.03) / NU]))
+            assert (sigma > 0) == (margin < 0)
+            lo, hi = float(ds["growth_rate_lower"].values[i]), float(ds["growth_rate_upper"].values[i])
+            assert lo <= sigma <= hi, (w, lo, sigma, hi)
