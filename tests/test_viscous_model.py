@@ -182,15 +182,21 @@ def test_chain_matrices_agree_with_the_sympy_reference(key):
         assert all(sympy.Rational(X[i][j].numerator, X[i][j].denominator) == R[i, j] for i in range(n) for j in range(n))
 
 
-@pytest.mark.parametrize("support, n, omegas, K0", [("fixed", 2, [30, 22], 3.0), ("fixed", 3, [30, 22, 40], 0),
-                                                    ("free", 2, [15, -9], 0), ("free", 3, [5, -3, 7], 0)])
-def test_newton_euler_chain_is_the_claimed_cubic(support, n, omegas, K0):
+@pytest.mark.parametrize("support, n, omegas, K0, dry", [("fixed", 2, [30, 22], 3.0, None),
+                                                         ("fixed", 3, [30, 22, 40], 0, None),
+                                                         ("fixed", 3, [30, 22, 40], 0, 1),
+                                                         ("free", 2, [15, -9], 0, None),
+                                                         ("free", 3, [5, -3, 7], 0, None),
+                                                         ("free", 3, [5, -3, 7], 0, 0)])
+def test_newton_euler_chain_is_the_claimed_cubic(support, n, omegas, K0, dry):
     """The chain placed body by body in inertial axes (vector Newton–Euler, its own sympy derivation) has exactly
-    the exponents s = iλ, −iλ̄ of the claimed det Φ_ε(λ) = 0, the n spurious roots included: the liquid term is
-    diagonal, with each body's own ω_k, in fixed and free chains."""
+    the exponents s = iλ, −iλ̄ of the claimed det Φ_ε(λ) = 0, the spurious roots included: the liquid term is
+    diagonal, with each body's own ω_k, in fixed and free chains, also with a body without liquid (``dry``)."""
     bodies = [dict(BODIES[k], omega=omegas[k]) for k in range(n)]
     joints = [6.0, 4.0][: n - 1]
     eps = [Fraction(1, 100), Fraction(3, 500), Fraction(17, 1000)][:n]
+    if dry is not None:
+        eps[dry] = 0
     g = Fraction(981, 100) if support == "fixed" else 0
     if support == "fixed":
         M, G, K = vr.fixed_chain_matrices(bodies, joints, g=g, K0=K0)
@@ -199,10 +205,26 @@ def test_newton_euler_chain_is_the_claimed_cubic(support, n, omegas, K0):
     with mp.workdps(40):
         s = vr.vector_chain_exponents(bodies, joints, support, eps, g=g, K0=K0)
         lam = vr.cubic_roots_mp(M, G, K, omegas, eps)
-        assert len(s) == 6 * n and len(lam) == 3 * n
+        assert len(s) == 2 * len(lam) == 2 * (2 * n + sum(1 for e in eps if e))
         for want in [1j * z for z in lam] + [-1j * mp.conj(z) for z in lam]:
             j = min(range(len(s)), key=lambda i: abs(s[i] - want))
             assert abs(s.pop(j) - want) <= mp.mpf(10) ** -30 * (1 + abs(want))
+
+
+@pytest.mark.parametrize("support, omegas, dry", [("fixed", [30, 22, 40], 1), ("free", [5, -3, 7], 0)])
+def test_chain_with_a_dry_body_converges_to_the_first_order_formula(support, omegas, dry):
+    """A body without liquid (ε_k = 0): one spurious root fewer, and σ(ε)/ε still tends to the formula."""
+    (M, G, K), _, _ = chain(support, omegas)
+    weights = list(WEIGHTS)
+    weights[dry] = 0
+    first = vr.first_order_rates_mp(M, G, K, omegas, weights)
+    errs = []
+    for e in (Fraction(1, 10**4), Fraction(1, 10**5), Fraction(1, 10**6)):
+        got = vr.chain_rates_mp(M, G, K, omegas, [e * w for w in weights])
+        errs.append(max(abs(s / q(e) - s1) / abs(s1) for (lam0, s1), (_, _, s) in zip(first, got)
+                        if abs(lam0) > mp.mpf(10) ** -30))
+        assert len(vr.cubic_roots_mp(M, G, K, omegas, [e * w for w in weights])) == 2 * 3 + 2
+    assert errs[2] < 1e-2 and errs[1] < 0.2 * errs[0] and errs[2] < 0.2 * errs[1], errs
 
 
 def test_the_spurious_root_of_the_top():
@@ -252,6 +274,9 @@ VISCOUS_SCENES = {
     "fixed2": ("fixed", [dict(m=1.0, A=0.02, C=0.1, c=0.1, s=0.25), dict(m=0.5, A=0.01, C=0.04, c=0.08)], [50.0],
                [0.03, 0.025], [6.0, 7.25, 7.5, 8.0, 9.0, 15.0, 40.0, 120.0]),
     # body 2 spins about its minor axis (C < A): stable while the joint holds it, unstable at high spin
+    # the same chain with a dry upper body (no cavity: ε_2 = 0)
+    "fixed2_dry": ("fixed", [dict(m=1.0, A=0.02, C=0.1, c=0.1, s=0.25), dict(m=0.5, A=0.01, C=0.04, c=0.08)], [50.0],
+                   [0.03, None], [6.0, 7.25, 7.5, 8.0, 9.0, 15.0, 40.0, 120.0]),
     "free2": ("free", [dict(m=1.0, A=0.02, C=0.05, c=0.1, s=0.25), dict(m=0.5, A=0.01, C=0.008, c=0.08)], [20.0],
               [0.03, 0.025], [1.0, 5.0, 10.0, 20.0, 40.0, 60.0, 80.0, 160.0]),
 }
@@ -266,8 +291,9 @@ def viscous_toml(support, bodies, joints, radii, omegas):
     for b, a in zip(bodies, radii):
         lines.append("[[bodies]]")
         lines += [f"{k} = {v!r}" for k, v in b.items()]
-        lines.append(f'cavity = {{ shape = "spheroid", radius = {a!r}, half_height = {a!r}, density = {RHO!r}, '
-                     f"viscosity = {NU!r} }}")
+        if a is not None:
+            lines.append(f'cavity = {{ shape = "spheroid", radius = {a!r}, half_height = {a!r}, density = {RHO!r}, '
+                         f"viscosity = {NU!r} }}")
     lines += ["[grid]", f"omega = {{ values = [{', '.join(repr(w) for w in omegas)}] }}"]
     return "\n".join(lines) + "\n"
 
@@ -283,7 +309,7 @@ def viscous_expected(support, bodies, joints, radii, w):
     bs = [dict(b, omega=w) for b in bodies]
     build = vr.fixed_chain_matrices if support == "fixed" else vr.free_chain_matrices
     M, G, K = build(bs, joints, g=9.81) if support == "fixed" else build(bs, joints)
-    eps = [RHO * vr.sphere_P(a) / NU for a in radii]
+    eps = [0 if a is None else RHO * vr.sphere_P(a) / NU for a in radii]
     try:
         rates = vr.first_order_rates_mp(M, G, K, [w] * len(bs), eps)
     except ValueError:
@@ -338,7 +364,7 @@ def test_stabmap_viscous_atlas_matches_the_references(name):
             f = float(ds["frequency"].values[i])
             assert abs(f - freq) <= rtol * abs(freq), (w, f, freq)
         assert abs(float(ds["time_constant"].values[i]) * abs(sigma) - 1) <= rtol, w
-        re = max(abs(w) * a * a / NU for a in radii)
+        re = max(abs(w) * a * a / NU for a in radii if a is not None)
         assert abs(float(ds["reynolds"].values[i]) - re) <= rtol * re
 
 

@@ -319,7 +319,7 @@ def vector_chain_exponents(bodies, joints, support, eps, g=0, K0=0, dps=40):
     """All 6n exponents s (motions ∝ e^{st}) of :func:`vector_chain_ode` for the given numbers, in mpmath.
 
     ``bodies``: dicts with m, A (about the centre of mass), C, c, s (the top body's may be left out), omega;
-    ``eps``: ε_k > 0 [kg m2 s]. Values are taken at their exact binary value.
+    ``eps``: ε_k ≥ 0 [kg m2 s]. Values are taken at their exact binary value. Returns the finite exponents.
     """
     n = len(bodies)
     B, S = vector_chain_ode(n, support)
@@ -418,10 +418,23 @@ def phi_eps(M, G, K, omega, eps, lam):
     return P
 
 
-def _companion_eigs(coeffs):
-    """Eigenvalues of Σ_j coeffs[j] λ^j (n×n mpmath matrices, leading one invertible): block companion."""
+def _companion_eigs(coeffs, shift=None):
+    """Finite eigenvalues of Σ_j coeffs[j] λ^j (n×n mpmath matrices) from a block companion.
+
+    With a singular leading coefficient (a body without liquid: ε_k = 0) the problem is first moved to
+    μ = 1/(λ − shift): Σ_j T_j μ^{d−j} with T_j the Taylor coefficients at the shift, whose leading one Φ(shift)
+    is invertible; μ = 0 are the infinite λ and are dropped.
+    """
     d = len(coeffs) - 1
     n = coeffs[0].rows
+    if shift is None and abs(mp.det(coeffs[d])) == 0:
+        shift = mp.mpc("0.5377", "0.3141") * (1 + mp.mnorm(coeffs[0], 1) / (1 + mp.mnorm(coeffs[d - 1], 1)))
+    if shift is not None:
+        taylor = [sum((mp.binomial(i, j) * shift ** (i - j) * coeffs[i] for i in range(j, d + 1)), mp.zeros(n, n))
+                  for j in range(d + 1)]
+        mus = _companion_eigs(taylor[::-1])
+        tiny = mp.mpf(10) ** (-mp.mp.dps // 2)
+        return [shift + 1 / u for u in mus if abs(u) > tiny * max(abs(v) for v in mus)]
     inv = mp.inverse(coeffs[d])
     L = mp.zeros(d * n, d * n)
     for i in range((d - 1) * n):
@@ -453,10 +466,10 @@ def _cubic_coeffs(M, G, K, omega, eps):
 
 
 def cubic_roots_mp(M, G, K, omega, eps, dps=40):
-    """All 3n roots of det Φ_ε(λ) (the claimed model), bounded and spurious, from the block companion."""
+    """The finite roots of det Φ_ε(λ) (the claimed model), bounded and spurious: 2n + #{k: ε_k > 0}."""
     with mp.workdps(dps):
-        if any(_mpf(e) <= 0 for e in eps):
-            raise ValueError("every eps_k must be positive: the cubic's leading coefficient is -i diag(eps)")
+        if any(_mpf(e) < 0 for e in eps):
+            raise ValueError("every eps_k must be positive, or 0 for a body without liquid")
         return list(_companion_eigs(_cubic_coeffs(M, G, K, omega, eps)))
 
 
@@ -467,13 +480,14 @@ def chain_rates_mp(M, G, K, omega, eps, dps=40):
     ----------
     M, G, K : n×n nested lists of numbers (fractions are exact), n ≤ 3
     omega : sequence of n spin rates [rad s-1]
-    eps : sequence of n positive ε_k = ρ_k P_k / ν_k [kg m2 s]
+    eps : sequence of n ε_k = ρ_k P_k / ν_k ≥ 0 [kg m2 s] (0: a body without liquid)
 
     Returns
     -------
     list of (λ₀, λ, σ) sorted by Re λ₀
         λ₀ a root of det Φ, λ the root of det Φ_ε nearest to it, σ = −Im λ its growth rate [s-1]. The n roots
-        left over (size ~ A/ε) are the singular perturbation's and are checked to lie 10× farther out.
+        left over (size ~ A/ε, one per body with ε_k > 0) are the singular perturbation's and are checked to lie
+        10× farther out.
     """
     n = len(M)
     with mp.workdps(dps):
