@@ -69,7 +69,7 @@ def test_vector_top_without_liquid_is_maievskii():
     eps = Fraction(1, 10**15)
     rates = vr.vector_top_rates(A, C, m, g, c, w, eps, dps=60)
     assert all(abs(r) < 1e-9 for r in rates)
-    s = vr._physical_exponents(A, C, m, g, c, w, eps, 60)
+    s = vr.vector_top_exponents(A, C, m, g, c, w, eps, 60)
     freqs = sorted({round(float(abs(mp.im(z))), 9) for z in s})
     assert np.allclose(freqs, sorted(abs(v) for v in want), rtol=1e-12)
 

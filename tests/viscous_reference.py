@@ -38,6 +38,7 @@ import sympy
 __all__ = [
     "sphere_P",
     "vector_top_ode",
+    "vector_top_exponents",
     "vector_top_rates",
     "free_body_rate",
     "integrate_top",
@@ -145,7 +146,11 @@ def _exact(v):
     return sympy.Rational(Fraction(v))
 
 
-def _physical_exponents(A, C, m, g, c, omega, eps, dps):
+def vector_top_exponents(A, C, m, g, c, omega, eps, dps=40):
+    """The four exponents s (motions ∝ e^{st}) of the linearised vector top that stay bounded as ε → 0 (mpmath).
+
+    The real 6-D system's other pair (|s| ≈ A/ε) is the singular perturbation's; it is checked to lie 10× out.
+    """
     params = tuple(_exact(v) for v in (A, C, m, g, c, omega, eps))
     with mp.workdps(dps):
         S = _state_matrix_mp(params, dps)
@@ -185,15 +190,15 @@ def vector_top_rates(A, C, m, g, c, omega, eps, dps=40):
         ε → 0. Each mode is a conjugate pair of s; one rate per mode is returned.
     """
     with mp.workdps(dps):
-        return _pairs([mp.re(z) for z in _physical_exponents(A, C, m, g, c, omega, eps, dps)], dps)
+        return _pairs([mp.re(z) for z in vector_top_exponents(A, C, m, g, c, omega, eps, dps)], dps)
 
 
 def free_body_rate(A, C, omega, eps, dps=40):
-    """Growth rates [s-1] of a free symmetric body spinning about its axis: ``[0, σ_nutation]`` order not kept.
+    """Growth rates [s-1] of a free symmetric body spinning about its axis: the neutral tilt's 0 and the nutation's.
 
     The body is :func:`vector_top_ode` without gravity (a free body turns about its centre of mass as about a
-    fixed point, A and C central). Returns the two bounded modes' rates, ascending: one is the neutral tilt
-    (exactly 0), the other the nutation's.
+    fixed point, A and C central). Returns the two bounded modes' rates in ascending order: one is the
+    neutral tilt's (exactly 0), the other the nutation's.
     """
     return vector_top_rates(A, C, 1, 0, 0, omega, eps, dps)
 
@@ -485,11 +490,10 @@ def chain_rates_mp(M, G, K, omega, eps, dps=40):
     Returns
     -------
     list of (λ₀, λ, σ) sorted by Re λ₀
-        λ₀ a root of det Φ, λ the root of det Φ_ε nearest to it, σ = −Im λ its growth rate [s-1]. The n roots
+        λ₀ a root of det Φ, λ the root of det Φ_ε nearest to it, σ = −Im λ its growth rate [s-1]. The roots
         left over (size ~ A/ε, one per body with ε_k > 0) are the singular perturbation's and are checked to lie
         10× farther out.
     """
-    n = len(M)
     with mp.workdps(dps):
         cubic = cubic_roots_mp(M, G, K, omega, eps, dps)
         rigid = rigid_roots_mp(M, G, K, dps)
