@@ -227,6 +227,19 @@ def test_chain_with_a_dry_body_converges_to_the_first_order_formula(support, ome
     assert errs[2] < 1e-2 and errs[1] < 0.2 * errs[0] and errs[2] < 0.2 * errs[1], errs
 
 
+def test_a_double_root_splits_at_order_sqrt_eps():
+    """Maievskii's boundary with λ₀ + ω ≠ 0 (A = 1/16 about the fixed point, C = 1/4, m g c = 1, ω = 2: λ₀ = −4
+    double): the first-order formula does not apply; the pair splits as ±√(iεX/A), X = λ₀²(λ₀ + ω), so one root
+    grows like √(ε|X|/(2A)) = 16√ε. A multiple root is therefore not neutral: it is unstable unless X = 0."""
+    A, C, mgc, w = Fraction(1, 16), Fraction(1, 4), Fraction(1), Fraction(2)
+    with mp.workdps(50):
+        for e in (Fraction(1, 10**8), Fraction(1, 10**10)):
+            lam = sorted(vr.cubic_roots_mp([[A]], [[C * w]], [[-mgc]], [w], [e], dps=50), key=abs)[:2]
+            rates = sorted(-mp.im(z) / mp.sqrt(q(e)) for z in lam)
+            assert abs(rates[0] + 16) < 5e-3 * 16 and abs(rates[1] - 16) < 5e-3 * 16, rates  # next term O(ε)
+            assert all(abs(z + 4) < 10 * mp.sqrt(q(e)) * 16 for z in lam)
+
+
 def test_the_spurious_root_of_the_top():
     """The singular perturbation's root: λ = −iA/ε + (C − A)ω/A + O(ε), a growth rate of +A/ε, to be left out."""
     A, C, m, g, c = TOP.values()
@@ -394,3 +407,19 @@ def test_stabmap_viscous_top_at_its_exact_threshold():
             assert (sigma > 0) == (margin < 0)
             lo, hi = float(ds["growth_rate_lower"].values[i]), float(ds["growth_rate_upper"].values[i])
             assert lo <= sigma <= hi, (w, lo, sigma, hi)
+
+
+def test_stabmap_viscous_double_root_is_never_stable():
+    """At the double root above (ω = 2 exactly) stabmap may say undecided (a multiple root) or unstable (it is:
+    ±16√ε), never asymptotically_stable. Just above it one of the two real roots grows at first order, up to
+    ω* = √(1/(C − A)) = 2.309, where the classical criterion turns stable."""
+    pytest.importorskip("stabmap.systems.viscous")
+    import stabmap
+
+    body = dict(m=1.0, A=0.046875, C=0.25, c=0.125)  # about the fixed point 3/64 + 1/64 = 1/16; m g c = 1 at g = 8
+    omegas = [1.5, 2.0, 2.1, 2.5]
+    toml = viscous_toml("fixed", [body], [], [0.03], omegas).replace("g = 9.81", "g = 8.0")
+    ds = stabmap.compute_atlas(stabmap.loads_scene(toml), progress=False, threads=1)
+    labels = _flag(ds["asymptotic_stability"])
+    assert labels[0] == labels[2] == "unstable" and labels[1] in ("undecided", "unstable"), labels
+    assert labels[3] == "asymptotically_stable"
