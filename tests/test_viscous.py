@@ -108,6 +108,22 @@ def test_a_double_root_of_the_frozen_top_is_undecided():
     assert DECIDED_BY.meaning(int(ds.decided_by.values[0])) == "multiple_root"
 
 
+def test_a_double_root_the_liquid_feels_splits_and_one_branch_grows():
+    # A' = 1, C = 4, g m c = 4, omega = 1: a double root at lambda = -2 (not -omega): q(-2) = -4 eps != 0, and
+    # delta^2 = i 2! q / p'' splits it into two branches of size sqrt(eps), one growing at sqrt(4 eps) sin(pi/4)
+    text = top("{ values = [1.0] }", m=0.5, A=0.5, C=4.0, c=1.0, g=8.0, radius=0.01)
+    ds = stabmap.compute_atlas(stabmap.loads_scene(text), progress=False)
+    assert ds.asymptotic_stability.values.tolist() == [UN]
+    assert DECIDED_BY.meaning(int(ds.decided_by.values[0])) == "split_multiple_root"
+    mpmath.mp.dps = 60
+    eps = sphere_eps(0.01, 1000.0, 0.5)
+    # the full cubic det Phi_eps = lambda^2 + 4 lambda + 4 - i eps lambda^2 (lambda + 1): its two bounded roots
+    bounded = sorted(mpmath.polyroots([-1j * eps, 1 - 1j * eps, 4, 4], maxsteps=400, extraprec=400), key=abs)[:2]
+    fastest = max(-mpmath.im(r) for r in bounded)
+    assert float(ds.growth_rate_lower[0]) <= float(mpmath.sqrt(2 * eps)) <= float(ds.growth_rate_upper[0])
+    assert float(fastest) == pytest.approx(float(mpmath.sqrt(2 * eps)), rel=1e-5)  # the cubic agrees to O(eps)
+
+
 def test_a_root_the_liquid_does_not_feel_is_undecided():
     # A' = 1, C = 3, g m c = 2, omega = 1: roots -1 and -2; lambda = -omega is still in the body frame (zero rate)
     text = top("{ values = [1.0] }", m=0.5, A=0.5, C=3.0, c=1.0, g=4.0, radius=0.01)

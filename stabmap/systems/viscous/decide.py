@@ -9,6 +9,7 @@ large spurious root that putting the viscous term into the polynomial would crea
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 
 import flint
@@ -172,31 +173,59 @@ def _exact(points, i, eps, eps_r, liquid, zeros, row, label, by, rate) -> None:
         body[k, 1] += h
         derivs.append((exact.char_poly(body, *args[1:]) - p) / exact._q(h))
     nonzero = flint.fmpq_poly(coeffs[m0:])
-    sig, sig_r, freq = [], [], []
+    sig, sig_r, freq, open_ = [], [], [], []
     old = flint.ctx.prec
     flint.ctx.prec = ARB_PREC
     try:
-        dp = flint.arb_poly([flint.arb(c) for c in p.derivative().coeffs()])
         dk = [flint.arb_poly([flint.arb(c) for c in d.coeffs()]) for d in derivs]
         for root, mult in nonzero.complex_roots():
-            if mult > 1:
-                label[row], by[row] = UNDECIDED, BY["multiple_root"]
-                return
             x = root.real  # every root is real here (N_c = 0 proved)
             q = sum((flint.arb(float(eps[j]), float(eps_r[j])) * (x + flint.arb(float(points.body[i, k, 5]))) * dk[j](x)
                      for j, k in enumerate(liquid)), flint.arb(0))
-            s = -q / dp(x)
-            if not (s > 0 or s < 0):
-                label[row], by[row] = UNDECIDED, BY["zero_rate"]
-                return
+            s = _split(p, x, q, mult)
+            if s is None:
+                open_.append("multiple_root" if mult > 1 else "zero_rate")
+                continue
             mid = float(s.mid())
             lo, hi = np.nextafter(float(s.lower()), -np.inf), np.nextafter(float(s.upper()), np.inf)
             sig.append(mid)
             sig_r.append(max(mid - lo, hi - mid) * (1.0 + 4.0 * U))
             freq.append(float(x.mid()))
+            if mult > 1:
+                open_.append("split")  # proved growing, at order eps^(1/m): not a first-order rate
     finally:
         flint.ctx.prec = old
-    _put(row, np.array(sig), np.array(sig_r), np.array(freq), label, by, rate, BY["first_order_arb"])
+    sig, sig_r, freq = np.array(sig), np.array(sig_r), np.array(freq)
+    undecided = [w for w in open_ if w != "split"]
+    grows = bool(np.any(sig - sig_r > 0))
+    if undecided and not grows:
+        label[row], by[row] = UNDECIDED, BY[undecided[0]]
+        return
+    _put(row, sig, sig_r, freq, label, by, rate, BY["split_multiple_root"] if "split" in open_ else BY["first_order_arb"])
+    if undecided:  # another root grows, so the label is proved; the largest rate is not (a root's rate is unknown)
+        rate["upper"][row] = np.nan
+
+
+def _split(p, x, q, mult: int):
+    """The growth rate of the fastest branch of the root x of p (multiplicity ``mult``) as an arb, or None if its
+    sign is not proved.  A simple root moves by i q / p'(x): sigma = -q / p'(x).  A root of multiplicity m >= 2 that
+    the liquid feels (q(x) != 0) splits as delta^m = i m! q / p^(m)(x) (Puiseux): m branches of size
+    eps^(1/m) spread evenly around x, and one of them always lies in the growing half plane."""
+    if mult == 1:
+        dp = flint.arb_poly([flint.arb(c) for c in p.derivative().coeffs()])
+        s = -q / dp(x)
+        return s if (s > 0 or s < 0) else None
+    if not (q > 0 or q < 0):
+        return None
+    d = p
+    for _ in range(mult):
+        d = d.derivative()
+    pm = flint.arb_poly([flint.arb(c) for c in d.coeffs()])(x)
+    c = q * math.factorial(mult) / pm  # delta^m = i c
+    phase = flint.arb.pi() / 2 if c > 0 else -flint.arb.pi() / 2
+    size = abs(c).root(mult)
+    branch = max((-((phase + 2 * k * flint.arb.pi()) / mult).sin() for k in range(mult)), key=lambda v: float(v.mid()))
+    return size * branch
 
 
 def _rate_variables(rate: dict) -> dict[str, np.ndarray]:

@@ -30,12 +30,14 @@ DECIDED_BY = Variable(
     "kernels (docs/certification.md): a root grows at order 1 and a small dissipation cannot stop it; "
     "first_order_balls: every simple real root's first-order growth rate enclosed in ball arithmetic from the "
     "kernels' root enclosures; first_order_arb: the same from the exact rational polynomial, its roots isolated by "
-    "FLINT/Arb; multiple_root, zero_rate, zero_root: undecided, because a root of the frozen chain is multiple, a growth "
-    "rate's exact enclosure holds 0, or lambda = 0 is a root beyond the structural ones; degenerate: p is identically "
+    "FLINT/Arb; split_multiple_root: unstable, because a multiple real root of the frozen chain that the liquid feels "
+    "splits as eps^(1/m) and one branch grows (Puiseux; its growth_rate is that branch's leading term); "
+    "multiple_root, zero_rate, zero_root: undecided, because a multiple root is not felt by the liquid at first order, a "
+    "growth rate's exact enclosure holds 0, or lambda = 0 is a root beyond the structural ones; degenerate: p is identically "
     f"zero; {INFERRED}: not computed (stabmap atlas --refine), the value on which its cell's corners agree",
     # INFERRED takes the gyroscopes' value, so that one number means "inferred" in both systems' atlases
     flags=((0, "frozen_chain_unstable"), (1, "first_order_balls"), (2, "first_order_arb"), (3, INFERRED),
-           (4, "multiple_root"), (5, "zero_rate"), (6, "zero_root"), (7, "degenerate")),
+           (4, "multiple_root"), (5, "zero_rate"), (6, "zero_root"), (7, "degenerate"), (8, "split_multiple_root")),
 )
 GROWTH_RATE = Variable(
     "growth_rate",
