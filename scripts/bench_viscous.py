@@ -41,7 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from stabmap import systems
-from stabmap.scene.grid import Axis
+from stabmap.scene.grid import Axis, resample
 from stabmap.systems.gyroscopes import scene as scene_module
 from stabmap.systems.gyroscopes.points import point_arrays
 from stabmap.systems.viscous.decide import dissipation
@@ -227,7 +227,8 @@ def run_row(seed: int, n: int, support: str, spin: str, kind: str, lines: int, p
     reynolds = np.concatenate([o["reynolds"] for o in outs["viscous"]])
     peer, peer_s, gap = float_peer(sc["viscous"])
     differ = at_boundary = compared = 0
-    for lab, pl in zip(labels, peer):
+    worst = 0.0  # the largest |growth rate| (stabmap's, proved) at a point where the peer differs
+    for lab, pl, o in zip(labels, peer, outs["viscous"]):
         decided = lab != UNDECIDED
         bad = decided & (lab != pl) & (lab >= 0)
         compared += int((decided & (lab >= 0)).sum())
@@ -236,6 +237,8 @@ def run_row(seed: int, n: int, support: str, spin: str, kind: str, lines: int, p
         change[1:] |= lab[1:] != lab[:-1]
         change[:-1] |= lab[1:] != lab[:-1]
         at_boundary += int((bad & change).sum())
+        if bad.any():
+            worst = max(worst, float(np.nanmax(np.abs(o["growth_rate"][bad]))))
     allv = np.concatenate(labels)
     closed = None
     if n == 1:  # the classical criteria, independent of stabmap's code
@@ -250,8 +253,28 @@ def run_row(seed: int, n: int, support: str, spin: str, kind: str, lines: int, p
         "by": {name: int((by == code).sum()) for name, code in BY.items()},
         "re_max": float(reynolds.max()),
         "peer_us": 1e6 * peer_s / npts, "peer_differ": differ, "peer_at_boundary": at_boundary, "compared": compared,
+        "peer_worst_rate": worst,
         "spurious_gap": gap, "closed_form_differ": closed,
     }
+
+
+def atlas_rows(quick: bool, repeat: int) -> list[dict]:
+    """The whole atlas of docs/figures/viscous-vs-ideal.png, ideal and viscous, one thread, cell by cell as by
+    default: the ideal atlas proves boxes and skips nodes inside them; the viscous one computes every node."""
+    import stabmap
+    from viscous_figure import scenes
+
+    out = []
+    for liquid, scene in zip(("ideal", "viscous"), scenes(quick)):
+        stabmap.compute_atlas(resample(scene, omega=3, C_1=3), progress=False, threads=1)  # load the kernels
+        seconds, ds = cpu_median(lambda: stabmap.compute_atlas(scene, progress=False, threads=1), repeat)
+        label = systems.of(scene).label
+        whole = 100.0 * float((ds["cell"] == ds["cell"].attrs["flag_values"][list(ds["cell"].attrs["flag_meanings"].split()).index("whole_cell")]).mean())
+        out.append({"liquid": liquid, "points": int(ds[label].size), "label": label, "seconds": seconds,
+                    "us": 1e6 * seconds / ds[label].size, "whole_cell_pct": whole})
+    for r in out:
+        r["x_ideal"] = r["seconds"] / out[0]["seconds"]
+    return out
 
 
 def cases(quick: bool) -> list[tuple[int, str, str, str, int, int]]:
@@ -262,7 +285,7 @@ def cases(quick: bool) -> list[tuple[int, str, str, str, int, int]]:
 
 
 HEADER = ("| n | support | spin | bodies | points | dry us/pt (deg 2n) | ideal us/pt (deg 3n) | viscous us/pt (deg 2n) | x dry | x ideal "
-          "| asympt. stable % | undecided | decided by | float peer us/pt | peer differs (at a boundary) | closed form differs | largest Re |")
+          "| asympt. stable % | undecided | decided by | float peer us/pt | peer differs (at a boundary) | where: largest abs. rate [1/s] | closed form differs | largest Re |")
 BY_SHORT = {"frozen_chain_unstable": "frozen", "first_order_balls": "balls", "first_order_arb": "arb",
             "multiple_root": "multiple", "zero_rate": "zero rate", "zero_root": "zero root", "degenerate": "degenerate"}
 
@@ -290,12 +313,19 @@ def main(argv: list[str] | None = None) -> list[dict]:
         by = ", ".join(f"{BY_SHORT.get(k, k)} {v}" for k, v in r["by"].items() if v)
         print(f"| {n} | {support} | {spin} | {kind} | {r['points']} | {r['us']['dry']:.1f} | {r['us']['ideal']:.1f} | {r['us']['viscous']:.1f} "
               f"| {r['x_dry']:.2f} | {r['x_ideal']:.2f} | {r['stable_pct']:.0f} | {r['undecided']} | {by} | {r['peer_us']:.1f} "
-              f"| {r['peer_differ']} of {r['compared']} ({r['peer_at_boundary']}) | {'-' if r['closed_form_differ'] is None else r['closed_form_differ']} | {r['re_max']:.2f} |", flush=True)
+              f"| {r['peer_differ']} of {r['compared']} ({r['peer_at_boundary']}) | {r['peer_worst_rate']:.1g} | {'-' if r['closed_form_differ'] is None else r['closed_form_differ']} | {r['re_max']:.2f} |", flush=True)
+    atlas = atlas_rows(args.quick, repeat)
+    print()
+    print("| whole atlas (the figure's heavy top) | points | label | seconds | us/pt | x ideal | cells proved whole % |")
+    print("|---|---|---|---|---|---|---|")
+    for r in atlas:
+        print(f"| {r['liquid']} | {r['points']} | {r['label']} | {r['seconds']:.2f} | {r['us']:.1f} | {r['x_ideal']:.2f} | {r['whole_cell_pct']:.1f} |")
     total = sum(r["points"] for r in rows)
     shares = {name: 100.0 * sum(r["by"][name] for r in rows) / total for name in BY}
     print(f"all {total} points: undecided {100.0 * sum(r['undecided'] for r in rows) / total:.2f} %; decided by "
-          + ", ".join(f"{name} {v:.2f} %" for name, v in shares.items() if v))
-    return rows
+          + ", ".join(f"{name} {v:.2f} %" for name, v in shares.items() if v)
+          + f"; the peer's dropped roots are at least {min(r['spurious_gap'] for r in rows):.2g} times the largest kept one")
+    return {"rows": rows, "atlas": atlas}
 
 
 if __name__ == "__main__":

@@ -144,7 +144,9 @@ def test_bench_rates_quick(capsys):
 
 
 def test_bench_viscous_quick(capsys):
-    rows = runpy.run_path(str(SCRIPTS / "bench_viscous.py"))["main"](["--quick"])
+    out = runpy.run_path(str(SCRIPTS / "bench_viscous.py"))["main"](["--quick"])
+    rows = out["rows"]
+    assert [(a["liquid"], a["label"]) for a in out["atlas"]] == [("ideal", "n_complex_pairs"), ("viscous", "asymptotic_stability")]
     assert [(r["n"], r["support"], r["spin"], r["kind"]) for r in rows] == [
         (n, s, w, "random") for n in (1, 2) for s in ("fixed", "free") for w in ("common", "distinct")] + [
         (2, s, "common", "identical") for s in ("fixed", "free")]
