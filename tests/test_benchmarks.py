@@ -141,3 +141,31 @@ def test_bench_rates_quick(capsys):
     for r in rows:  # the rate variables add 17 bytes a point to the plain atlas's 5, the frequencies 17 per root
         assert r["bytes"] == r["points"] * (5 + 17 * (r["way"] != "plain") + 17 * r["degree"] * (r["way"] == "frequencies"))
     assert "| scene | degree | points |" in capsys.readouterr().out
+
+
+def test_bench_viscous_quick(capsys):
+    out = runpy.run_path(str(SCRIPTS / "bench_viscous.py"))["main"](["--quick"])
+    rows = out["rows"]
+    assert [(a["liquid"], a["label"]) for a in out["atlas"]] == [("ideal", "n_complex_pairs"), ("viscous", "asymptotic_stability")]
+    assert [(r["n"], r["support"], r["spin"], r["kind"]) for r in rows] == [
+        (n, s, w, "random") for n in (1, 2) for s in ("fixed", "free") for w in ("common", "distinct")] + [
+        (2, s, "common", "identical") for s in ("fixed", "free")]
+    for r in rows:
+        assert sum(r["by"].values()) == r["points"] > 0  # every point decided by one named way
+        assert r["undecided"] == sum(r["by"][k] for k in ("multiple_root", "zero_rate", "zero_root"))
+        assert all(r["us"][k] > 0 for k in ("dry", "ideal", "viscous")) and r["peer_us"] > 0
+        # every disagreement with the float peer is in the table, and none of stabmap's proved labels is compared twice
+        assert 0 <= r["peer_at_boundary"] <= r["peer_differ"] <= r["compared"] == r["points"] - r["undecided"] - r["by"]["degenerate"]
+        assert r["spurious_gap"] > 100  # the dropped roots are the spurious large ones, far from the physical
+        assert r["re_max"] < 1
+        if r["n"] == 1:  # one body: the classical criteria (C - A') omega^2 > m g c on a point, C > A free
+            assert r["closed_form_differ"] == 0
+    assert "| n | support | spin |" in capsys.readouterr().out
+
+
+def test_viscous_figure_quick(tmp_path, capsys):
+    out = runpy.run_path(str(SCRIPTS / "viscous_figure.py"))["main"](["--quick", "--out", str(tmp_path)])
+    assert out["path"].is_file()
+    # the curves drawn on the figure are the maps' boundaries: Maievskii's for the ideal liquid, (C - A') omega^2 > m g c
+    assert out["ideal_off_closed_form"] == 0 and out["viscous_off_closed_form"] == 0
+    assert out["lost"] > 0 and out["undecided"] == 0 and out["re_max"] < 1
