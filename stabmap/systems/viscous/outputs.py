@@ -68,7 +68,8 @@ FREQUENCY = Variable(
     "float32",
     "frequency of the mode of growth_rate in the non-spinning frame: Re lambda",
     units="rad s-1",
-    comment="lambda < 0: prograde (as docs/model.md); the approximation of the frozen chain's root",
+    comment="lambda < 0: prograde (as docs/model.md); the approximation of the frozen chain's root. NaN where the frozen "
+    "chain is unstable (its growing root is complex) and where growth_rate is NaN",
     fill=float("nan"),
 )
 REYNOLDS = Variable(
