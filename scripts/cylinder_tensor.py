@@ -47,7 +47,8 @@ def half_ellipse_mesh(radius: float, half_height: float, n: int) -> MeshTri2:
     m1 = MeshTri1(pts.T.copy(), tri.T.copy())
     m2 = MeshTri2.from_mesh(m1)
     doflocs = m2.doflocs.copy()
-    arc = m2.facets_satisfying(lambda x: np.hypot(x[0], x[1]) > 1.0 - 1e-9 - 0.5 / n**2, boundaries_only=True)
+    axis = m2.facets_satisfying(lambda x: x[0] < 1e-12, boundaries_only=True)
+    arc = np.setdiff1d(m2.boundary_facets(), axis)
     dofs = m2.dofs.get_facet_dofs(arc).flatten()
     # edge midpoints onto the unit circle, then the affine stretch puts every boundary node on the ellipse
     doflocs[:, dofs] /= np.linalg.norm(doflocs[:, dofs], axis=0)

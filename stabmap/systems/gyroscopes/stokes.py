@@ -117,14 +117,20 @@ def tensor(shape: str, radius, half_height):
     return scale * f_t, scale * f_a, rel_error
 
 
+def _has_bool(value) -> bool:
+    return isinstance(value, (bool, np.bool_)) or (isinstance(value, (list, tuple)) and any(map(_has_bool, value)))
+
+
 def check_tensor(value, where: str = "tensor") -> tuple[float, float]:
     """(P_t, P_a) [m⁷] from a user's tensor: [P_t, P_a], or a 3×3 nested list, symmetric, diagonal and
     axisymmetric about z (P_11 == P_22) to 1e-12 relative; entries finite and > 0."""
     forms = "give [P_t, P_a] or a 3x3 list [[P_t, 0, 0], [0, P_t, 0], [0, 0, P_a]] in m^7"
     try:
+        if _has_bool(value):  # TOML's true would pass as 1.0
+            raise TypeError
         arr = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise StabmapError(f"{where}: a cavity tensor must be numbers; {forms}, got {value!r}") from None
+    except (TypeError, ValueError):  # text, tables, booleans, or rows of unequal length
+        raise StabmapError(f"{where}: a cavity tensor is 2 numbers or 3x3 numbers; {forms}, got {value!r}") from None
     if isinstance(value, (str, bytes)) or arr.shape not in ((2,), (3, 3)):
         raise StabmapError(f"{where}: a cavity tensor has 2 entries or 3x3; {forms}, got {value!r}")
     if not np.all(np.isfinite(arr)):
