@@ -16,6 +16,8 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import stabmap
 from stabmap.errors import StabmapError
@@ -128,6 +130,17 @@ def test_slender_limits():
     assert p_t == pytest.approx(16 * math.pi * a**2 * 1e-20 / 315, rel=1e-6)
 
 
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.floats(1e-3, 1e3), min_size=3, max_size=3), st.permutations([0, 1, 2]))
+def test_ellipsoid_entries_follow_their_axes(semi, perm):
+    """Renaming the axes renames the entries; each entry is positive and scales like length^7."""
+    p = stokes.ellipsoid_tensor(*semi)
+    q = stokes.ellipsoid_tensor(*(semi[i] for i in perm))
+    assert np.allclose([p[i] for i in perm], q, rtol=1e-13, atol=0)
+    assert all(v > 0 for v in p)
+    assert np.allclose(stokes.ellipsoid_tensor(*(2.0 * s for s in semi)), [128.0 * v for v in p], rtol=1e-13, atol=0)
+
+
 @pytest.mark.parametrize("shape", ["spheroid", "cylinder"])
 def test_scaling_and_broadcasting(shape):
     radius = np.array([0.1, 0.5, 2.0])
@@ -213,6 +226,13 @@ def test_cylinder_table_limits():
     t05, a05, _ = stokes.cylinder_scaled(0.05)
     t10, a10, _ = stokes.cylinder_scaled(0.1)  # the edge correction halves with q
     assert 1.6 < (1 - t10 / (8 * math.pi * 0.1**5 / 45)) / (1 - t05 / (8 * math.pi * 0.05**5 / 45)) < 2.4
+
+
+def test_generator_quick_mode(capsys, tmp_path):
+    """The script's own pipeline (meshes, both solvers, the spline check) runs, coarse, and writes nothing."""
+    fem()["main"](["--quick", "-o", str(tmp_path / "t.csv")])
+    assert "5 nodes, mesh n = 8" in capsys.readouterr().out
+    assert not (tmp_path / "t.csv").exists()
 
 
 def test_cylinder_table_file():
