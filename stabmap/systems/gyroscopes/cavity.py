@@ -5,6 +5,10 @@ inertia; kappa_l is dimensionless, |kappa_l| > 1, negative on the prograde
 branch of the cylinder. Every E scales as density * radius**5 at a fixed aspect
 ratio half_height / radius and every kappa depends on that ratio alone, so the
 work is done once per ratio (``scaled_*``) and scaled afterwards.
+
+A viscous liquid's cavity tensor P¹ [m⁷] (Chernousko; docs/viscous-tensors.md) comes from stokes.py:
+``viscous_tensor(shape, radius, half_height) -> (P_t, P_a, rel_error)``, the closed forms ``ellipsoid_tensor``,
+``spheroid_tensor``, ``sphere_tensor``, and ``check_viscous_tensor`` for a tensor a scene gives directly.
 """
 
 from __future__ import annotations
@@ -16,6 +20,9 @@ from scipy import special
 from scipy.optimize import elementwise
 
 from ...errors import StabmapError
+from .stokes import check_tensor as check_viscous_tensor  # noqa: F401  (re-exported: stabmap.cavity)
+from .stokes import ellipsoid_tensor, sphere_tensor, spheroid_tensor  # noqa: F401
+from .stokes import tensor as viscous_tensor  # noqa: F401
 
 SHAPES = ("spheroid", "cylinder")
 DEFAULT_MODES = 8  # cylinder modes kept with the tail: 1e-4 on the critical spin (scripts/bench_truncation.py, BENCHMARKS.md)
