@@ -139,7 +139,11 @@ def test_atlas_refine_and_critical_call_only_the_precompiled_signatures():
             'support = "fixed"\\n[[bodies]]\\nm = 1.0\\nA = 0.02\\nC = 0.03\\nc = 0.1\\n[grid]\\nomega = { start = -2.0, stop = 2.0, num = 5 }\\n')
         stabmap.critical(through_zero, "omega", progress=False, threads=1)  # plain boxes at omega = 0
         stabmap.roots(small, **{a.name: a.values[0] for a in small.grid})  # query --roots
-        called = decide_block.signatures + box_block.signatures + nodes_box_block.signatures + roots_block.signatures + linearise_block.signatures
+        viscous = stabmap.example("viscous-top-sphere")  # a viscous liquid's first-order rates
+        stabmap.compute_atlas(resample(viscous, **{a.name: 9 for a in viscous.grid}), progress=False, threads=1)
+        from stabmap.kernels.firstorder import first_order_block
+        called = (decide_block.signatures + box_block.signatures + nodes_box_block.signatures + roots_block.signatures
+                  + linearise_block.signatures + first_order_block.signatures)
         print(json.dumps({"called": sorted(map(str, called)),
                           "precompiled": sorted(str(sig) for _, sig in precompile.signatures())}))
     """

@@ -237,6 +237,12 @@ def test_a_viscosity_makes_the_scene_viscous_and_it_round_trips():
     (lambda t: t + "viscosity_2 = { values = [0.1] }\n", "viscosity_2"),
     (lambda t: t.replace('title = "top"', 'title = "top"\nfrequencies = true'), "frequencies"),
     (lambda t: 'system = "viscous"\n' + t.replace(", viscosity = 0.5", ""), "needs a viscous liquid"),
+    (lambda t: t.replace('shape = "spheroid", radius = 0.04, half_height = 0.04', 'shape = "table", tensor = [1e-12, 1e-12, 3.0], radius = 0.04'),
+     "tensor"),
+    (lambda t: t.replace('shape = "spheroid", radius = 0.04, half_height = 0.04', 'shape = "table", tensor = [[1e-12, 0, 0], [0, 2e-12, 0], [0, 0, 1e-12]], radius = 0.04'),
+     "tensor"),
+    (lambda t: t.replace('shape = "spheroid"', 'shape = "cylinder"') + "half_height_1 = { values = [0.0001, 0.04] }\n",
+     "tabulated"),
 ])
 def test_bad_viscous_scenes_are_refused_by_name(edit, words):
     with pytest.raises(StabmapError, match=words):
@@ -287,3 +293,20 @@ def test_paper_cases_with_a_viscous_liquid_agree_with_kelvin_tait_chetaev(capsys
     # each row: | case | points | stable share | undecided | agree | disagree |
     assert all(int(r.split("|")[6]) == 0 and int(r.split("|")[5]) > 500 for r in rows)
     assert sum(float(r.split("|")[3].strip(" %")) > 10 for r in rows) >= 5  # both classes occur
+
+
+def test_a_tensor_table_and_a_cylinder_decide_as_their_tensors_say():
+    # the same top with a sphere's tensor given as a table; and a cylinder, whose label (one body) needs only P_t > 0
+    sphere = stabmap.loads_scene(top("{ values = [8.0, 12.0, 30.0] }"))
+    P = float(8 * mpmath.pi * mpmath.mpf(0.04) ** 7 / 525)
+    table = stabmap.loads_scene(top("{ values = [8.0, 12.0, 30.0] }").replace(
+        'shape = "spheroid", radius = 0.04, half_height = 0.04', f'shape = "table", tensor = [{P!r}, {P!r}], radius = 0.04'))
+    cylinder = stabmap.loads_scene(top("{ values = [8.0, 12.0, 30.0] }", radius=0.03).replace('"spheroid"', '"cylinder"'))
+    a, b, c = (stabmap.compute_atlas(s, progress=False) for s in (sphere, table, cylinder))
+    assert np.array_equal(a.asymptotic_stability.values, b.asymptotic_stability.values)
+    assert np.array_equal(a.asymptotic_stability.values, c.asymptotic_stability.values)
+    assert b.growth_rate.values == pytest.approx(a.growth_rate.values, rel=1e-6)
+    # a cylinder's rates are its tensor's: P_t from stabmap.cavity, within the table's stated accuracy
+    Pt, _, rel = stabmap.cavity.viscous_tensor("cylinder", 0.03, 0.03)
+    ratio = c.growth_rate.values[1:] / a.growth_rate.values[1:]  # the decaying points: rates proportional to P_t
+    assert ratio == pytest.approx(np.full(2, float(Pt) / P), rel=1e-5 + float(rel))

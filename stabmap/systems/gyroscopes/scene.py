@@ -383,6 +383,16 @@ def _check_cavities(scene: Scene) -> tuple[Body, ...]:
             values[key] = axes.get(f"{key}_{k}", axes.get(key, np.array([fixed])) if key in EVERY_BODY else np.array([fixed]))
         extremes = {key: (float(v.min()), float(v.max())) for key, v in values.items()}
         liquid.check_body(cav, f"bodies[{k}]", extremes)
+        if cav.viscous and cav.shape == "cylinder":  # its tensor is tabulated: refuse the grid now, not mid-run
+            from .stokes import cylinder_range
+
+            low, high = cylinder_range()
+            q = (extremes["half_height"][0] / extremes["radius"][1], extremes["half_height"][1] / extremes["radius"][0])
+            if q[0] < low or q[1] > high:
+                raise StabmapError(
+                    f"bodies[{k}].cavity: half_height / radius runs from {q[0]:.4g} to {q[1]:.4g} on this grid; the viscous "
+                    f"cylinder's tensor is tabulated for {low:g} <= half_height / radius <= {high:g} (docs/viscous-tensors.md): "
+                    "narrow the grid, or give the tensor directly (shape = \"table\", tensor = [P_t, P_a])")
         if cav.geometric and not cav.viscous:
             inertia = extremes["A"][0]
             if not cav.liquid_in_body:  # the engine adds the frozen liquid, at least its inertia at the smallest sizes
