@@ -336,11 +336,11 @@ def _check_omega(scene: Scene) -> None:
 
 def _check_one_liquid_model(scene: Scene) -> None:
     """A scene is either ideal (modes) or viscous (Chernousko's first order): the two models do not combine."""
+    names = {a.name for a in scene.grid}
+    for k, b in enumerate(scene.bodies, start=1):
+        if f"viscosity_{k}" in names and (b.cavity is None or not b.cavity.viscous):
+            raise StabmapError(f"grid axis 'viscosity_{k}': body {k} has no viscous cavity; add viscosity to its cavity or remove the axis")
     if not scene.viscous:
-        if any(a.name.startswith("viscosity_") for a in scene.grid):
-            axis = next(a.name for a in scene.grid if a.name.startswith("viscosity_"))
-            raise StabmapError(f"grid axis {axis!r}: body {axis.rpartition('_')[2]} has no viscous cavity; add viscosity to its cavity "
-                               "or remove the axis")
         return
     for k, b in enumerate(scene.bodies, start=1):
         ideal = "fluid modes (E, kappa)" if b.E else "an ideal-liquid cavity (no viscosity)" if b.cavity is not None and not b.cavity.viscous else ""
@@ -351,10 +351,7 @@ def _check_one_liquid_model(scene: Scene) -> None:
     if scene.frequencies:
         raise StabmapError("frequencies: a viscous scene stores the frequency of its slowest-decaying mode (variable frequency); "
                            "remove frequencies = true")
-    names = {a.name for a in scene.grid}
     for k, b in enumerate(scene.bodies, start=1):
-        if f"viscosity_{k}" in names and (b.cavity is None or not b.cavity.viscous):
-            raise StabmapError(f"grid axis 'viscosity_{k}': body {k} has no viscous cavity; add one or remove the axis")
         if b.cavity is not None and not b.cavity.geometric and ({f"half_height_{k}", f"aspect_{k}"} & names):
             raise StabmapError(f"grid axis of body {k}'s cavity size: its tensor is given as a table, so no size moves it; "
                                "give the cavity's shape and sizes to scan them")

@@ -17,12 +17,11 @@ import numpy as np
 
 from ...kernels import REAL, ROOTS_FAILED, roots_block
 from ...kernels.firstorder import RATE_OK, first_order_block
-from ..gyroscopes import exact, topology
+from ..gyroscopes import exact, ratios, stokes, topology
 from ..gyroscopes.decide import decide as decide_frozen
 from ..gyroscopes.decide import kernel_args
 from ..gyroscopes.points import PointArrays, point_arrays
 from ..gyroscopes.rates import rates as frozen_rates
-from ..gyroscopes import ratios, stokes
 from .outputs import ASYMPTOTICALLY_STABLE, BY, DEGENERATE, UNDECIDED, UNSTABLE
 
 U = 2.0**-53
@@ -33,6 +32,7 @@ def dissipation(scene, values: dict, points: PointArrays):
     """(eps, eps_r, liquid, reynolds): each viscous cavity's eps_k = rho_k P_k / nu_k as a ball (npts, nl), the
     kernel indices of those bodies (nl,), and each point's largest Reynolds number |omega_k| a_k^2 / nu_k."""
     arrays = {name: np.asarray(v, dtype=np.float64) for name, v in ratios.underlying(scene, values).items()}
+    shape = np.broadcast_shapes(*(a.shape for a in arrays.values())) if arrays else ()
     npts = points.body.shape[0]
     order = np.arange(scene.n) if scene.topology is None else topology.kernel_layout(scene.topology.parent)[0]
     position = np.argsort(order)  # the kernel index of each scene body
@@ -43,9 +43,7 @@ def dissipation(scene, values: dict, points: PointArrays):
             continue
 
         def get(key):
-            v = arrays.get(f"{key}_{k + 1}", getattr(cav, key))
-            return np.broadcast_to(np.asarray(v, dtype=np.float64), np.broadcast_shapes(*(a.shape for a in arrays.values()))
-                                   if arrays else ()).reshape(-1) * np.ones(npts)
+            return np.broadcast_to(np.asarray(arrays.get(f"{key}_{k + 1}", getattr(cav, key)), dtype=np.float64), shape).reshape(-1)
 
         nu, rho, a = get("viscosity"), get("density"), get("radius")
         if cav.geometric:
@@ -56,8 +54,8 @@ def dissipation(scene, values: dict, points: PointArrays):
         i = int(position[k])
         liquid.append(i)
         eps.append(e)
-        # two roundings (a product and a quotient) of the float eps, and the tensor's stated relative accuracy
-        eps_r.append(np.abs(e) * (np.asarray(rel) + 8.0 * U) + 1e-300)
+        # the roundings of the closed form (a few dozen operations) and of rho P / nu, and the tensor's stated accuracy
+        eps_r.append(np.abs(e) * (np.asarray(rel) + 64.0 * U) + 1e-300)
         reynolds = np.maximum(reynolds, np.abs(points.body[:, i, 5]) * a * a / nu)
     return (np.ascontiguousarray(np.stack(eps, axis=1)), np.ascontiguousarray(np.stack(eps_r, axis=1)),
             np.array(liquid, dtype=np.int64), reynolds)
