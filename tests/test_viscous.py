@@ -249,13 +249,18 @@ def test_bad_viscous_scenes_are_refused_by_name(edit, words):
         stabmap.loads_scene(edit(top("{ values = [1.0] }")))
 
 
-def test_mixing_an_ideal_and_a_viscous_cavity_is_one_line_exit_2_and_no_file(tmp_path, capsys):
-    text = CHAIN.format(support="fixed", K="1.0", C1=0.09, w1=30.0).replace(", viscosity = 0.2", "")
-    (tmp_path / "mixed.toml").write_text(text)
-    code = main(["atlas", str(tmp_path / "mixed.toml"), "-o", str(tmp_path / "mixed.nc")])
+@pytest.mark.parametrize("edit, words", [
+    (lambda t: t.replace(", viscosity = 0.2", ""), "one liquid model"),
+    (lambda t: t.replace("viscosity = 0.2", "viscosity = -0.2"), "viscosity must be > 0"),
+    (lambda t: t.replace('shape = "spheroid", radius = 0.03, half_height = 0.045', 'shape = "table", tensor = [[1e-12, 0], [0, 1e-12]], radius = 0.03'),
+     "tensor"),
+])
+def test_bad_input_is_one_line_exit_2_and_no_file(tmp_path, capsys, edit, words):
+    (tmp_path / "bad.toml").write_text(edit(CHAIN.format(support="fixed", K="1.0", C1=0.09, w1=30.0)))
+    code = main(["atlas", str(tmp_path / "bad.toml"), "-o", str(tmp_path / "bad.nc")])
     err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and len(err) == 1 and "one liquid model" in err[0]
-    assert not list(tmp_path.glob("mixed.nc*"))
+    assert code == 2 and len(err) == 1 and words in err[0]
+    assert not list(tmp_path.glob("bad.nc*"))
 
 
 # ------------------------------------------------------------------------------------------------ the pipeline
