@@ -110,6 +110,8 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
     lsum = 0
     for k in range(n):
         for l in range(nmodes[k]):
+            if beta[0, k, l] == 0.0 and beta[1, k, l] == 0.0:
+                continue  # kappa = 2: no pole (pencil._liquid_real); its zero of prod Q is among the m exact zero roots
             feat[nr + lsum] = -beta[0, k, l]
             lsum += 1
     roots = np.sort(feat[:nr])

@@ -53,7 +53,8 @@ def _to_ball(x):
 def prepare(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
     """Fill ``ws`` for one point; ``reuse``: M T and K T are those of the previous point.
 
-    Returns the number m of exact zero roots (columns of K T that are exactly zero).
+    Returns the number m of exact zero roots: columns of K T that are exactly zero, and modes with beta exactly 0
+    (kappa = 2, or omega_k = 0), each a factor z of prod Q with no pole in Phi (``_liquid_real``).
     """
     T, dd, sub, mat, vec, beta, cm, cr = ws
     n = body.shape[0]
@@ -71,6 +72,7 @@ def prepare(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
                     mat[a, k, parent[c]], mat[a + 1, k, parent[c]] = ball.radd(
                         mat[a, k, parent[c]], mat[a + 1, k, parent[c]], -mat[a - 6, k, c], mat[a - 5, k, c]
                     )
+    m = 0
     for k in range(n):
         vec[0, k], vec[1, k] = ball.rmul(body[k, 2], 0.0, body[k, 5], 0.0)
         sm, sr = 0.0, 0.0
@@ -79,13 +81,13 @@ def prepare(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
             # kappa - 2 exactly as a float pair, so beta is an exact zero when kappa == 2
             h, lo = two_sum(kappa[k, l], -2.0)
             t = ball.rmul(body[k, 5], 0.0, h, abs(lo))
-            if h == 0.0:
+            if h == 0.0 or body[k, 5] == 0.0:
                 beta[0, k, l], beta[1, k, l] = 0.0, 0.0
+                m += 1
             else:
                 beta[0, k, l], beta[1, k, l] = ball.rdiv(t[0], t[1], kappa[k, l], 0.0)
         vec[2, k], vec[3, k] = sm, sr
     # the exact zero roots: a column of K T that is exactly zero makes that column of Phi T divisible by z
-    m = 0
     for j in range(n):
         if not _column_nonzero(mat[2], mat[3], j):
             m += 1
@@ -102,15 +104,23 @@ def _column_nonzero(m, r, j):
 
 @kernel
 def _liquid_real(x, k, E, nmodes, beta):
-    """sum_l E_kl / (x + beta_kl) as a ball at real x; ok False if x may be a pole."""
-    am, ar = 0.0, 0.0
+    """(sum_l E_kl / (x + beta_kl) over the modes with beta_kl != 0, sum_l E_kl over those with beta_kl = 0) as
+    balls at real x; ok False if x may be a pole.
+
+    A mode with beta exactly 0 (kappa = 2, the sphere's) has no pole: its term x^2 (x + omega) E / x of Phi is
+    x (x + omega) E, and dividing by x near 0 would only lose the enclosure there, next to the exact zero roots.
+    """
+    am, ar, em, er = 0.0, 0.0, 0.0, 0.0
     for l in range(nmodes[k]):
+        if beta[0, k, l] == 0.0 and beta[1, k, l] == 0.0:
+            em, er = ball.radd(em, er, E[k, l], 0.0)
+            continue
         dm, dr = ball.radd(x, 0.0, beta[0, k, l], beta[1, k, l])
         if not ball.excludes_zero(dm, dr):
-            return am, ar, False
+            return am, ar, em, er, False
         qm, qr = ball.rdiv(E[k, l], 0.0, dm, dr)
         am, ar = ball.radd(am, ar, qm, qr)
-    return am, ar, True
+    return am, ar, em, er, True
 
 
 @kernel
@@ -125,15 +135,19 @@ def real_matrix(x, body, E, nmodes, parent, ws, Sm, Sr):
     n = body.shape[0]
     x2, x2r = ball.rmul(x, 0.0, x, 0.0)  # with ETA: x * x may underflow
     for k in range(n):
-        am, ar, ok = _liquid_real(x, k, E, nmodes, beta)
+        am, ar, em, er, ok = _liquid_real(x, k, E, nmodes, beta)
         if not ok:
             return False
-        # d_k = x G_k - x^2 (x + omega_k) a_k
+        # d_k = x G_k - x^2 (x + omega_k) a_k - x (x + omega_k) e_k   (e_k: the modes without a pole)
         wm, wr = ball.radd(x, 0.0, body[k, 5], 0.0)
         t = ball.rmul(x2, x2r, wm, wr)
         t = ball.rmul(t[0], t[1], am, ar)
         gm, gr = ball.rmul(x, 0.0, vec[0, k], vec[1, k])
         dm, dr = ball.radd(gm, gr, -t[0], t[1])
+        if em != 0.0:
+            t = ball.rmul(x, 0.0, wm, wr)
+            t = ball.rmul(t[0], t[1], em, er)
+            dm, dr = ball.radd(dm, dr, -t[0], t[1])
         for j in range(k + 1):
             m, r = ball.rmul(x2, x2r, mat[6, k, j], mat[7, k, j])
             m, r = ball.radd(m, r, -mat[8, k, j], mat[9, k, j])

@@ -2,6 +2,7 @@
 
     python scripts/bench_kernel.py            # degree 2..64 (n = 1..16) and n = 24, 32 (about 15 minutes)
     python scripts/bench_kernel.py --quick    # seconds; run once by the test suite
+    python scripts/bench_kernel.py --corners  # only the structural corners below (a few minutes)
 
 Point sets, for every (n, modes): random chains (realistic ranges, joints and
 liquid modes as given), each scanned along omega over a line of points in grid
@@ -11,6 +12,16 @@ before).  Kinds:
   identical  one random body repeated n times (exactly repeated roots);
   scattered  mixed bodies, every point a new random chain (no neighbours: the
              cost without warm starts).
+Structural corners (issue 32), each a modification of mixed chains that random draws never produce:
+  kappa2      kappa = 2 (the sphere's mode, beta = 0: a root at lambda = 0, no pole) in every other body;
+  sameshape   every body's cavity the same shape (kappa shared by all, E scaled per body);
+  someshape   the same shape in half of the bodies;
+  halfsame    the upper half of the chain identical bodies;
+  free        free chains;
+  omega0      lines through omega = 0 exactly;
+  ideal       every joint ideal (K = 0);
+  tinyE       E -> 0 (E scaled by 1e-9);
+  tree        a binary tree instead of a chain.
 stabmap: ``kernels.decide_block`` on one thread, then exact arithmetic for the
 points it leaves (timed on a sample, extrapolated); throughput on every core.
 Float peer: what a user would write, batched ``numpy.linalg.eigvals`` of the
@@ -85,8 +96,43 @@ def point_set(rng, kind: str, lines: int, per_line: int, n: int, modes: int) -> 
     return PointArrays(body, rep(base.joint), rep(base.g), rep(base.E), rep(base.kappa), base.nmodes, base.free)
 
 
+CORNERS = ("kappa2", "sameshape", "someshape", "halfsame", "free", "omega0", "ideal", "tinyE", "tree")
+
+
+def corner_set(rng, corner: str, lines: int, per_line: int, n: int, modes: int) -> PointArrays:
+    """Mixed chains scanned along omega, changed into one structural corner (module docstring)."""
+    pts = point_set(rng, "mixed", lines, per_line + (corner == "omega0" and per_line % 2 == 0), n, modes)
+    body, joint, E, kappa = pts.body, pts.joint, pts.E, pts.kappa
+    free, parent, at = False, None, None
+    h = n // 2
+    if corner == "kappa2" and modes:
+        kappa[:, ::2, 0] = 2.0
+    elif corner in ("sameshape", "someshape") and modes:
+        upto = n if corner == "sameshape" else max(h, 1)
+        kappa[:, :upto] = kappa[:, :1]
+        E[:, :upto] = E[:, :1] * rng.uniform(0.2, 2.0, (1, upto, 1))
+    elif corner == "halfsame":
+        for x in (body, E, kappa):
+            x[:, h:] = x[:, h : h + 1]
+        joint[:, h:] = joint[:, h : h + 1]
+    elif corner == "free":
+        free = True
+        joint[:, 0] = 0.0
+    elif corner == "ideal":
+        joint[:] = 0.0
+    elif corner == "tinyE":
+        E *= 1e-9
+    elif corner == "tree":
+        parent = np.array([-1] + [(k - 1) // 2 for k in range(1, n)], dtype=np.int64)
+        at = np.zeros(body.shape[:2])
+        at[:, 1:] = rng.uniform(-0.2, 0.6, (1, n - 1))
+    # omega0: per_line made odd, so the line's linspace(-150, 150) passes through omega = 0 exactly
+    return PointArrays(body, joint, pts.g, E, kappa, pts.nmodes, free, parent, at)
+
+
 def _subset(pts: PointArrays, sl) -> PointArrays:
-    return PointArrays(pts.body[sl], pts.joint[sl], pts.g[sl], pts.E[sl], pts.kappa[sl], pts.nmodes, pts.free)
+    return PointArrays(pts.body[sl], pts.joint[sl], pts.g[sl], pts.E[sl], pts.kappa[sl], pts.nmodes, pts.free, pts.parent,
+                       pts.at[sl])
 
 
 def decide_threads(pts: PointArrays, threads: int):
@@ -126,7 +172,7 @@ def float_peer(pts: PointArrays) -> tuple[np.ndarray, float]:
 
 def run(n: int, modes: int, kind: str, lines: int, per_line: int, rng) -> dict:
     degree = n * (2 + modes)
-    pts = point_set(rng, kind, lines, per_line, n, modes)
+    pts = corner_set(rng, kind, lines, per_line, n, modes) if kind in CORNERS else point_set(rng, kind, lines, per_line, n, modes)
     npts = pts.body.shape[0]
     threads = os.cpu_count() or 1
     decide_threads(_subset(pts, slice(0, 4)), 1)  # compile outside the timed calls
@@ -155,10 +201,14 @@ def run(n: int, modes: int, kind: str, lines: int, per_line: int, rng) -> dict:
     }
 
 
-def cases(quick: bool, max_degree: int):
+def cases(quick: bool, max_degree: int, corners: bool = False):
     """(n, modes, kind, lines, points per line) of every row."""
     if quick:
-        return [(n, m, k, 2, 12) for n, m in ((1, 0), (2, 1), (3, 2)) for k in ("mixed", "identical")]
+        return [(n, m, k, 2, 12) for n, m in ((1, 0), (2, 1), (3, 2)) for k in ("mixed", "identical")] + [
+            (3, 2, c, 1, 6) for c in CORNERS]
+    corner_rows = [(n, m, c, 10, 50) for n, m in ((3, 2), (6, 3), (8, 3)) for c in CORNERS]
+    if corners:
+        return corner_rows
     ladder = [(1, 0), (2, 1), (3, 2), (4, 2), (6, 2), (6, 4), (8, 4), (12, 3), (16, 2)]
     out = []
     for n, m in ladder:
@@ -169,7 +219,7 @@ def cases(quick: bool, max_degree: int):
         if (n, m) in ((3, 2), (6, 4), (8, 4)):
             out.append((n, m, "scattered", lines, per))
     out += [(24, 0, "mixed", 2, 20), (32, 0, "mixed", 2, 20), (32, 1, "mixed", 1, 10)]
-    return [c for c in out if c[0] * (2 + c[1]) <= max_degree]
+    return [c for c in out + corner_rows if c[0] * (2 + c[1]) <= max_degree]
 
 
 HEADER = (
@@ -182,13 +232,14 @@ def main(argv=None) -> list[dict]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="tiny sizes, for the test suite")
     ap.add_argument("--max-degree", type=int, default=96, help="skip larger (n, modes) cases")
+    ap.add_argument("--corners", action="store_true", help="only the structural corners (module docstring)")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(2026)
     print(f"# machine: {os.cpu_count()} cores, {platform.processor() or platform.machine()}, python {platform.python_version()}")
     print(HEADER)
     print("|" + "---|" * (HEADER.count("|") - 1))
     rows = []
-    for n, modes, kind, lines, per in cases(args.quick, args.max_degree):
+    for n, modes, kind, lines, per in cases(args.quick, args.max_degree, args.corners):
         r = run(n, modes, kind, lines, per, rng)
         rows.append(r)
         shares = ", ".join(f"{name} {v:.1f}" for name, v in r["shares"].items() if v)

@@ -12,7 +12,9 @@ SCRIPTS = pathlib.Path(__file__).resolve().parents[1] / "scripts"
 
 def test_bench_kernel_quick(capsys):
     rows = runpy.run_path(str(SCRIPTS / "bench_kernel.py"))["main"](["--quick"])
-    assert [(r["degree"], r["kind"]) for r in rows] == [(d, k) for d in (2, 6, 12) for k in ("mixed", "identical")]
+    corners = runpy.run_path(str(SCRIPTS / "bench_kernel.py"))["CORNERS"]
+    assert [(r["degree"], r["kind"]) for r in rows] == [(d, k) for d in (2, 6, 12) for k in ("mixed", "identical")] + [
+        (12, c) for c in corners]
     for r in rows:
         assert r["pts_per_s_1"] > 0 and r["peer_us"] > 0
         assert abs(sum(r["shares"].values()) - 100) < 1e-9
