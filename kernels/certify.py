@@ -144,6 +144,8 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
                 near = min(near, x - roots[k - 1])
             fence = near < RIDE * abs(x)
             eps = FENCE * abs(x) + 1e-300
+            if near < 2.0 * eps:  # a root inside the fence (a tiny E): the fence between them, if floats can tell
+                eps = max(0.5 * near, 64.0 * 2.0**-52 * abs(x)) + 1e-300
             j += 1
         else:
             fence = m > 0 and x == 0.0
