@@ -73,22 +73,25 @@ def char_matrix(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=No
         rows.append((betas, [_q(E[k][l]) for l in range(int(nmodes[k]))]))
     degree = sum(2 + len(b) for b, _ in rows)
 
+    Mm, Km = flint.fmpq_mat(M), flint.fmpq_mat(Kmat)
+    spin = [C[k] * w[k] for k in range(n)]
+
     def P(x: flint.fmpq) -> flint.fmpq_mat:
-        """diag(Q) Phi at lambda = x, a rational matrix."""
-        out = flint.fmpq_mat(n, n)
+        """diag(Q) Phi at lambda = x, a rational matrix: diag(Q) (x^2 M - K) + diag(x C w Q - x^2 (x + w) R), the
+        matrix products in FLINT (a Python loop over the n^2 entries cost most of the exact path)."""
+        scale = flint.fmpq_mat(n, n)
+        extra = []
         for k, (betas, Es) in enumerate(rows):
             Q = flint.fmpq(1)
             R = zero
             for beta, e in zip(betas, Es):
                 R = R * (x + beta) + e * Q
                 Q = Q * (x + beta)
-            for j in range(n):
-                v = x * x * M[k][j] - Kmat[k][j]
-                if j == k:
-                    v = (v + x * C[k] * w[k]) * Q - x * x * (x + w[k]) * R
-                else:
-                    v *= Q
-                out[k, j] = v
+            scale[k, k] = Q
+            extra.append(x * spin[k] * Q - x * x * (x + w[k]) * R)
+        out = scale * (Mm * (x * x) - Km)
+        for k in range(n):
+            out[k, k] += extra[k]
         return out
 
     return P, degree
