@@ -22,6 +22,14 @@ from .status import DECIDED_FLOAT, ZERO_POLYNOMIAL, UNDECIDED
 
 
 @kernel
+def _discriminant(a0, a1, a2):
+    """An enclosure of a1^2 - 4 a0 a2 for intervals (hi, lo, rad); ``certain_nonzero`` refuses one out of range."""
+    sq = dd.mul(a1[0], a1[1], a1[2], a1[0], a1[1], a1[2])
+    ac = dd.mul(a0[0], a0[1], a0[2], a2[0], a2[1], a2[2])
+    return dd.add(*sq, *dd.neg(*dd.mul(*ac, 4.0, 0.0, 0.0)))
+
+
+@kernel
 def count_complex_pairs(c, W):
     """Number of complex-conjugate root pairs of p from an interval enclosure.
 
@@ -45,6 +53,11 @@ def count_complex_pairs(c, W):
         return -1, UNDECIDED
     real = z  # exact zeros at the bottom are lambda = 0 roots
     d = top - z
+    if d == 2:  # one top, or a chain's quadratic factor: the discriminant's sign is the whole count
+        disc = _discriminant(c[z], c[z + 1], c[top])
+        if dd.certain_nonzero(*disc):
+            real += 2 if disc[0] > 0 else 0
+            return (top - real) // 2, DECIDED_FLOAT
     a, b = 0, 1
     A = W[a]
     A[: d + 1] = c[z : top + 1]

@@ -191,3 +191,31 @@ def test_reused_inertia_and_stiffness_give_the_same_labels():
         kernels.count_block(*one.kernel_args(), nc1, st1)
         assert (nc[p], st[p]) == (nc1[0], st1[0])
     assert len(set(nc.tolist())) > 1
+
+
+def test_a_quadratic_is_counted_by_its_discriminant_exactly_near_zero():
+    """Degree 2 (one top, or what is left above exact zero roots): the Sturm kernel proves the discriminant's sign,
+    never a float guess. Quadratics with a1^2 - 4 a0 a2 within a few ulps of 0, either side, against exact."""
+    from fractions import Fraction
+
+    import numpy as np
+
+    from stabmap.kernels import sturm
+    from stabmap.kernels.status import DECIDED_FLOAT
+
+    rng = random.Random(31)
+    W = np.empty((2, 3, 3))
+    decided = 0
+    for _ in range(400):
+        a2 = rng.uniform(0.01, 5.0)
+        a0 = rng.uniform(0.01, 5.0)
+        a1 = (4 * a0 * a2) ** 0.5 * (1 + rng.choice([-1, 1]) * rng.choice([0.0, 2.0**-52, 2.0**-50, 1e-12, 1e-6]))
+        z = rng.randint(0, 2)  # exact zero roots below
+        c = np.zeros((z + 3, 3))
+        c[z:, 0] = (a0, a1, a2)
+        nc, status = sturm.count_complex_pairs(c, W)
+        disc = Fraction(a1) ** 2 - 4 * Fraction(a0) * Fraction(a2)
+        if status == DECIDED_FLOAT:
+            decided += 1
+            assert nc == (1 if disc < 0 else 0), (a0, a1, a2, disc)
+    assert decided > 250  # the near-zero discriminants are left to exact arithmetic, the rest proved
