@@ -200,6 +200,20 @@ def _snap_real(X, d, z):
 
 
 @kernel
+def group_disks(z, R, d, parent):
+    """Join the disks |lambda - z_i| <= R_i (i < d) that meet, the test rounded outward, into the union-find
+    forest ``parent``: a connected group of k disks that meets no other holds exactly k roots."""
+    for i in range(d):
+        parent[i] = i
+    for i in range(d):
+        for j in range(i + 1, d):
+            if abs(z[i] - z[j]) * (1.0 - 4.0 * dd.U) <= (R[i] + R[j]) * (1.0 + 2.0 * dd.U):
+                ri, rj = find_root(parent, i), find_root(parent, j)
+                if ri != rj:
+                    parent[ri] = rj
+
+
+@kernel
 def find_root(parent, i):
     """The representative of i in the union-find forest ``parent`` (with path halving)."""
     while parent[i] != i:
@@ -275,14 +289,7 @@ def count_complex_pairs_inclusion(X, d, a, z, R, group, flags):
     if not disk_radii(X, d, z, R):
         return -1, UNDECIDED
     parent, size = group[:d], group[d : 2 * d]
-    for i in range(d):
-        parent[i] = i
-    for i in range(d):
-        for j in range(i + 1, d):
-            if abs(z[i] - z[j]) * (1.0 - 4.0 * dd.U) <= (R[i] + R[j]) * (1.0 + 2.0 * dd.U):
-                ri, rj = find_root(parent, i), find_root(parent, j)
-                if ri != rj:
-                    parent[ri] = rj
+    group_disks(z, R, d, parent)
     size[:] = 0
     flags[:d] = False  # flags[r]: the group with representative r meets the real axis
     for i in range(d):

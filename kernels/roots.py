@@ -22,7 +22,7 @@ import numpy as np
 from . import dd
 from .block import LAPLACE_MAX
 from .charpoly import allocate, charpoly_point, same_structure
-from .inclusion import approximate, disk_radii, find_root
+from .inclusion import approximate, disk_radii, find_root, group_disks
 from .options import kernel
 from .scaling import nonzero_span, rescale, root_scale
 
@@ -101,14 +101,7 @@ def _point(c, X, a, z, R, group, flags, oz, orad, okind, orate):
     elif not (approximate(X, d, a, z, flags) and disk_radii(X, d, z, R)):
         return ROOTS_FAILED
 
-    for i in range(d):
-        group[i] = i
-    for i in range(d):
-        for j in range(i + 1, d):
-            if abs(z[i] - z[j]) * (1.0 - 4.0 * dd.U) <= (R[i] + R[j]) * (1.0 + 2.0 * dd.U):
-                ri, rj = find_root(group, i), find_root(group, j)
-                if ri != rj:
-                    group[ri] = rj
+    group_disks(z, R, d, group)
     # back to lambda = 2**shift mu: exact scalings, unless they overflow (then no enclosure)
     for i in range(d):
         zi = complex(math.ldexp(z[i].real, shift), math.ldexp(z[i].imag, shift))
