@@ -54,7 +54,8 @@ def rates(points: PointArrays, nc: np.ndarray, growth: bool = True, frequencies:
         kind[todo] = np.take_along_axis(k, order, 1)
     out = {}
     if growth:
-        lo32, hi32 = _outward(lower, upper)
+        lo32, hi32 = outward_float32(lower, upper)
+        lo32 = np.maximum(lo32, np.float32(0))  # |Im lambda| >= 0
         rate32 = np.clip(best.astype(np.float32), lo32, hi32)
         with np.errstate(divide="ignore"):
             efold = np.where(rate32 == 0, np.float32(np.inf), np.float32(1) / rate32).astype(np.float32)
@@ -103,30 +104,32 @@ def exact_roots(points: PointArrays, p: int, D: int) -> tuple[np.ndarray, np.nda
             z[i] = complex(float(root.real.mid()), float(root.imag.mid()))
             # the arb radii, and the rounding of its midpoints to the floats stored
             spill = (abs(root.real.mid()) + abs(root.imag.mid())) * flint.arb(2.0**-52)
-            r[i] = _up(flint.arb(root.real.rad()) + flint.arb(root.imag.rad()) + spill)
+            r[i] = up(flint.arb(root.real.rad()) + flint.arb(root.imag.rad()) + spill)
             k[i] = REAL if root.imag.is_zero() else NONREAL
             i += 1
         rate[0] = max(rate[0], float(im.mid()))
-        rate[2] = max(rate[2], _up(im))
+        rate[2] = max(rate[2], up(im))
         if not root.imag.is_zero():
-            rate[1] = max(rate[1], max(0.0, _down(im)))
+            rate[1] = max(rate[1], max(0.0, down(im)))
     return z, r, k, rate
 
 
-def _up(x: flint.arb) -> float:
+def up(x: flint.arb) -> float:
+    """A float >= every point of the arb ball x."""
     return float(np.nextafter(float(x.upper()), np.inf))
 
 
-def _down(x: flint.arb) -> float:
+def down(x: flint.arb) -> float:
+    """A float <= every point of the arb ball x."""
     return float(np.nextafter(float(x.lower()), -np.inf))
 
 
-def _outward(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def outward_float32(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """float32 bounds that hold the float64 ones: each rounded away from the enclosed value where float32 rounds in."""
     lo, hi = lower.astype(np.float32), upper.astype(np.float32)
     lo = np.where(lo.astype(np.float64) > lower, np.nextafter(lo, np.float32(-np.inf)), lo)
     hi = np.where(hi.astype(np.float64) < upper, np.nextafter(hi, np.float32(np.inf)), hi)
-    return np.maximum(lo, np.float32(0)), hi
+    return lo, hi
 
 
 def _roots(points: PointArrays, D: int):
@@ -140,4 +143,4 @@ def _roots(points: PointArrays, D: int):
     return z, r, k, rate, status
 
 
-__all__ = ["rates", "not_computed", "exact_roots"]
+__all__ = ["rates", "not_computed", "exact_roots", "up", "down", "outward_float32"]

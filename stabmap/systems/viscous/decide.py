@@ -21,6 +21,7 @@ from ..gyroscopes import exact, ratios, stokes, topology
 from ..gyroscopes.decide import decide as decide_frozen
 from ..gyroscopes.decide import kernel_args
 from ..gyroscopes.points import PointArrays, point_arrays
+from ..gyroscopes.rates import down, outward_float32, up
 from ..gyroscopes.rates import rates as frozen_rates
 from .outputs import ASYMPTOTICALLY_STABLE, BY, DEGENERATE, UNDECIDED, UNSTABLE
 
@@ -92,7 +93,8 @@ def _gravity_free_columns(body, at, parent, ideal) -> int:
 
 
 def evaluate(scene, values: dict) -> dict[str, np.ndarray]:
-    """Every variable of ``outputs.ALL_VARIABLES`` at the points ``values`` (flat arrays)."""
+    """Every variable of ``outputs.ALL_VARIABLES`` at the points ``values`` (flat arrays); where the frozen chain is
+    unstable its growth rates are computed only if the scene stores them (``growth_rate``), NaN otherwise."""
     points = point_arrays(scene, values)
     npts, D = points.body.shape[0], int((points.nmodes + 2).sum())
     eps, eps_r, liquid, reynolds = dissipation(scene, values, points)
@@ -103,7 +105,7 @@ def evaluate(scene, values: dict) -> dict[str, np.ndarray]:
     label[nc < 0], by[nc < 0] = DEGENERATE, BY["degenerate"]
     unstable = np.flatnonzero(nc > 0)
     label[unstable], by[unstable] = UNSTABLE, BY["frozen_chain_unstable"]
-    if unstable.size:
+    if unstable.size and scene.growth_rate:  # the frozen chain's rates only for a scene that stores them
         grown = frozen_rates(points.take(unstable), nc[unstable], growth=True)
         rate["best"][unstable], rate["lower"][unstable], rate["upper"][unstable] = (
             grown["growth_rate"], grown["growth_rate_lower"], grown["growth_rate_upper"])
@@ -146,8 +148,9 @@ def _put(row, sig, sig_r, freq, label, by, rate, method) -> None:
     label[row] = UNSTABLE if np.any(sig - sig_r > 0) else ASYMPTOTICALLY_STABLE
     by[row] = method
     rate["best"][row] = sig[top]
-    rate["lower"][row] = float(np.max(sig - sig_r))
-    rate["upper"][row] = float(np.max(sig + sig_r))
+    # mid -+ radius rounds to nearest: one step outward keeps the enclosure
+    rate["lower"][row] = float(np.max(np.nextafter(sig - sig_r, -np.inf)))
+    rate["upper"][row] = float(np.max(np.nextafter(sig + sig_r, np.inf)))
     rate["frequency"][row] = freq[top]
 
 
@@ -185,7 +188,7 @@ def _exact(points, i, eps, eps_r, liquid, zeros, row, label, by, rate) -> None:
                 open_.append("multiple_root" if mult > 1 else "zero_rate")
                 continue
             mid = float(s.mid())
-            lo, hi = np.nextafter(float(s.lower()), -np.inf), np.nextafter(float(s.upper()), np.inf)
+            lo, hi = down(s), up(s)
             sig.append(mid)
             sig_r.append(max(mid - lo, hi - mid) * (1.0 + 4.0 * U))
             freq.append(float(x.mid()))
@@ -227,9 +230,7 @@ def _split(p, x, q, mult: int):
 
 
 def _rate_variables(rate: dict) -> dict[str, np.ndarray]:
-    lo, hi = rate["lower"].astype(np.float32), rate["upper"].astype(np.float32)
-    lo = np.where(lo.astype(np.float64) > rate["lower"], np.nextafter(lo, np.float32(-np.inf)), lo)
-    hi = np.where(hi.astype(np.float64) < rate["upper"], np.nextafter(hi, np.float32(np.inf)), hi)
+    lo, hi = outward_float32(rate["lower"], rate["upper"])
     best = np.clip(rate["best"].astype(np.float32), lo, hi)
     with np.errstate(divide="ignore"):
         tau = (np.float32(1) / np.abs(best)).astype(np.float32)
