@@ -8,6 +8,7 @@ from . import certify, dd, pencil
 from .boxcount import middle
 from .charpoly import allocate, block_det, charpoly_point, diagonal_blocks, matrix_box, matrix_point, same_structure
 from .count import allocate_count, count_box, count_nodes, count_point, fails_at_nodes
+from .onetop import one_top
 from .options import kernel
 from .status import DECIDED_FLOAT, DECIDED_INCLUSION, UNDECIDED, ZERO_POLYNOMIAL
 
@@ -108,7 +109,8 @@ def _count_matrix(ws, rowdeg, c, cs, starts, inclusion, box):
 def decide_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out_status):
     """N_c of a block of points by whichever certificate proves it fastest.
 
-    Inputs and outputs as for ``count_block``.  Up to degree ``STURM_FIRST``
+    Inputs and outputs as for ``count_block``.  One body without modes goes
+    first through a float filter with a proved error bound (``onetop``).  Up to degree ``STURM_FIRST``
     the interval Sturm sequence on the coefficients is the cheapest proof
     (scripts/bench_kernel.py), so it goes first; then the certificates of
     ``certify``; then root inclusion on the coefficients, up to ``LAPLACE_MAX``
@@ -127,11 +129,17 @@ def decide_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out
     starts = np.empty(n + 1, np.int64)
     coefficients_last = -1  # the last point whose M and K the coefficient path built
     certified_last = -1  # and the certificate
+    top = n == 1 and nmodes[0] == 0
     for p in range(npts):
+        if top:  # a float filter with a proved error bound decides almost every one-top point (onetop.py)
+            out_nc[p], out_status[p] = one_top(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, free)
+            if out_status[p] != UNDECIDED:
+                continue
         reuse = same_structure(body, joint, at, g, p)
         nc, st = -1, UNDECIDED
         if sturm_first:
-            nc, st = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, reuse, False)
+            again = reuse and coefficients_last == p - 1
+            nc, st = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, again, False)
             coefficients_last = p
         if st == UNDECIDED:
             # M and K in the certificate's workspace are those of the last point it saw

@@ -171,3 +171,11 @@ def test_viscous_figure_quick(tmp_path, capsys):
     # the curves drawn on the figure are the maps' boundaries: Maievskii's for the ideal liquid, (C - A') omega^2 > m g c
     assert out["ideal_off_closed_form"] == 0 and out["viscous_off_closed_form"] == 0
     assert out["lost"] > 0 and out["undecided"] == 0 and out["re_max"] < 1
+
+
+def test_bench_onetop_quick():
+    rows = runpy.run_path(str(SCRIPTS / "bench_onetop.py"))["main"](quick=True)
+    assert len(rows) == 5
+    for row in rows[2:]:
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert cells[2] == "1000" and cells[-1] == "0"  # every random top proved by the filter or the kernels
