@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import approximations, disks, elimination, pencil
+from . import approximations, ball, disks, elimination, pencil
 from .approximations import RIDE
 from .options import kernel
 from .status import DECIDED_DISKS, DECIDED_INERTIA, UNDECIDED
@@ -53,7 +53,7 @@ def allocate(n, nmodes, parent):
     """Scratch for ``certify_point`` (one block)."""
     lmax = max(1, nmodes.max())
     degree = int((nmodes + 2).sum())
-    nfeat = 2 * degree + 3 * int(nmodes.sum()) + 6  # roots, poles, then the separators
+    nfeat = 2 * degree + 4 * int(nmodes.sum()) + 8  # roots, poles, then the separators
     pws = pencil.allocate(n, lmax, parent)
     C = np.empty((degree, degree))
     Mo = np.empty((n, n))
@@ -89,12 +89,14 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
 
     Neighbouring features (approximations that may be real, within NUDGE of
     the axis, and poles) get a separator midway; poles with such an
-    approximation close by, and the exact zero roots, are fenced by
-    separators just either side instead.  So a root that moved past a pole
-    since z was found is still counted; where nu changes
+    approximation close by, and the exact zero roots, are also fenced by
+    separators just either side.  So a root that moved past a pole
+    since z was found is still counted; where a fence cannot be evaluated,
+    the sign change of p between the midway separators still proves a root
+    beside its pole (``_sign_of_p``).  Where nu changes
     less across an interval than the near-real roots and poles inside it, the
     approximations inside are marked in ``suspect``: polishing them is usually
-    all a retry needs.  ``feat`` needs 2 degree + 3 sum L + 6 entries.
+    all a retry needs.  ``feat`` needs 2 degree + 4 sum L + 8 entries.
     """
     n = body.shape[0]
     beta = pws[5]
@@ -129,7 +131,7 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
     sep[0] = lo - pad
     ns = 1
     i, j = 0, 0
-    last, last_fenced, started = 0.0, False, False
+    last, started = 0.0, False
     while i < nr or j < lsum:
         pole = j < lsum and (i >= nr or poles[j] < roots[i])
         x = poles[j] if pole else roots[i]
@@ -151,20 +153,23 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
             fence = m > 0 and x == 0.0
             eps = zero_eps
             i += 1
+        # midway between neighbours even beside a fence: where a fence cannot be evaluated (a root within a few
+        # hundred ulps of its pole), the pole and that root still get an interval of their own, whose sign change
+        # of p proves the root
+        if started and x - last > MERGE * max(abs(x), abs(last)):
+            sep[ns] = 0.5 * (x + last)
+            ns += 1
         if fence:
             sep[ns] = x - eps
             sep[ns + 1] = x + eps
             ns += 2
-        elif started and not last_fenced and x - last > MERGE * max(abs(x), abs(last)):
-            sep[ns] = 0.5 * (x + last)
-            ns += 1
-        last, last_fenced, started = x, fence, True
+        last, started = x, True
     sep[ns] = hi + pad
     ns += 1
     # the count below needs increasing separators (a fence may lie beyond a neighbouring root)
     sep[:ns].sort()
     suspect[:d] = False
-    total, last, prev = 0, -1, 0.0
+    total, last, prev, sign_last = 0, -1, 0.0, 0
     for s in range(ns):
         x = sep[s]
         if not pencil.real_matrix(x, body, E, nmodes, parent, pws, Sm, Sr):
@@ -172,12 +177,17 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
         nu = elimination.inertia(Sm, Sr, n)
         if nu < 0:
             continue
+        sign = _sign_of_p(x, nu, beta, nmodes, n)
         if last >= 0:
             # roots of p in (prev, x) >= |jump| - poles inside (and >= m around the zero roots)
             inside = 0
             for t in range(lsum):
                 inside += prev < poles[t] < x
             here = max(abs(nu - last) - inside, 0)
+            if sign * sign_last < 0:
+                # p changes sign: at least one root, though a pole's jump may cancel the root's in nu (a tiny E
+                # puts a root within a few hundred ulps of its pole, too close for a separator between them)
+                here = max(here, 1)
             expected = 0
             for i in range(d):
                 if prev < z[i].real < x and abs(z[i].imag) <= NEAR_REAL * abs(z[i]):
@@ -190,8 +200,27 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
                 for i in range(d):
                     if prev < z[i].real < x:
                         suspect[i] = True
-        last, prev = nu, x
+        last, prev, sign_last = nu, x, sign
     return total
+
+
+@kernel
+def _sign_of_p(x, nu, beta, nmodes, n):
+    """Sign of p(x) = det Phi(x) prod (x + beta_kl) at a separator where Phi(x) has nu negative eigenvalues, else 0.
+
+    Phi(x) is proved nonsingular there, so det Phi(x) has the sign (-1)^nu; ``real_matrix`` succeeded, so every
+    ball x + beta_kl with beta_kl != 0 excludes 0 and its midpoint has its sign (the same balls are formed here).
+    A mode with beta exactly 0 contributes the factor x (0 at x = 0: sign unknown).
+    """
+    sign = -1 if nu % 2 else 1
+    for k in range(n):
+        for l in range(nmodes[k]):
+            tm, tr = ball.radd(x, 0.0, beta[0, k, l], beta[1, k, l])
+            if not ball.excludes_zero(tm, tr):
+                return 0
+            if tm < 0.0:
+                sign = -sign
+    return sign
 
 
 @kernel
