@@ -1,0 +1,146 @@
+"""The exact path's fast count: root inclusion disks from ball values of det A(z), no exact polynomial.
+
+A(x) = sum_t coefs[t] x^t is diag(Q) Phi with its rows cleared of denominators (``exact.int_matrix``), so
+p = det A / den.  Approximations z_1 .. z_d of the roots of det A come from the eigenvalues of a block
+companion matrix of A in floats (numpy); they only place the disks.  The proof is section 3's theorem
+(docs/certification.md): with a the exact leading coefficient of det A (an integer determinant) and
+
+    W_i = det A(z_i) / (a prod_{j != i} (z_i - z_j)),
+
+every disk |lambda - z_i| <= d |W_i| that meets no other disk holds exactly one root; such a disk centred on the
+real axis holds a real root, one that misses the axis a non-real root.  det A(z_i) and the products are Arb
+balls (python-flint) at ``PREC`` bits from the exact integer coefficients, so each W_i encloses the true
+value.  Whenever a disk meets another or a non-real disk meets the axis (close or repeated roots, poor
+approximations), ``count`` returns None and the caller takes the exact polynomial (``exact.complex_pairs``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import flint
+import numpy as np
+
+PREC = 128  # bits of the balls: det A(z_i) at a simple root's float approximation needs ~60 above the noise
+SAFE = 1.0 + 2.0**-40  # float distances and radii are rounded outward by far more than their few-ulp errors
+
+
+def count(coefs: list, degrees: list) -> int | None:
+    """Real roots of det(sum_t coefs[t] x^t) with multiplicity, or None where the disks do not prove it.
+
+    ``coefs``: integer n x n matrices (``flint.fmpz_mat``); ``degrees[k]``: the degree bound of row k.  The
+    count is proved only when the x^sum(degrees) coefficient a of the determinant is nonzero, so the degree
+    is exactly d = sum(degrees) and all d roots sit in the d disks (after the rows' factors x, ``_deflate``).
+    """
+    coefs, degrees, zeros = _deflate(coefs, degrees)
+    d = sum(degrees)
+    if d == 0:
+        return zeros
+    lead = _lead(coefs, degrees)
+    a = lead.det()
+    if a == 0:
+        return None
+    z = _approximations(coefs, degrees, lead)
+    if z is None:
+        return None
+    radius = _radii(coefs, a, z, d)
+    if radius is None:
+        return None
+    real = z.imag == 0.0
+    # A non-real disk must miss the axis; every pair of disks must be apart.
+    if np.any(~real & (np.abs(z.imag) * (1.0 - 2.0**-50) <= radius)):
+        return None
+    gap = np.abs(z[:, None] - z[None, :]) / SAFE
+    reach = (radius[:, None] + radius[None, :]) * SAFE
+    np.fill_diagonal(gap, np.inf)
+    if np.any(gap <= reach):
+        return None
+    return zeros + int(np.count_nonzero(real))
+
+
+def _deflate(coefs: list, degrees: list):
+    """(coefs, degrees, zeros): every row whose entries all vanish at x = 0 divided by x, as often as it goes.
+
+    det A = x^zeros det A'; a liquid mode with beta = 0 (kappa = 2, or omega = 0) puts the factor x in its
+    body's whole row, and a root exactly at 0 would otherwise sit under a disk it cannot be told apart from.
+    """
+    coefs = [c for c in coefs]
+    degrees = list(degrees)
+    n, zeros = coefs[0].nrows(), 0
+    for k in range(n):
+        while degrees[k] > 0 and all(coefs[0][k, j] == 0 for j in range(n)):
+            coefs = [flint.fmpz_mat(c) for c in coefs]  # copies: the caller's matrices stay as they were
+            for t in range(len(coefs) - 1):
+                for j in range(n):
+                    coefs[t][k, j] = coefs[t + 1][k, j]
+            for j in range(n):
+                coefs[-1][k, j] = 0
+            degrees[k] -= 1
+            zeros += 1
+    return coefs, degrees, zeros
+
+
+def _lead(coefs: list, degrees: list) -> flint.fmpz_mat:
+    """Row k's coefficient of x^degrees[k]: det of it is the x^d coefficient of det A."""
+    n = coefs[0].nrows()
+    out = flint.fmpz_mat(n, n)
+    for k, m in enumerate(degrees):
+        if m < len(coefs):
+            for j in range(n):
+                out[k, j] = coefs[m][k, j]
+    return out
+
+
+def _approximations(coefs: list, degrees: list, lead: flint.fmpz_mat) -> np.ndarray | None:
+    """d float approximations: eigenvalues of the block companion of A with row k shifted by x^(m - degrees[k]).
+
+    The shifts add sum(m - degrees[k]) roots at 0 to the padded determinant; that many eigenvalues of
+    smallest modulus are dropped.  Rows are scaled by powers of two (roots unchanged) so the floats stay in range.
+    """
+    n, m = coefs[0].nrows(), max(degrees)
+    shift = [m - dk for dk in degrees]
+    F = np.zeros((m + 1, n, n))
+    for k in range(n):
+        row = [[int(coefs[t][k, j]) if 0 <= t < len(coefs) else 0 for j in range(n)] for t in range(-shift[k], m + 1 - shift[k])]
+        bits = max((abs(v).bit_length() for r in row for v in r), default=0)
+        if bits == 0:
+            return None
+        scale = 1 << max(bits - 60, 0)
+        for t, r in enumerate(row):
+            F[t, k] = [v / scale for v in r]
+    try:
+        X = np.linalg.solve(F[m], np.concatenate(F[:m], axis=1))
+    except np.linalg.LinAlgError:
+        return None
+    C = np.zeros((n * m, n * m))
+    C[: n * (m - 1), n:] = np.eye(n * (m - 1))
+    C[n * (m - 1):] = -X
+    with np.errstate(all="ignore"):
+        z = np.linalg.eigvals(C)
+    if not np.all(np.isfinite(z)):
+        return None
+    drop = sum(shift)
+    z = z[np.argsort(np.abs(z), kind="stable")][drop:] if drop else z
+    return z.astype(complex)
+
+
+def _radii(coefs: list, a, z: np.ndarray, d: int) -> np.ndarray | None:
+    """d |W_i| rounded up to floats, from Arb balls; None where a ball is not finite or divides by zero."""
+    old = flint.ctx.prec
+    flint.ctx.prec = PREC
+    try:
+        mats = [flint.acb_mat(c) for c in coefs]
+        pts = [flint.acb(float(x.real), float(x.imag)) for x in z]
+        prods = flint.acb_poly.from_roots(pts).derivative().evaluate(pts, algorithm="iter")
+        out = np.empty(len(pts))
+        for i, x in enumerate(pts):
+            val = mats[-1]
+            for c in mats[-2::-1]:
+                val = val * x + c
+            w = val.det() / (prods[i] * a)
+            if not w.is_finite():
+                return None
+            out[i] = math.nextafter(float((w.abs_upper() * d).upper()), math.inf)
+    finally:
+        flint.ctx.prec = old
+    return out if np.all(np.isfinite(out)) else None
