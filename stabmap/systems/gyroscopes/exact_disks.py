@@ -22,6 +22,7 @@ import flint
 import numpy as np
 
 PREC = 128  # bits of the balls: det A(z_i) at a simple root's float approximation needs ~60 above the noise
+REFINE = 4  # Weierstrass steps in balls when the float disks do not separate; a cluster converges slowly (linearly)
 SAFE = 1.0 + 2.0**-40  # float distances and radii are rounded outward by far more than their few-ulp errors
 
 
@@ -40,22 +41,70 @@ def count(coefs: list, degrees: list) -> int | None:
     a = lead.det()
     if a == 0:
         return None
-    z = _approximations(coefs, degrees, lead)
+    z = _approximations(coefs, degrees)
     if z is None:
         return None
-    radius = _radii(coefs, a, z, d)
-    if radius is None:
+    old = flint.ctx.prec
+    flint.ctx.prec = PREC
+    try:
+        mats = [flint.acb_mat(c) for c in coefs]
+        centres = [flint.acb(float(x.real), float(x.imag)) for x in z]
+        for step in range(REFINE + 1):
+            W = _corrections(mats, a, centres)
+            if W is None:
+                return None
+            real = _real_if_separated(centres, W, d)
+            if real is not None:
+                return zeros + real
+            # A Weierstrass (Durand-Kerner) step on the midpoints.  The first one also tilts every centre off the
+            # axis by 2^-30 of itself: real approximations of a cluster that holds a complex pair stay real
+            # under the real iteration, and a real root's centre comes back to the axis in a step or two.
+            tilt = [flint.acb(0, 2.0**-30 * (-1) ** i) if step == 0 else 0 for i in range(d)]
+            centres = [(c - w + c * t).mid() for c, w, t in zip(centres, W, tilt)]
+    finally:
+        flint.ctx.prec = old
+    return None
+
+
+def _corrections(mats: list, a, centres: list) -> list | None:
+    """W_i = det A(z_i) / (a prod_{j != i} (z_i - z_j)) as Arb balls; None where one is not finite."""
+    prods = flint.acb_poly.from_roots(centres).derivative().evaluate(centres, algorithm="iter")
+    out = []
+    for x, q in zip(centres, prods):
+        val = mats[-1]
+        for c in mats[-2::-1]:
+            val = val * x + c
+        w = val.det() / (q * a)
+        if not w.is_finite():
+            return None
+        out.append(w)
+    return out
+
+
+def _real_if_separated(centres: list, W: list, d: int) -> int | None:
+    """The number of real roots if the disks |lambda - z_i| <= d |W_i| are pairwise apart, else None.
+
+    A disk that meets the real axis is moved onto it (centre Re z_i, radius grown by |Im z_i|: it still
+    holds the first) and then, isolated, holds one real root; a disk off the axis, isolated, holds one
+    non-real root.  Checked in floats: each centre rounded to a float grows its radius by the rounding, and
+    the float distances and sums are rounded outward by SAFE.
+    """
+    z = np.empty(len(centres), dtype=complex)
+    radius = np.empty(len(centres))
+    for i, (c, w) in enumerate(zip(centres, W)):
+        z[i] = complex(float(c.real.mid()), float(c.imag.mid()))
+        moved = abs(c - flint.acb(z[i].real, z[i].imag)).upper()
+        radius[i] = math.nextafter(float((w.abs_upper() * d + moved).upper()), math.inf)
+    if not np.all(np.isfinite(radius)):
         return None
-    real = z.imag == 0.0
-    # A non-real disk must miss the axis; every pair of disks must be apart.
-    if np.any(~real & (np.abs(z.imag) * (1.0 - 2.0**-50) <= radius)):
-        return None
+    real = np.abs(z.imag) / SAFE <= radius * SAFE
+    radius[real] = (radius[real] + np.abs(z.imag[real])) * SAFE
+    z[real] = z[real].real
     gap = np.abs(z[:, None] - z[None, :]) / SAFE
-    reach = (radius[:, None] + radius[None, :]) * SAFE
     np.fill_diagonal(gap, np.inf)
-    if np.any(gap <= reach):
+    if np.any(gap <= (radius[:, None] + radius[None, :]) * SAFE):
         return None
-    return zeros + int(np.count_nonzero(real))
+    return int(np.count_nonzero(real))
 
 
 def _deflate(coefs: list, degrees: list):
@@ -91,7 +140,7 @@ def _lead(coefs: list, degrees: list) -> flint.fmpz_mat:
     return out
 
 
-def _approximations(coefs: list, degrees: list, lead: flint.fmpz_mat) -> np.ndarray | None:
+def _approximations(coefs: list, degrees: list) -> np.ndarray | None:
     """d float approximations: eigenvalues of the block companion of A with row k shifted by x^(m - degrees[k]).
 
     The shifts add sum(m - degrees[k]) roots at 0 to the padded determinant; that many eigenvalues of
@@ -122,25 +171,3 @@ def _approximations(coefs: list, degrees: list, lead: flint.fmpz_mat) -> np.ndar
     drop = sum(shift)
     z = z[np.argsort(np.abs(z), kind="stable")][drop:] if drop else z
     return z.astype(complex)
-
-
-def _radii(coefs: list, a, z: np.ndarray, d: int) -> np.ndarray | None:
-    """d |W_i| rounded up to floats, from Arb balls; None where a ball is not finite or divides by zero."""
-    old = flint.ctx.prec
-    flint.ctx.prec = PREC
-    try:
-        mats = [flint.acb_mat(c) for c in coefs]
-        pts = [flint.acb(float(x.real), float(x.imag)) for x in z]
-        prods = flint.acb_poly.from_roots(pts).derivative().evaluate(pts, algorithm="iter")
-        out = np.empty(len(pts))
-        for i, x in enumerate(pts):
-            val = mats[-1]
-            for c in mats[-2::-1]:
-                val = val * x + c
-            w = val.det() / (prods[i] * a)
-            if not w.is_finite():
-                return None
-            out[i] = math.nextafter(float((w.abs_upper() * d).upper()), math.inf)
-    finally:
-        flint.ctx.prec = old
-    return out if np.all(np.isfinite(out)) else None
