@@ -7,6 +7,8 @@ the float path was asked about.  Same per-point layout as ``kernels.charpoly``.
 
 from __future__ import annotations
 
+import functools
+
 import flint
 import numpy as np
 
@@ -113,8 +115,7 @@ def _parts(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=None):
     arm = [_q(at[k]) for k in range(n)]
     zero = flint.fmpq(0)
     tree = [p + 1 for p in parent]  # 1-based, 0 = the base
-    S = topology.incidence(*topology.arcs(tree))[1:].tolist()  # arcs away from the base; no base row
-    T = topology.path_matrix(*topology.arcs(tree)).tolist()
+    S, T = _incidence_and_paths(tuple(tree))
     J = [[zero + x for x in row] for row in topology.lever_arms(tree, arm, c).tolist()]
     if free:
         mt = sum(m, zero)
@@ -122,11 +123,14 @@ def _parts(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=None):
             mean = sum((m[j] * J[j][i] for j in range(n)), zero) / mt
             for k in range(n):
                 J[k][i] -= mean
-    M = [[(A[i] if i == j else zero) + sum((m[k] * J[k][i] * J[k][j] for k in range(n)), zero) for j in range(n)] for i in range(n)]
+    # M = diag(A) + J^T diag(m) J and K = S diag(K_a) S^T as FLINT products (Python sums cost most of a point).
+    Jm = flint.fmpq_mat(J)
+    M = (Jm.transpose() * _diag(m) * Jm + _diag(A)).tolist()
     if free:
         Kj[0] = zero  # no base joint
     # Elastic: sum_a K_a phi_a^2 / 2 with phi = -S^T theta, so K = S diag(K_a) S^T.
-    Kmat = [[sum((S[i][a] * S[j][a] * Kj[a] for a in range(n)), zero) for j in range(n)] for i in range(n)]
+    Sm = flint.fmpq_mat(S)
+    Kmat = (Sm * _diag(Kj) * Sm.transpose()).tolist()
     if not free:
         gq = _q(g)
         # a = m c - S+ diag(at) T m: each body's own first moment plus, for every joint a on it,
@@ -142,6 +146,19 @@ def _parts(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=None):
     degree = sum(2 + len(b) for b, _ in rows)
 
     return rows, flint.fmpq_mat(M), flint.fmpq_mat(Kmat), [C[k] * w[k] for k in range(n)], w, degree
+
+
+def _diag(v: list) -> flint.fmpq_mat:
+    out = flint.fmpq_mat(len(v), len(v))
+    for i, x in enumerate(v):
+        out[i, i] = x
+    return out
+
+
+@functools.lru_cache(maxsize=64)
+def _incidence_and_paths(tree: tuple) -> tuple[list, list]:
+    """S (arcs away from the base, no base row) and T of ``topology`` as integer lists; one per tree shape."""
+    return topology.incidence(*topology.arcs(tree))[1:].tolist(), topology.path_matrix(*topology.arcs(tree)).tolist()
 
 
 def _interpolate(ys: list) -> flint.fmpq_poly:

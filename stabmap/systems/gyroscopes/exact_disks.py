@@ -47,7 +47,7 @@ def count(coefs: list, degrees: list) -> int | None:
     old = flint.ctx.prec
     flint.ctx.prec = PREC
     try:
-        mats = [flint.acb_mat(c) for c in coefs]
+        mats = ([flint.arb_mat(c) for c in coefs], [flint.acb_mat(c) for c in coefs])
         centres = [flint.acb(float(x.real), float(x.imag)) for x in z]
         for step in range(REFINE + 1):
             W = _corrections(mats, a, centres)
@@ -66,13 +66,19 @@ def count(coefs: list, degrees: list) -> int | None:
     return None
 
 
-def _corrections(mats: list, a, centres: list) -> list | None:
-    """W_i = det A(z_i) / (a prod_{j != i} (z_i - z_j)) as Arb balls; None where one is not finite."""
+def _corrections(mats: tuple, a, centres: list) -> list | None:
+    """W_i = det A(z_i) / (a prod_{j != i} (z_i - z_j)) as Arb balls; None where one is not finite.
+
+    ``mats``: the coefficients as arb_mat and as acb_mat; a real centre takes the real ones (2-3x cheaper).
+    """
     prods = flint.acb_poly.from_roots(centres).derivative().evaluate(centres, algorithm="iter")
     out = []
     for x, q in zip(centres, prods):
-        val = mats[-1]
-        for c in mats[-2::-1]:
+        real = x.imag.is_zero()
+        coefs = mats[0] if real else mats[1]
+        x = x.real if real else x
+        val = coefs[-1]
+        for c in coefs[-2::-1]:
             val = val * x + c
         w = val.det() / (q * a)
         if not w.is_finite():
