@@ -200,3 +200,9 @@ def test_disks_prove_the_random_chains_and_leave_the_double_root():
         coefs, _, degrees = exact.int_matrix(a[0][0], a[1][0], a[2][0], a[3][0], a[4][0], a[5], a[6], a[7], a[8][0])
         proved.append(exact_disks.count(coefs, degrees) is not None)
     assert proved == [True] * 26 + [False]
+
+
+def test_a_row_above_its_degree_bound_is_refused():
+    coefs = [flint.fmpz_mat([[1, 0], [0, 1]]), flint.fmpz_mat([[0, 0], [1, 0]])]
+    with pytest.raises(ValueError, match=r"row 1 .*degrees\[1\] = 0"):
+        exact_disks.count(coefs, [1, 0])

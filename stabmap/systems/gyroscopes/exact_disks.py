@@ -24,6 +24,7 @@ import numpy as np
 PREC = 128  # bits of the balls: det A(z_i) at a simple root's float approximation needs ~60 above the noise
 REFINE = 4  # Weierstrass steps in balls when the float disks do not separate; a cluster converges slowly (linearly)
 SAFE = 1.0 + 2.0**-40  # float distances and radii are rounded outward by far more than their few-ulp errors
+TINY = 2.0**-1000
 
 
 def count(coefs: list, degrees: list) -> int | None:
@@ -33,6 +34,11 @@ def count(coefs: list, degrees: list) -> int | None:
     count is proved only when the x^sum(degrees) coefficient a of the determinant is nonzero, so the degree
     is exactly d = sum(degrees) and all d roots sit in the d disks (after the rows' factors x, ``_deflate``).
     """
+    n = coefs[0].nrows()
+    for k, m in enumerate(degrees):
+        if any(coefs[t][k, j] != 0 for t in range(m + 1, len(coefs)) for j in range(n)):
+            raise ValueError(f"exact_disks.count: row {k} has terms above its degree bound degrees[{k}] = {m}; "
+                             "pass each row's true degree bound (the proof needs the x^sum(degrees) coefficient)")
     coefs, degrees, zeros = _deflate(coefs, degrees)
     d = sum(degrees)
     if d == 0:
@@ -103,12 +109,13 @@ def _real_if_separated(centres: list, W: list, d: int) -> int | None:
         radius[i] = math.nextafter(float((w.abs_upper() * d + moved).upper()), math.inf)
     if not np.all(np.isfinite(radius)):
         return None
-    real = np.abs(z.imag) / SAFE <= radius * SAFE
+    real = np.abs(z.imag) / SAFE <= radius * SAFE + TINY
     radius[real] = (radius[real] + np.abs(z.imag[real])) * SAFE
     z[real] = z[real].real
-    gap = np.abs(z[:, None] - z[None, :]) / SAFE
+    # TINY: a difference or hypot that lands below the normal range has an absolute, not a relative, error.
+    gap = np.abs(z[:, None] - z[None, :]) / SAFE - TINY
     np.fill_diagonal(gap, np.inf)
-    if np.any(gap <= (radius[:, None] + radius[None, :]) * SAFE):
+    if np.any(gap <= (radius[:, None] + radius[None, :]) * SAFE + TINY):
         return None
     return int(np.count_nonzero(real))
 
