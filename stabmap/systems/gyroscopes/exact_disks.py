@@ -22,7 +22,7 @@ import flint
 import numpy as np
 
 PREC = 128  # bits of the balls: det A(z_i) at a simple root's float approximation needs ~60 above the noise
-REFINE = 4  # Weierstrass steps in balls when the float disks do not separate; a cluster converges slowly (linearly)
+REFINE = 4  # at most this many Weierstrass steps in balls when the float disks do not separate
 SAFE = 1.0 + 2.0**-40  # float distances and radii are rounded outward by far more than their few-ulp errors
 TINY = 2.0**-1000
 
@@ -55,6 +55,7 @@ def count(coefs: list, degrees: list) -> int | None:
     try:
         mats = ([flint.arb_mat(c) for c in coefs], [flint.acb_mat(c) for c in coefs])
         centres = [flint.acb(float(x.real), float(x.imag)) for x in z]
+        largest = math.inf
         for step in range(REFINE + 1):
             W = _corrections(mats, a, centres)
             if W is None:
@@ -62,6 +63,12 @@ def count(coefs: list, degrees: list) -> int | None:
             real = _real_if_separated(centres, W, d)
             if real is not None:
                 return zeros + real
+            # Steps that do not shrink the largest correction 4x are in a cluster's or a repeated root's slow
+            # (linear) regime: the exact polynomial is cheaper than more of them.
+            now = max(float(abs(w).mid()) for w in W)
+            if now > largest / 4:
+                return None
+            largest = now
             # A Weierstrass (Durand-Kerner) step on the midpoints.  The first one also tilts every centre off the
             # axis by 2^-30 of itself: real approximations of a cluster that holds a complex pair stay real
             # under the real iteration, and a real root's centre comes back to the axis in a step or two.
