@@ -2,6 +2,7 @@
 
     python scripts/bench_exact.py            # degree 6..64 (a minute or two)
     python scripts/bench_exact.py --quick    # seconds; run once by the test suite
+    python scripts/bench_exact.py --corners  # also the E -> 0 corner points the kernels leave undecided
 
 Scattered random fixed chains (the point sets of ``bench_kernel.py``).  For each point:
 
@@ -31,9 +32,9 @@ import numpy as np
 from stabmap.systems.gyroscopes import exact, exact_disks
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_kernel import point_set  # noqa: E402
+from bench_kernel import corner_set, point_set  # noqa: E402
 
-HEADER = ("| n | modes | degree | points | before: rational dets ms | before: roots ms | before: total ms "
+HEADER = ("| set | n | modes | degree | points | before: rational dets ms | before: roots ms | before: total ms "
           "| now: exact polynomial ms | now: proved by disks | now: total ms | speed-up |")
 
 
@@ -46,12 +47,28 @@ def before(*args) -> tuple[flint.fmpq_poly, int, float]:
     return poly, (poly.degree() - real) // 2, time.process_time() - t
 
 
-def run(n: int, modes: int, npts: int, rng) -> dict:
-    args = point_set(rng, "scattered", 1, npts, n, modes).kernel_args()
+def undecided(n: int, modes: int, rng, corner: str = "tinyE", most: int = 20):
+    """(kernel args, indices): the points of a ``bench_kernel`` corner set that the kernels leave to the exact path."""
+    from stabmap import kernels
+    from stabmap.systems.gyroscopes.decide import kernel_args
+
+    pts = corner_set(rng, corner, 10, 50, n, modes)
+    nc = np.empty(pts.body.shape[0], np.int16)
+    st = np.empty(pts.body.shape[0], np.int8)
+    kernels.decide_block(*kernel_args(pts), nc, st)
+    return pts.kernel_args(), np.flatnonzero(st == kernels.UNDECIDED)[:most]
+
+
+def run(n: int, modes: int, npts: int, rng, corner: str | None = None) -> dict:
+    if corner:
+        args, index = undecided(n, modes, rng, corner)
+        npts = len(index)
+    else:
+        args, index = point_set(rng, "scattered", 1, npts, n, modes).kernel_args(), range(npts)
     body, joint, g, E, kappa, nmodes, free, parent, at = args
     t = {"before": 0.0, "roots": 0.0, "poly": 0.0, "now": 0.0}
     proved = 0
-    for p in range(npts):
+    for p in index:
         point = (body[p], joint[p], g[p], E[p], kappa[p], nmodes, free, parent, at[p])
         t0 = time.process_time()
         old, nc_old, roots = before(*point)
@@ -68,13 +85,15 @@ def run(n: int, modes: int, npts: int, rng) -> dict:
         t["roots"] += roots
         t["now"] += t2 - t1
         t["poly"] += t3 - t2
-    ms = {k: 1e3 * v / npts for k, v in t.items()}
-    return {"n": n, "modes": modes, "degree": n * (2 + modes), "points": npts, "proved": proved, **ms}
+    ms = {k: 1e3 * v / max(npts, 1) for k, v in t.items()}
+    return {"n": n, "modes": modes, "degree": n * (2 + modes), "points": npts, "proved": proved, "set": corner or "scattered", **ms}
 
 
 def main(argv=None) -> list[dict]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="tiny sizes, for the test suite")
+    ap.add_argument("--corners", action="store_true",
+                    help="also the points the kernels leave undecided in bench_kernel's E -> 0 corner (n = 6, 8; 3 modes)")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(2026)
     ladder = [(2, 1, 2), (3, 2, 2)] if args.quick else [(2, 1, 20), (3, 2, 20), (6, 2, 10), (6, 4, 10), (8, 4, 10), (12, 3, 5), (16, 2, 3)]
@@ -83,10 +102,16 @@ def main(argv=None) -> list[dict]:
     print(HEADER)
     print("|" + "---|" * (HEADER.count("|") - 1))
     rows = []
-    for n, modes, npts in ladder:
-        r = run(n, modes, npts, rng)
+    ladder = [(n, modes, npts, None) for n, modes, npts in ladder]
+    if args.corners:
+        ladder += [(6, 3, 0, "tinyE"), (8, 3, 0, "tinyE")]
+    for n, modes, npts, corner in ladder:
+        r = run(n, modes, npts, rng, corner)
         rows.append(r)
-        print(f"| {n} | {modes} | {r['degree']} | {npts} | {r['before'] - r['roots']:.1f} | {r['roots']:.1f} | {r['before']:.1f} "
+        npts = r["points"]
+        if not npts:
+            continue
+        print(f"| {r['set']} | {n} | {modes} | {r['degree']} | {npts} | {r['before'] - r['roots']:.1f} | {r['roots']:.1f} | {r['before']:.1f} "
               f"| {r['poly']:.1f} | {r['proved']} of {npts} | {r['now']:.1f} | {r['before'] / r['now']:.1f}x |", flush=True)
     return rows
 
