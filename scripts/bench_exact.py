@@ -59,8 +59,24 @@ def undecided(n: int, modes: int, rng, corner: str = "tinyE", most: int = 20):
     return pts.kernel_args(), np.flatnonzero(st == kernels.UNDECIDED)[:most]
 
 
+def split_chain(omega: float = 40.0):
+    """(kernel args, [0]): a fixed chain of 8 bodies, 4 modes each, whose 7 identical upper bodies have their joints
+    at their centres of mass, so p = F_1 F_2^7 (docs/model.md): a repeated factor no disk separates."""
+    from stabmap.systems.gyroscopes.points import point_arrays
+    from stabmap.systems.gyroscopes.scene import from_dict
+
+    fluid = {"E": [1e-3, 5e-4, 2e-4, 1e-4], "kappa": [1.31, 2.7, -1.9, 3.3]}
+    low = {"m": 2.0, "A": 0.05, "C": 0.06, "c": 0.1, "s": 0.3, "fluid": dict(fluid, kappa=[1.5, 2.5, 3.5, -1.7])}
+    upper = {"m": 1.0, "A": 0.02, "C": 0.03, "c": 0.0, "s": 0.0, "fluid": fluid}
+    scene = {"support": "fixed", "g": 9.81, "omega": omega, "bodies": [low] + [dict(upper) for _ in range(7)]}
+    return point_arrays(from_dict(scene), {}).kernel_args(), [0]
+
+
 def run(n: int, modes: int, npts: int, rng, corner: str | None = None) -> dict:
-    if corner:
+    if corner == "split":
+        args, index = split_chain()
+        npts = 1
+    elif corner:
         args, index = undecided(n, modes, rng, corner)
         npts = len(index)
     else:
@@ -93,7 +109,8 @@ def main(argv=None) -> list[dict]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="tiny sizes, for the test suite")
     ap.add_argument("--corners", action="store_true",
-                    help="also the points the kernels leave undecided in bench_kernel's E -> 0 corner (n = 6, 8; 3 modes)")
+                    help="also the points the kernels leave undecided in bench_kernel's E -> 0 corner (n = 6, 8; 3 modes) "
+                         "and a split chain with a repeated factor (n = 8, 4 modes), which the disks leave")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(2026)
     ladder = [(2, 1, 2), (3, 2, 2)] if args.quick else [(2, 1, 20), (3, 2, 20), (6, 2, 10), (6, 4, 10), (8, 4, 10), (12, 3, 5), (16, 2, 3)]
@@ -104,7 +121,7 @@ def main(argv=None) -> list[dict]:
     rows = []
     ladder = [(n, modes, npts, None) for n, modes, npts in ladder]
     if args.corners:
-        ladder += [(6, 3, 0, "tinyE"), (8, 3, 0, "tinyE")]
+        ladder += [(6, 3, 0, "tinyE"), (8, 3, 0, "tinyE"), (8, 4, 1, "split")]
     for n, modes, npts, corner in ladder:
         r = run(n, modes, npts, rng, corner)
         rows.append(r)
