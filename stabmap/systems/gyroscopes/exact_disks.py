@@ -8,10 +8,11 @@ companion matrix of A in floats (numpy); they only place the disks.  The proof i
     W_i = det A(z_i) / (a prod_{j != i} (z_i - z_j)),
 
 every disk |lambda - z_i| <= d |W_i| that meets no other disk holds exactly one root; such a disk centred on the
-real axis holds a real root, one that misses the axis a non-real root.  det A(z_i) and the products are Arb
-balls (python-flint) at ``PREC`` bits from the exact integer coefficients, so each W_i encloses the true
-value.  Whenever a disk meets another or a non-real disk meets the axis (close or repeated roots, poor
-approximations), ``count`` returns None and the caller takes the exact polynomial (``exact.complex_pairs``).
+real axis holds a real root, one that misses the axis a non-real root (a disk that meets the axis is first
+moved onto it, grown to still hold itself).  det A(z_i) and the products are Arb balls (python-flint) at
+``PREC`` bits from the exact integer coefficients, so each W_i encloses the true value.  Whenever the disks
+are not pairwise apart (close or repeated roots, poor approximations), even after a few Weierstrass steps,
+``count`` returns None and the caller takes the exact polynomial (``exact.complex_pairs``).
 """
 
 from __future__ import annotations
