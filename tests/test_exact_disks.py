@@ -206,3 +206,23 @@ def test_a_row_above_its_degree_bound_is_refused():
     coefs = [flint.fmpz_mat([[1, 0], [0, 1]]), flint.fmpz_mat([[0, 0], [1, 0]])]
     with pytest.raises(ValueError, match=r"row 1 .*degrees\[1\] = 0"):
         exact_disks.count(coefs, [1, 0])
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_tiny_liquid_and_near_boundaries_match_the_sympy_model(seed):
+    """Where the kernels leave points to the exact path: E/A from 1e-12 to 1e-9 (roots within sqrt(E) of the poles
+    -beta), and spin rates scanned across a boundary; decide_points against tests/reference.py at every point."""
+    rng = random.Random(400 + seed)
+    system = random_system(rng, 3, 2, rng.choice(["fixed", "free"]))
+    for b in system["bodies"]:
+        b["fluid"]["E"] = [b["A"] * 10.0 ** rng.uniform(-12, -9) for _ in b["fluid"]["E"]]
+    proved = 0
+    for omega in np.linspace(-60.0, 60.0, 7):
+        system["omega"] = float(omega)
+        a = _points(system)
+        got = int(exact.decide_points(*a, np.arange(1))[0])
+        want = ref.count_complex_pairs(ref.char_poly(**reference_args(system)))
+        assert got == want, (system, omega)
+        coefs, _, degrees = exact.int_matrix(a[0][0], a[1][0], a[2][0], a[3][0], a[4][0], a[5], a[6], a[7], a[8][0])
+        proved += exact_disks.count(coefs, degrees) is not None
+    assert proved >= 5  # most of them by the disks themselves, not by the fallback
