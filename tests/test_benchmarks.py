@@ -14,7 +14,7 @@ def test_bench_kernel_quick(capsys):
     rows = runpy.run_path(str(SCRIPTS / "bench_kernel.py"))["main"](["--quick"])
     corners = runpy.run_path(str(SCRIPTS / "bench_kernel.py"))["CORNERS"]
     assert [(r["degree"], r["kind"]) for r in rows] == [(d, k) for d in (2, 6, 12) for k in ("mixed", "identical")] + [
-        (12, c) for c in corners]
+        (12, c) for c in corners] + [(24, "mixed")]
     for r in rows:
         assert r["pts_per_s_1"] > 0 and r["peer_us"] > 0
         assert abs(sum(r["shares"].values()) - 100) < 1e-9
