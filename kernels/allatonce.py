@@ -16,9 +16,10 @@ T = [[1, 1], [i, -i]] on each 2 x 2 block, centred at the eigenvalues of L, hold
 clear of the axis hold non-real ones, a lone disc of a 1 x 1 block a real one.  Only float matrix products with
 a priori error bounds (gamma_k |A||B|, Higham section 3.5) are O(D^3): they run at BLAS speed.
 
-Along a grid line the previous point's X and Y are refined by one first-order step (``refine``: a
-Newton-Schulz step for Y, then the off-diagonal blocks of Y A X removed by small Sylvester equations), so a
-point costs a handful of D x D products and no eigenvalue problem.
+Along a grid line the last points' X and Y, extrapolated, are refined by Newton steps (``refine``: Newton-Schulz
+steps for Y, pairs regrouped where roots joined or left the axis, then the off-diagonal blocks of Y A X removed
+to first order by 2 x 2 Sylvester equations in closed form), so a point costs a few D x D products per step and
+no eigenvalue problem; the eigenvectors of LAPACK's dgeev where that fails.
 """
 
 from __future__ import annotations
@@ -42,8 +43,10 @@ U = ball.U
 ETA = ball.ETA
 SCHULZ = 0.25  # ||I - Z Y|| of a stale inverse above this: LAPACK's inverse instead of Newton-Schulz steps
 SCHULZ_STEPS = 3
-REFINE_STEPS = 6  # first-order steps at most per point
-REFINE_TOL = 2.0**-30  # a step that moved the eigenvectors less than this (largest entry of P) is the last
+REFINE_STEPS = 8  # first-order steps at most per point
+DIVERGED = 1e3  # a step moving the eigenvectors this much (largest entry of P): Newton's method diverges
+REFINE_TOL = 2.0**-20  # a step that moved the eigenvectors less than this (largest entry of P) is the last: it
+# leaves an error of about its square, near the rounding of the products
 CLUSTER = 2.0**-30  # eigenvalues this close (relative) are a cluster: not separated by the refinement
 MAX_E = 0.5  # ||I - Y B X|| proved below this, so e / (1 - e) <= 2 e
 
@@ -77,8 +80,9 @@ def allocate(n, nmodes):
     rad = np.empty(D)
     group = np.empty(D, np.int64)
     # [0] X, Y hold a decomposition to refine; [1] cold starts; [2] points decided warm; [3] points left to skip
-    # (``certify.certify_point``); [4] the X, Y one point back continue this one (extrapolate from both)
-    state = np.zeros(5, np.int64)
+    # (``certify.certify_point``); [4] the X, Y one point back continue this one (extrapolate from both);
+    # [5] the blocks changed at this point (a pair split or joined: columns moved, so no extrapolation next)
+    state = np.zeros(6, np.int64)
     return mats, An, Mp, yk, yb, lam, size, vec, disc, rad, group, state
 
 
@@ -238,17 +242,24 @@ def verify(m, aw):
         rr[i] = (rz[i] + gD * xq[i]) * grow + ETA
     np.dot(Y, Z, F)
     _absmv(Y, rr, ra, D)
+    # every maximum below is checked row by row: max() would pass over a NaN
     e = 0.0
     for i in range(D):
         s = 0.0
         for j in range(D):
             s += abs((1.0 if i == j else 0.0) - F[i, j])
-        e = max(e, (s * grow + ra[i]) * grow + 2.0 * U)
-    if not e < MAX_E:
-        return -1
+        row = (s * grow + ra[i]) * grow + 2.0 * U
+        if not row < MAX_E:
+            return -1
+        e = max(e, row)
     gnorm = 0.0
     for i in range(D):
+        if not rho[i] < math.inf:
+            return -1
         gnorm = max(gnorm, rho[i])
+    for j in range(D):
+        if not (math.isfinite(lam[j, 0]) and math.isfinite(lam[j, 1])):
+            return -1
     eta = 2.0 * e * gnorm / (1.0 - e) * grow  # the similarity T at most doubles an inf-norm
     if not math.isfinite(eta):
         return -1
@@ -450,26 +461,32 @@ def _transform(X, Y, H, j, s11, s12, s21, s22, D):
 
 @kernel
 def _regroup(X, Y, H, size, tmp, D):
-    """Pair two 1 x 1 blocks whose 2 x 2 submatrix of H has non-real eigenvalues (two real roots that met and
-    left the axis) and make them neighbours: X's columns, Y's rows and H permuted alike (``tmp`` scratch).
-    Always True (the greedy pairing never takes a column twice)."""
+    """Pair two neighbouring 1 x 1 blocks whose 2 x 2 submatrix of H has non-real eigenvalues (two real roots that
+    met and left the axis) and make them neighbours: X's columns, Y's rows and H permuted alike (``tmp`` scratch).
+    True if it paired any (the columns moved)."""
+    # two real eigenvalues that met are neighbours in the sorted order of the 1 x 1 blocks' diagonal entries
     partner = np.full(D, -1, np.int64)
     found = False
+    real = np.empty(D, np.int64)
+    key = np.empty(D)
+    nr = 0
     for i in range(D):
-        if size[i] != 1 or partner[i] >= 0:
-            continue
-        best, k = np.inf, -1
-        for j in range(D):
-            if j == i or size[j] != 1 or partner[j] >= 0:
-                continue
-            p, q, r, s = H[i, i], H[i, j], H[j, i], H[j, j]
-            if 0.25 * (p - s) * (p - s) + q * r < 0.0 and abs(p - s) < best:
-                best, k = abs(p - s), j
-        if k >= 0:
-            partner[i], partner[k] = k, i
+        if size[i] == 1:
+            real[nr], key[nr] = i, H[i, i]
+            nr += 1
+    order = np.argsort(key[:nr])
+    a = 0
+    while a + 1 < nr:
+        i, j = real[order[a]], real[order[a + 1]]
+        p, q, r, s = H[i, i], H[i, j], H[j, i], H[j, j]
+        if 0.25 * (p - s) * (p - s) + q * r < 0.0:
+            partner[i], partner[j] = j, i
             found = True
+            a += 2
+        else:
+            a += 1
     if not found:
-        return True
+        return False
     order = np.empty(D, np.int64)
     placed = np.zeros(D, np.bool_)
     t = 0
@@ -505,7 +522,7 @@ def _regroup(X, Y, H, size, tmp, D):
 
 
 @kernel
-def refine(aw, first):
+def refine(aw):
     """One first-order step of the stored X, Y, L towards this point's pencil (needs ``pencil_balls``).
 
     Returns the largest entry of the correction P (X <- X (I + P)): the step is quadratically convergent, so a
@@ -539,8 +556,8 @@ def refine(aw, first):
         Y[:] = H
     np.dot(Y, AX, H)  # ~ X^-1 B^-1 A X
     # where two real eigenvalues met and left the axis, or a pair met it, the blocks change with them
-    if not _regroup(X, Y, H, size, mats[8], D):
-        return -1.0
+    if _regroup(X, Y, H, size, mats[8], D):
+        state[5] = 1
     # the 2 x 2 diagonal blocks back to normal form [[a, b], [-b, a]] (S: H_bb S = S N), 1 x 1 ones read off
     j = 0
     while j < D:
@@ -562,6 +579,7 @@ def refine(aw, first):
             if not _transform(X, Y, H, j, s11, s12, s21, s22, D):
                 return -1.0
             size[j], size[j + 1] = 1, 1
+            state[5] = 1
             lam[j, 0], lam[j, 1], lam[j + 1, 0], lam[j + 1, 1] = H[j, j], 0.0, H[j + 1, j + 1], 0.0
             j += 2
             continue
@@ -576,6 +594,7 @@ def refine(aw, first):
     # order.  A 2 x 2 normal form [[a, b], [-b, a]] acts as the complex number a + i b; a 2 x 2 P splits into a part
     # that commutes with it and one that conjugates it (``_sylvester``), so every block has a closed form.
     P[:] = 0.0
+    big = 0.0
     i = 0
     while i < D:
         j = 0
@@ -585,15 +604,15 @@ def refine(aw, first):
                 da = lam[i, 0] - lam[j, 0]
                 if i != j and abs(da) > CLUSTER * (li + abs(lam[j, 0])):
                     P[i, j] = -H[i, j] / da
+                    big = max(big, abs(P[i, j]))
             elif i != j:
                 _sylvester(H, P, lam, size, i, j)
+                for r in range(i, i + size[i]):
+                    for c in range(j, j + size[j]):
+                        big = max(big, abs(P[r, c]))
             j += size[j]
         i += size[i]
-    big = 0.0
-    for i in range(D):
-        for j in range(D):
-            big = max(big, abs(P[i, j]))
-    if not math.isfinite(big):
+    if not big < math.inf:  # a NaN that max() passed over only makes verify fail: it checks every bound
         return -1.0
     np.dot(X, P, H)
     X += H
@@ -621,20 +640,21 @@ def certify(body, E, nmodes, parent, m, pws, C, Mo, aw, warm):
                 if state[4] == 1:
                     X[i, j], Y[i, j] = 2.0 * x - Xp[i, j], 2.0 * y - Yp[i, j]
                 Xp[i, j], Yp[i, j] = x, y
-        moved = refine(aw, True)
+        state[5] = 0
+        moved = refine(aw)
         last = np.inf
-        for _ in range(REFINE_STEPS - 1):
-            # quadratic convergence until rounding: stop there, or when steps no longer shrink (a cluster, or a
-            # neighbour too far for Newton's method)
-            if not (moved > REFINE_TOL and moved < 0.5 * last):
+        for step in range(1, REFINE_STEPS):
+            # quadratic convergence until rounding: stop there, or when the steps no longer shrink after the first
+            # few (a cluster, or a neighbour too far for Newton's method), or grow wild
+            if not (moved > REFINE_TOL and (step < 4 or moved < 0.5 * last) and moved < DIVERGED):
                 break
             last = moved
-            moved = refine(aw, False)
+            moved = refine(aw)
         if moved >= 0.0:
             nonreal = verify(m, aw)
             if nonreal >= 0:
                 state[2] += 1
-                state[4] = 1
+                state[4] = 1 - state[5]
                 return nonreal // 2, True
     state[0] = 0
     state[4] = 0

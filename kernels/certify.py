@@ -45,7 +45,10 @@ MERGE = 2.0**-40  # features closer than this share of their size get no separat
 FENCE = 2.0**-30  # separators this close (relative) either side of each pole
 NEAR_REAL = 2.0**-20  # approximations this close to the axis (relative) are expected to be real roots
 NUDGE = 2.0**-10  # relative imaginary offset given to suspect real approximations before polishing
-ALLATONCE_BODIES = 10  # from this many bodies the all-at-once certificate goes first (BENCHMARKS.md, "All at once")
+# The all-at-once certificate goes first from this many bodies, where n^4 >= ALLATONCE_PRICE D^3: the Newton disks
+# cost about n^4 a point, it about D^3 (measured: BENCHMARKS.md, "All eigenvalues at once")
+ALLATONCE_BODIES = 10
+ALLATONCE_PRICE = 0.1
 MAGNITUDE_LOW, MAGNITUDE_HIGH = 2.0**-150, 2.0**150  # parameters outside are left to exact arithmetic
 
 
@@ -279,7 +282,7 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     if not ok:  # deg p unproved: nothing below counts
         state[0] = 0
         return -1, UNDECIDED
-    if n >= ALLATONCE_BODIES:
+    if n >= ALLATONCE_BODIES and float(n) ** 4 >= ALLATONCE_PRICE * float(degree) ** 3:
         nc = _allatonce(body, E, nmodes, parent, m, ws)
         if nc >= 0:
             state[0] = 0  # the roots in z are not this point's

@@ -171,3 +171,10 @@ def test_viscous_figure_quick(tmp_path, capsys):
     # the curves drawn on the figure are the maps' boundaries: Maievskii's for the ideal liquid, (C - A') omega^2 > m g c
     assert out["ideal_off_closed_form"] == 0 and out["viscous_off_closed_form"] == 0
     assert out["lost"] > 0 and out["undecided"] == 0 and out["re_max"] < 1
+
+
+def test_bench_allatonce_quick(capsys):
+    rows = runpy.run_path(str(SCRIPTS / "bench_allatonce.py"), run_name="bench")["main"](["--quick"])
+    assert len(rows) == 1 and rows[0]["points"] == 8
+    assert rows[0]["us"]["peer"] > 0 and rows[0]["decided_pct"] > 0
+    assert "| n | modes | degree |" in capsys.readouterr().out
