@@ -554,6 +554,8 @@ def refine(aw):
             break
         np.dot(Y, T, H)
         Y[:] = H
+        if worst < 2.0**-15:  # the step squares the error: no need to check again
+            break
     np.dot(Y, AX, H)  # ~ X^-1 B^-1 A X
     # where two real eigenvalues met and left the axis, or a pair met it, the blocks change with them
     if _regroup(X, Y, H, size, mats[8], D):
@@ -622,6 +624,22 @@ def refine(aw):
 
 
 @kernel
+def extrapolate(aw):
+    """X, Y linearly extrapolated from the last two points where they continue each other (else the last
+    point's kept); the last point's saved for the next."""
+    mats, An, Mp, yk, yb, lam, size, vec, disc, rad, group, state = aw
+    X, Y, Xp, Yp = mats[0], mats[1], mats[9], mats[10]
+    D = X.shape[0]
+    for i in range(D):
+        for j in range(D):
+            x, y = X[i, j], Y[i, j]
+            if state[4] == 1:
+                X[i, j], Y[i, j] = 2.0 * x - Xp[i, j], 2.0 * y - Yp[i, j]
+            Xp[i, j], Yp[i, j] = x, y
+    state[5] = 0
+
+
+@kernel
 def certify(body, E, nmodes, parent, m, pws, C, Mo, aw, warm):
     """(N_c, warm used) of one point whose pencil workspace ``pws`` is prepared, or (-1, ...) if unproved.
 
@@ -631,16 +649,7 @@ def certify(body, E, nmodes, parent, m, pws, C, Mo, aw, warm):
     mats, An, Mp, yk, yb, lam, size, vec, disc, rad, group, state = aw
     pencil_balls(body, E, nmodes, pws, aw)
     if warm and state[0] == 1:
-        X, Y, Xp, Yp = mats[0], mats[1], mats[9], mats[10]
-        D = X.shape[0]
-        # linear extrapolation from the last two points where they continue each other, else the last point's
-        for i in range(D):
-            for j in range(D):
-                x, y = X[i, j], Y[i, j]
-                if state[4] == 1:
-                    X[i, j], Y[i, j] = 2.0 * x - Xp[i, j], 2.0 * y - Yp[i, j]
-                Xp[i, j], Yp[i, j] = x, y
-        state[5] = 0
+        extrapolate(aw)
         moved = refine(aw)
         last = np.inf
         for step in range(1, REFINE_STEPS):

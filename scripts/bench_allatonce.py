@@ -42,6 +42,7 @@ def split(pts) -> dict:
         nonreal = -1
         if state[0] == 1:
             t0 = clock()
+            allatonce.extrapolate(aw)
             moved, k, last = allatonce.refine(aw), 1, np.inf
             while k < allatonce.REFINE_STEPS and moved > allatonce.REFINE_TOL and (k < 4 or moved < 0.5 * last) and moved < allatonce.DIVERGED:
                 last, moved, k = moved, allatonce.refine(aw), k + 1
@@ -51,6 +52,9 @@ def split(pts) -> dict:
             t["proof"] += clock() - t1
             steps += k
             warm += nonreal >= 0
+            state[4] = int(nonreal >= 0) * (1 - state[5])
+        else:
+            state[4] = 0
         pencil.linearisation(body[p], E[p], nmodes, parent, pws, C, Mo)
         t0 = clock()
         np.linalg.eigvals(C)
