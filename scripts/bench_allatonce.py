@@ -44,7 +44,9 @@ def split(pts) -> dict:
             t0 = clock()
             allatonce.extrapolate(aw)
             moved, k, last = allatonce.refine(aw), 1, np.inf
-            while k < allatonce.REFINE_STEPS and moved > allatonce.REFINE_TOL and (k < 4 or moved < 0.5 * last) and moved < allatonce.DIVERGED:
+            # the stopping rule of allatonce.certify
+            while (k < allatonce.REFINE_STEPS and moved > allatonce.REFINE_TOL and (k < 4 or moved < 0.5 * last)
+                   and moved < allatonce.DIVERGED):
                 last, moved, k = moved, allatonce.refine(aw), k + 1
             t1 = clock()
             nonreal = allatonce.verify(m, aw) if moved >= 0 else -1
