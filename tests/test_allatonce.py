@@ -114,3 +114,15 @@ def test_near_boundaries_never_wrong(n, modes, seed):
         decided += int((st == kernels.DECIDED_ALLATONCE).sum())
     # far enough from the boundary it does decide (1e-2 and 1e-3 of omega away, on either side)
     assert decided >= 2
+
+
+def test_atlas_layer_names_it_all_eigenvalues_at_once():
+    """The labelled layer writes the new provenance as decided_by = all_eigenvalues_at_once (a proof)."""
+    from stabmap.systems.gyroscopes.decide import decide
+    from stabmap.systems.gyroscopes.outputs import BY_ALLATONCE, DECIDED_BY
+
+    pts = random_chain(np.random.default_rng(11), 12, 1, False, "mixed", omegas=np.linspace(-50.0, 50.0, 8))
+    nc, by = decide(pts)
+    assert DECIDED_BY.value("all_eigenvalues_at_once") == BY_ALLATONCE == 7
+    assert (by == BY_ALLATONCE).sum() >= 4
+    assert [int(nc[p]) for p in (0, 7)] == [exact_nc(pts, p) for p in (0, 7)]
