@@ -7,11 +7,13 @@ of lambda everywhere (as ``numpy.polynomial``).  This folder is installed as
 modules import each other relatively, so they work under either name.
 """
 
-from .block import box_block, charpoly_block, count_block, decide_block, linearise_block, nodes_box_block
+from .block import allatonce_block, box_block, charpoly_block, count_block, decide_block, linearise_block, nodes_box_block
 from .roots import NONREAL, REAL, ROOTS_FAILED, UNSEPARATED, roots_block
-from .status import DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL
+from .status import DECIDED_ALLATONCE, DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL
 
 __all__ = [
+    "allatonce_block",
+    "DECIDED_ALLATONCE",
     "box_block",
     "charpoly_block",
     "count_block",

@@ -155,6 +155,22 @@ def decide_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out
 
 
 @kernel
+def allatonce_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out_status):
+    """N_c of a block of points by the all-at-once certificate alone (docs/certification.md, section 4b).
+
+    Inputs and outputs as for ``count_block``; out_status is DECIDED_ALLATONCE or UNDECIDED.  For tests and
+    benchmarks: ``decide_block`` puts this certificate in its proof chain where it pays.  Returns the number of
+    cold starts (eigenvector computations); the other decided points were refined from their neighbour's.
+    """
+    npts, n = body.shape[0], body.shape[1]
+    cws = certify.allocate(n, nmodes, parent)
+    for p in range(npts):
+        reuse = same_structure(body, joint, at, g, p)
+        out_nc[p], out_status[p] = certify.allatonce_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, cws, reuse)
+    return cws[-1][-1][1]
+
+
+@kernel
 def linearise_block(body, joint, g, E, kappa, nmodes, free, parent, at, out):
     """The D x D first-order linearisation of every point into out (npts, D, D); returns a bool mask of success.
 

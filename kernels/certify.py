@@ -27,10 +27,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import approximations, ball, disks, elimination, pencil
+from . import allatonce, approximations, ball, disks, elimination, pencil
 from .approximations import RIDE
 from .options import kernel
-from .status import DECIDED_DISKS, DECIDED_INERTIA, UNDECIDED
+from .status import DECIDED_ALLATONCE, DECIDED_DISKS, DECIDED_INERTIA, UNDECIDED
 
 COLD_SWEEPS = 24  # Aberth sweeps from the linearisation's eigenvalues (CERTIFY.md: enough to degree 48)
 WARM_STEPS = 8  # Aberth sweeps (at most) on a neighbour's non-real roots before their disks
@@ -45,6 +45,10 @@ MERGE = 2.0**-40  # features closer than this share of their size get no separat
 FENCE = 2.0**-30  # separators this close (relative) either side of each pole
 NEAR_REAL = 2.0**-20  # approximations this close to the axis (relative) are expected to be real roots
 NUDGE = 2.0**-10  # relative imaginary offset given to suspect real approximations before polishing
+# The all-at-once certificate goes first from this many bodies, where n^4 >= ALLATONCE_PRICE D^3: the Newton disks
+# cost about n^4 a point, it about D^3 (measured: BENCHMARKS.md, "All eigenvalues at once")
+ALLATONCE_BODIES = 10
+ALLATONCE_PRICE = 0.1
 MAGNITUDE_LOW, MAGNITUDE_HIGH = 2.0**-150, 2.0**150  # parameters outside are left to exact arithmetic
 
 
@@ -80,7 +84,8 @@ def allocate(n, nmodes, parent):
     dr = np.empty((n, n))
     centre = np.empty(degree, np.complex128)
     done = np.empty(degree, np.bool_)
-    return pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs
+    aw = allatonce.allocate(n, nmodes)  # the all-at-once certificate's scratch and its decomposition
+    return pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw
 
 
 @kernel
@@ -231,7 +236,7 @@ def _attempt(z, d, m, degree, body, E, nmodes, parent, ws, sweeps):
     approximations of non-real roots by at most as many Aberth sweeps (a
     neighbour's roots are good enough for separators, not for disks).
     """
-    pws, C, Mo, wr, wi, vdummy, _z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs = ws
+    pws, C, Mo, wr, wi, vdummy, _z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
     real = max(m, _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, done))
     near, upper = 0, 0
     for i in range(d):
@@ -290,7 +295,7 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     The previous point given to the same workspace is taken as a grid
     neighbour: its roots are tried first.
     """
-    pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs = ws
+    pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
     n = body.shape[0]
     degree = C.shape[0]
     # M T and K T in the workspace are the previous point's only if it got as far as prepare
@@ -306,6 +311,11 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     if not ok:  # deg p unproved: nothing below counts
         state[0] = 0
         return -1, UNDECIDED
+    if n >= ALLATONCE_BODIES and float(n) ** 4 >= ALLATONCE_PRICE * float(degree) ** 3:
+        nc = _allatonce(body, E, nmodes, parent, m, ws)
+        if nc >= 0:
+            state[0] = 0  # the roots in z are not this point's
+            return nc, DECIDED_ALLATONCE
     nc, status = -1, UNDECIDED
     # 1. a grid neighbour's roots, extrapolated, usually separate this point's: no eigenvalue problem
     neighbour = state[0] == 1 and state[1] == d
@@ -359,3 +369,36 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     state[0] = 1 if status != UNDECIDED else 0
     state[1] = d
     return nc, status
+
+
+@kernel
+def _allatonce(body, E, nmodes, parent, m, ws):
+    """N_c by the all-at-once certificate (docs/certification.md, section 4b), or -1; it pauses for PAUSE points
+    after a cold start that did not decide (a free chain's defective zero roots, say), since it then only adds
+    its cost to the certificates behind it."""
+    pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
+    flags = aw[-1]
+    if flags[3] > 0:
+        flags[3] -= 1
+        flags[0] = 0  # the decomposition kept is too old to refine
+        return -1
+    nc, warm = allatonce.certify(body, E, nmodes, parent, m, pws, C, Mo, aw, True)
+    if nc < 0 and not warm:
+        flags[3] = PAUSE
+    return nc
+
+
+@kernel
+def allatonce_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
+    """(N_c, status) of one point by the all-at-once certificate alone (section 4b): DECIDED_ALLATONCE or
+    UNDECIDED, never another proof (for tests and benchmarks).  The previous point's decomposition is refined
+    first; ``reuse`` as for ``certify_point``."""
+    pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
+    reuse = reuse and state[4] == 1
+    state[4] = 0
+    if not _moderate(body, joint, at, g, E, kappa, nmodes):
+        return -1, UNDECIDED
+    m = pencil.prepare(body, joint, at, g, E, kappa, nmodes, parent, free, pws, reuse)
+    state[4] = 1
+    nc, warm = allatonce.certify(body, E, nmodes, parent, m, pws, C, Mo, aw, True)
+    return (nc, DECIDED_ALLATONCE) if nc >= 0 else (-1, UNDECIDED)

@@ -3,6 +3,7 @@
     python scripts/bench_kernel.py            # degree 2..64 (n = 1..16) and n = 24, 32 (about 15 minutes)
     python scripts/bench_kernel.py --quick    # seconds; run once by the test suite
     python scripts/bench_kernel.py --corners  # only the structural corners below (a few minutes)
+    python scripts/bench_kernel.py --many     # many bodies: n = 12, 16, 24, 32, 0-4 modes, degree <= 128 (~15 minutes)
 
 Point sets, for every (n, modes): random chains (realistic ranges, joints and
 liquid modes as given), each scanned along omega over a line of points in grid
@@ -54,6 +55,7 @@ STATUSES = (
     (kernels.DECIDED_INCLUSION, "coeff. disks"),
     (kernels.DECIDED_INERTIA, "inertia"),
     (kernels.DECIDED_DISKS, "inertia+disks"),
+    (getattr(kernels, "DECIDED_ALLATONCE", -99), "all at once"),  # getattr: the script also times older trees
     (kernels.UNDECIDED, "exact"),
 )
 
@@ -201,11 +203,17 @@ def run(n: int, modes: int, kind: str, lines: int, per_line: int, rng) -> dict:
     }
 
 
-def cases(quick: bool, max_degree: int, corners: bool = False):
+MANY = ((12, 0), (12, 2), (12, 4), (16, 0), (16, 2), (16, 4), (24, 0), (24, 1), (24, 3), (32, 0), (32, 1), (32, 2))
+
+
+def cases(quick: bool, max_degree: int, corners: bool = False, many: bool = False):
     """(n, modes, kind, lines, points per line) of every row."""
+    if many:  # issue 32: many bodies, mixed and identical, 2 lines of 50 points (quick: one small row)
+        rows = [(n, m, k, 2, 50) for n, m in MANY for k in ("mixed", "identical")]
+        return [r for r in rows if r[0] * (2 + r[1]) <= max_degree]
     if quick:
         return [(n, m, k, 2, 12) for n, m in ((1, 0), (2, 1), (3, 2)) for k in ("mixed", "identical")] + [
-            (3, 2, c, 1, 6) for c in CORNERS]
+            (3, 2, c, 1, 6) for c in CORNERS] + [(12, 0, "mixed", 1, 6)]
     corner_rows = [(n, m, c, 10, 50) for n, m in ((3, 2), (6, 3), (8, 3)) for c in CORNERS]
     if os.environ.get("STABMAP_CORNERS"):  # a subset while developing, e.g. STABMAP_CORNERS=tinyE
         corner_rows = [r for r in corner_rows if r[2] in os.environ["STABMAP_CORNERS"].split(",")]
@@ -235,13 +243,14 @@ def main(argv=None) -> list[dict]:
     ap.add_argument("--quick", action="store_true", help="tiny sizes, for the test suite")
     ap.add_argument("--max-degree", type=int, default=96, help="skip larger (n, modes) cases")
     ap.add_argument("--corners", action="store_true", help="only the structural corners (module docstring)")
+    ap.add_argument("--many", action="store_true", help="only many bodies: n = 12..32, degree <= --max-degree")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(2026)
     print(f"# machine: {os.cpu_count()} cores, {platform.processor() or platform.machine()}, python {platform.python_version()}")
     print(HEADER)
     print("|" + "---|" * (HEADER.count("|") - 1))
     rows = []
-    for n, modes, kind, lines, per in cases(args.quick, args.max_degree, args.corners):
+    for n, modes, kind, lines, per in cases(args.quick, args.max_degree, args.corners, args.many):
         r = run(n, modes, kind, lines, per, rng)
         rows.append(r)
         shares = ", ".join(f"{name} {v:.1f}" for name, v in r["shares"].items() if v)

@@ -14,7 +14,7 @@ def test_bench_kernel_quick(capsys):
     rows = runpy.run_path(str(SCRIPTS / "bench_kernel.py"))["main"](["--quick"])
     corners = runpy.run_path(str(SCRIPTS / "bench_kernel.py"))["CORNERS"]
     assert [(r["degree"], r["kind"]) for r in rows] == [(d, k) for d in (2, 6, 12) for k in ("mixed", "identical")] + [
-        (12, c) for c in corners]
+        (12, c) for c in corners] + [(24, "mixed")]
     for r in rows:
         assert r["pts_per_s_1"] > 0 and r["peer_us"] > 0
         assert abs(sum(r["shares"].values()) - 100) < 1e-9
@@ -180,3 +180,10 @@ def test_bench_onetop_quick():
     for row in rows[2:]:
         cells = [c.strip() for c in row.strip("|").split("|")]
         assert cells[2] == "1000" and cells[-1] == "0"  # every random top proved by the filter or the kernels
+
+
+def test_bench_allatonce_quick(capsys):
+    rows = runpy.run_path(str(SCRIPTS / "bench_allatonce.py"), run_name="bench")["main"](["--quick"])
+    assert len(rows) == 1 and rows[0]["points"] == 8
+    assert rows[0]["us"]["peer"] > 0 and rows[0]["decided_pct"] > 0
+    assert "| n | modes | degree |" in capsys.readouterr().out

@@ -32,10 +32,12 @@ DECIDED_BY = Variable(
     "between the roots (no coefficients formed); "
     "inertia_and_disks: the real roots counted by that inertia, the non-real ones by inclusion "
     "disks from the determinant of the characteristic matrix in interval arithmetic; "
+    "all_eigenvalues_at_once: every root at once, by Gerschgorin discs of the first-order linearisation after an "
+    "approximate eigen-decomposition, in rigorous float matrix products (docs/certification.md, section 4b); "
     "exact_rational_arithmetic: none of these could decide and the point was recomputed exactly; "
     "box_proof: not computed on its own: N_c was proved at every point of a box of parameters that holds this "
     "node (docs/certification.md, section 6; docs/cells.md). "
-    "These six are proofs; docs/certification.md. "
+    "These seven are proofs; docs/certification.md. "
     f"{INFERRED}: not computed and not proved; an adaptive atlas (stabmap atlas --refine) "
     "gave the point the value on which all corners of its grid cell agree; docs/refine.md",
     flags=(
@@ -46,6 +48,7 @@ DECIDED_BY = Variable(
         (4, "interval_inertia"),
         (5, "inertia_and_disks"),
         (6, "box_proof"),
+        (7, "all_eigenvalues_at_once"),
     ),
 )
 VARIABLES = (N_COMPLEX_PAIRS, STABILITY, DECIDED_BY)
@@ -57,6 +60,7 @@ BY_INFERRED = DECIDED_BY.value(INFERRED)
 BY_INERTIA = DECIDED_BY.value("interval_inertia")
 BY_DISKS = DECIDED_BY.value("inertia_and_disks")
 BY_BOX = DECIDED_BY.value("box_proof")
+BY_ALLATONCE = DECIDED_BY.value("all_eigenvalues_at_once")
 
 
 def stability_from_pairs(nc: np.ndarray) -> np.ndarray:
