@@ -42,9 +42,16 @@ import time
 import warnings
 from pathlib import Path
 
-import numba
-import numpy
-from numba.core import event
+# The kernels run one block per core (threads or dask workers) and call BLAS on small matrices (the all-at-once
+# certificate, the Newton disks of long chains): BLAS threads inside each call only oversubscribe the cores, which
+# measured 2.5x the CPU time at 24 bodies (BENCHMARKS.md, "All eigenvalues at once").  One BLAS thread, as dask's
+# Nanny sets for its workers; a value the user set wins, and it must be set before the BLAS library loads.
+for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import numba  # noqa: E402 -- after the BLAS threads are set
+import numpy  # noqa: E402
+from numba.core import event  # noqa: E402
 
 CACHE = os.environ.get("STABMAP_NUMBA_CACHE", "1").lower() not in {"0", "false", "no", "off"}
 COMPILE_SECONDS = 20  # a full compile of decide_block on the 2-core machine of BENCHMARKS.md, unloaded

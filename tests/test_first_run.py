@@ -152,3 +152,17 @@ def test_atlas_refine_and_critical_call_only_the_precompiled_signatures():
     assert out.returncode == 0, out.stderr
     seen = json.loads(out.stdout)
     assert seen["called"] == seen["precompiled"]
+
+
+@pytest.mark.parametrize("given", [None, "3"])
+def test_one_blas_thread_unless_the_user_chose(given):
+    """The kernels run a block per core and call BLAS on small matrices: importing them sets one BLAS thread
+    (as dask's Nanny does), before the BLAS library loads, and leaves a value the user set alone."""
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
+    if given:
+        env["OPENBLAS_NUM_THREADS"] = given
+    code = ("import os, sys; import stabmap.kernels; "
+            "print(os.environ['OPENBLAS_NUM_THREADS'], os.environ['MKL_NUM_THREADS'])")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == [given or "1", "1"]
