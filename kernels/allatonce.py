@@ -44,6 +44,7 @@ ETA = ball.ETA
 SCHULZ = 0.25  # ||I - Z Y|| of a stale inverse above this: LAPACK's inverse instead of Newton-Schulz steps
 SCHULZ_STEPS = 3
 REFINE_STEPS = 8  # first-order steps at most per point
+VERIFY_AT = 2.0**-10  # steps this small (largest entry of P) are followed by a proof attempt (``certify``)
 DIVERGED = 1e3  # a step moving the eigenvectors this much (largest entry of P): Newton's method diverges
 REFINE_TOL = 2.0**-20  # a step that moved the eigenvectors less than this (largest entry of P) is the last: it
 # leaves an error of about its square, near the rounding of the products
@@ -652,14 +653,25 @@ def certify(body, E, nmodes, parent, m, pws, C, Mo, aw, warm):
         extrapolate(aw)
         moved = refine(aw)
         last = np.inf
-        for step in range(1, REFINE_STEPS):
+        tried = np.inf  # the step size at the last proof attempt
+        for step in range(1, REFINE_STEPS + 1):
+            # a step of size s leaves an error of about s^2: from VERIFY_AT on, the discs may already separate, and
+            # a proof costs less than a step, so try it before refining further (again only once the steps have
+            # shrunk a lot since the last try)
+            if 0.0 <= moved <= VERIFY_AT and moved <= tried * VERIFY_AT:
+                tried = moved
+                nonreal = verify(m, aw)
+                if nonreal >= 0:
+                    state[2] += 1
+                    state[4] = 1 - state[5]
+                    return nonreal // 2, True
             # quadratic convergence until rounding: stop there, or when the steps no longer shrink after the first
             # few (a cluster, or a neighbour too far for Newton's method), or grow wild
-            if not (moved > REFINE_TOL and (step < 4 or moved < 0.5 * last) and moved < DIVERGED):
+            if step == REFINE_STEPS or not (moved > REFINE_TOL and (step < 4 or moved < 0.5 * last) and moved < DIVERGED):
                 break
             last = moved
             moved = refine(aw)
-        if moved >= 0.0:
+        if moved >= 0.0 and moved < tried:
             nonreal = verify(m, aw)
             if nonreal >= 0:
                 state[2] += 1
