@@ -15,7 +15,7 @@ from stabmap import kernels
 from stabmap.kernels import certify
 from stabmap.systems.gyroscopes.points import PointArrays
 
-from test_certify import OFFSETS, _bisect_boundary, _with_omega, exact_nc, random_chain, run_decide, seed_of
+from test_certify import OFFSETS, _bisect_boundary, _with_omega, chain_with_boundary, exact_nc, random_chain, run_decide, seed_of
 
 
 def run_allatonce(pts: PointArrays):
@@ -90,16 +90,8 @@ def test_decide_block_uses_it_from_allatonce_bodies():
 def test_near_boundaries_never_wrong(n, modes, seed):
     """Next to a change of N_c (a pair that meets the real axis: a near-double root, or a pair with a tiny
     imaginary part) the certificate either proves the right label or leaves the point undecided."""
-    rng = np.random.default_rng(seed)
-    for _ in range(30):
-        pts = random_chain(rng, n, modes, False, "mixed", omegas=[1.0])
-        grid = np.linspace(1.0, 150.0, 12)
-        labels = [exact_nc(_with_omega(pts, [w]), 0) for w in grid]
-        changes = [i for i in range(len(grid) - 1) if labels[i] != labels[i + 1]]
-        if changes:
-            break
-    else:
-        pytest.skip("no boundary found")
+    grid = np.linspace(1.0, 150.0, 12)
+    pts, changes = chain_with_boundary(np.random.default_rng(seed), n, modes, grid, 30)
     decided = 0
     for i in changes[:2]:
         w_star = _bisect_boundary(pts, grid[i], grid[i + 1])

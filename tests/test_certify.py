@@ -835,18 +835,22 @@ def test_near_maievskii_boundary(m, A, C, c, g):
     _check_near(pts, w_star)
 
 
-@pytest.mark.parametrize("n,modes,seed", [(2, 1, 1), (2, 2, 2), (3, 1, 3), (3, 2, 4)])
-def test_near_liquid_boundaries(n, modes, seed):
-    rng = np.random.default_rng(seed)
-    for _ in range(20):  # find a chain with a boundary in (1, 100)
+def chain_with_boundary(rng, n: int, modes: int, grid, tries: int):
+    """(points, changes): a random fixed chain whose exact N_c changes between grid[i] and grid[i + 1] of omega
+    for each i in ``changes``; the test is skipped if ``tries`` chains show none."""
+    for _ in range(tries):
         pts = random_chain(rng, n, modes, False, "mixed", omegas=[1.0])
-        grid = np.linspace(1.0, 100.0, 10)
         labels = [exact_nc(_with_omega(pts, [w]), 0) for w in grid]
         changes = [i for i in range(len(grid) - 1) if labels[i] != labels[i + 1]]
         if changes:
-            break
-    else:
-        pytest.skip("no boundary found")
+            return pts, changes
+    pytest.skip("no boundary found")
+
+
+@pytest.mark.parametrize("n,modes,seed", [(2, 1, 1), (2, 2, 2), (3, 1, 3), (3, 2, 4)])
+def test_near_liquid_boundaries(n, modes, seed):
+    grid = np.linspace(1.0, 100.0, 10)
+    pts, changes = chain_with_boundary(np.random.default_rng(seed), n, modes, grid, 20)
     for i in changes[:2]:
         _check_near(pts, _bisect_boundary(pts, grid[i], grid[i + 1]))
 
