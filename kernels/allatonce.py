@@ -31,7 +31,7 @@ from numba import types
 from numba.np.linalg import _LAPACK
 
 from . import ball, pencil
-from .inclusion import find_root
+from .inclusion import find_root, group_disks
 from .options import kernel
 
 _RGEEV = _LAPACK().numba_ez_rgeev(types.float64)
@@ -287,15 +287,9 @@ def _count(disc, rad, size, group, m, D):
     and exactly m discs.
     """
     for i in range(D):
-        group[i] = i
         if not (rad[i] < math.inf):
             return -1
-    for i in range(D):
-        for j in range(i + 1, D):
-            if abs(disc[i] - disc[j]) * ball.LOW <= (rad[i] + rad[j]) * ball.INFL:
-                a, b = find_root(group, i), find_root(group, j)
-                if a != b:
-                    group[a] = b
+    group_disks(disc, rad, D, group)
     # per component (at its root): members, whether it may touch the axis, whether it may hold 0
     members = np.zeros(D, np.int64)
     touches = np.zeros(D, np.bool_)

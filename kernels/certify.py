@@ -272,7 +272,7 @@ def _fits(x):
 
 
 @kernel
-def _moderate(body, joint, at, g, E, kappa, nmodes):
+def moderate(body, joint, at, g, E, kappa, nmodes):
     """True if every parameter is zero or of moderate magnitude: the balls then neither overflow nor underflow."""
     if not _fits(g):
         return False
@@ -301,7 +301,7 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     # M T and K T in the workspace are the previous point's only if it got as far as prepare
     reuse = reuse and state[4] == 1
     state[4] = 0
-    if not _moderate(body, joint, at, g, E, kappa, nmodes):
+    if not moderate(body, joint, at, g, E, kappa, nmodes):
         state[0] = 0
         return -1, UNDECIDED
     m = pencil.prepare(body, joint, at, g, E, kappa, nmodes, parent, free, pws, reuse)
@@ -396,7 +396,7 @@ def allatonce_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reus
     pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
     reuse = reuse and state[4] == 1
     state[4] = 0
-    if not _moderate(body, joint, at, g, E, kappa, nmodes):
+    if not moderate(body, joint, at, g, E, kappa, nmodes):
         return -1, UNDECIDED
     m = pencil.prepare(body, joint, at, g, E, kappa, nmodes, parent, free, pws, reuse)
     state[4] = 1

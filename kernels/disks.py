@@ -15,7 +15,7 @@ import numpy as np
 
 from . import ball, elimination, pencil
 from .approximations import UPPER
-from .inclusion import find_root
+from .inclusion import find_root, group_disks
 from .options import kernel
 
 SMALL = 8  # bodies up to which plain elimination in balls beats preconditioning (BLAS products)
@@ -57,14 +57,7 @@ def nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e):
         R[i] = math.ldexp(mant * d * ball.INFL, expo) + ball.ETA
         if not R[i] <= np.inf:  # NaN: an infinite disk, which proves nothing
             R[i] = np.inf
-    for i in range(d):
-        group[i] = i
-    for i in range(d):
-        for j in range(i + 1, d):
-            if abs(z[i] - z[j]) * ball.LOW <= (R[i] + R[j]) * ball.INFL:
-                a, b = find_root(group, i), find_root(group, j)
-                if a != b:
-                    group[a] = b
+    group_disks(z, R, d, group)
     # a group touching the axis anywhere proves nothing; count members of the others
     touches = np.zeros(d, np.bool_)
     for i in range(d):

@@ -207,7 +207,8 @@ def group_disks(z, R, d, parent):
         parent[i] = i
     for i in range(d):
         for j in range(i + 1, d):
-            if abs(z[i] - z[j]) * (1.0 - 4.0 * dd.U) <= (R[i] + R[j]) * (1.0 + 2.0 * dd.U):
+            # the margins of ball.LOW and ball.INFL: the float modulus and sum rounded outward
+            if abs(z[i] - z[j]) * (1.0 - 4.0 * dd.U) <= (R[i] + R[j]) * (1.0 + 8.0 * dd.U):
                 ri, rj = find_root(parent, i), find_root(parent, j)
                 if ri != rj:
                     parent[ri] = rj

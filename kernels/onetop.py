@@ -8,7 +8,7 @@ Delta = b^2 + 4 a k is the whole count: two real roots if Delta > 0, one
 complex pair if Delta < 0.
 
 Why floats suffice where they are used: with every input zero or of moderate
-magnitude (``certify._moderate``: 2^-150 < |x| < 2^150), no product of up to
+magnitude (``certify.moderate``: 2^-150 < |x| < 2^150), no product of up to
 five inputs under- or overflows, so each operation has relative error at most
 u = 2^-53.  Writing alpha = |A| + |m| c^2 and kappa = |K_0| + |g m c|, the
 computed a and k are within 3u alpha and 3u kappa, b^2 within 3u b^2, 4 a k
@@ -23,7 +23,7 @@ problem at this degree (BENCHMARKS.md, "Degree 2").
 
 from __future__ import annotations
 
-from .certify import _moderate
+from .certify import moderate
 from .options import kernel
 from .status import DECIDED_FLOAT, UNDECIDED
 
@@ -33,7 +33,7 @@ BOUND = 16.0 * 2.0**-53  # twice the first-order error of the discriminant (modu
 @kernel
 def one_top(body, joint, at, g, E, kappa, nmodes, free):
     """(N_c, status) of a one-body point without modes; UNDECIDED where the float filter cannot tell."""
-    if not _moderate(body, joint, at, g, E, kappa, nmodes):
+    if not moderate(body, joint, at, g, E, kappa, nmodes):
         return -1, UNDECIDED
     m, A, C, c, omega = body[0, 0], body[0, 1], body[0, 2], body[0, 3], body[0, 5]
     if free:
