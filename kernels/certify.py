@@ -94,11 +94,12 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
 
     Neighbouring features (approximations that may be real, within NUDGE of
     the axis, and poles) get a separator midway; poles with such an
-    approximation close by, and the exact zero roots, are also fenced by
-    separators just either side.  So a root that moved past a pole
-    since z was found is still counted; where a fence cannot be evaluated,
-    the sign change of p between the midway separators still proves a root
-    beside its pole (``_sign_of_p``).  Where nu changes
+    approximation close by, and the exact zero roots, are fenced by
+    separators just either side instead.  So a root that moved past a pole
+    since z was found is still counted.  Where a root lies inside a pole's
+    fence (a tiny E), every neighbouring pair gets its midway separator too:
+    if the fences cannot be evaluated, the sign change of p between those
+    still proves the root beside its pole (``_sign_of_p``).  Where nu changes
     less across an interval than the near-real roots and poles inside it, the
     approximations inside are marked in ``suspect``: polishing them is usually
     all a retry needs.  ``feat`` needs 2 degree + 4 sum L + 8 entries.
@@ -135,8 +136,18 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
     # both sides instead, so that a root that moved past its pole since z was found is still counted
     sep[0] = lo - pad
     ns = 1
+    # a root inside a pole's fence (a tiny E) may be too close to it for the fences to be evaluated: then every
+    # neighbouring pair of features gets its midway separator, fenced or not, so that the pole and that root
+    # still get an interval of their own, whose sign change of p proves the root.  Otherwise fenced features get
+    # no midway separator: it would only cost an inertia evaluation.
+    tight = False
+    for t in range(lsum):
+        k = np.searchsorted(roots[:nr], poles[t])
+        for r in (k - 1, k):
+            if 0 <= r < nr and abs(roots[r] - poles[t]) < 2.0 * (FENCE * abs(poles[t]) + 1e-300):
+                tight = True
     i, j = 0, 0
-    last, started = 0.0, False
+    last, last_fenced, started = 0.0, False, False
     while i < nr or j < lsum:
         pole = j < lsum and (i >= nr or poles[j] < roots[i])
         x = poles[j] if pole else roots[i]
@@ -158,17 +169,14 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
             fence = m > 0 and x == 0.0
             eps = zero_eps
             i += 1
-        # midway between neighbours even beside a fence: where a fence cannot be evaluated (a root within a few
-        # hundred ulps of its pole), the pole and that root still get an interval of their own, whose sign change
-        # of p proves the root
-        if started and x - last > MERGE * max(abs(x), abs(last)):
+        if started and (tight or not (fence or last_fenced)) and x - last > MERGE * max(abs(x), abs(last)):
             sep[ns] = 0.5 * (x + last)
             ns += 1
         if fence:
             sep[ns] = x - eps
             sep[ns + 1] = x + eps
             ns += 2
-        last, started = x, True
+        last, last_fenced, started = x, fence, True
     sep[ns] = hi + pad
     ns += 1
     # the count below needs increasing separators (a fence may lie beyond a neighbouring root)
