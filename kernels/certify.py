@@ -142,10 +142,7 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
     # no midway separator: it would only cost an inertia evaluation.
     tight = False
     for t in range(lsum):
-        k = np.searchsorted(roots[:nr], poles[t])
-        for r in (k - 1, k):
-            if 0 <= r < nr and abs(roots[r] - poles[t]) < 2.0 * (FENCE * abs(poles[t]) + 1e-300):
-                tight = True
+        tight = tight or _gap_to_root(roots, nr, poles[t]) < 2.0 * (FENCE * abs(poles[t]) + 1e-300)
     i, j = 0, 0
     last, last_fenced, started = 0.0, False, False
     while i < nr or j < lsum:
@@ -154,12 +151,7 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
         fence = False
         eps = 0.0
         if pole:
-            k = np.searchsorted(roots[:nr], x)
-            near = np.inf
-            if k < nr:
-                near = roots[k] - x
-            if k > 0:
-                near = min(near, x - roots[k - 1])
+            near = _gap_to_root(roots, nr, x)
             fence = near < RIDE * abs(x)
             eps = FENCE * abs(x) + 1e-300
             if near < 2.0 * eps:  # a root inside the fence (a tiny E): the fence between them, if floats can tell
@@ -215,6 +207,18 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
                         suspect[i] = True
         last, prev, sign_last = nu, x, sign
     return total
+
+
+@kernel
+def _gap_to_root(roots, nr, x):
+    """Distance from x to the nearest of the sorted roots[:nr] (inf if there are none)."""
+    k = np.searchsorted(roots[:nr], x)
+    near = np.inf
+    if k < nr:
+        near = roots[k] - x
+    if k > 0:
+        near = min(near, x - roots[k - 1])
+    return near
 
 
 @kernel
