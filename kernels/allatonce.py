@@ -635,6 +635,27 @@ def extrapolate(aw):
 
 
 @kernel
+def last_step(step, moved, last):
+    """True if the refinement stops after ``step`` steps, the last of size ``moved``, the one before ``last``.
+
+    Quadratic convergence until rounding: stop there, or when the steps no longer shrink after the first few (a
+    cluster, or a neighbour too far for Newton's method), or grow wild, or after REFINE_STEPS.
+    """
+    return step >= REFINE_STEPS or not (moved > REFINE_TOL and (step < 4 or moved < 0.5 * last) and moved < DIVERGED)
+
+
+@kernel
+def proof_due(moved, tried, stop):
+    """True if the discs are to be tried after a step of size ``moved`` (the last try was after one of ``tried``).
+
+    A step of size s leaves an error of about s^2: from VERIFY_AT on, the discs may already separate, and a proof
+    costs less than a step, so it is tried before refining further (again only once the steps have shrunk a lot
+    since the last try); the last step's decomposition is tried unless it already was.
+    """
+    return 0.0 <= moved < tried and (stop or (moved <= VERIFY_AT and moved <= tried * VERIFY_AT))
+
+
+@kernel
 def certify(body, E, nmodes, parent, m, pws, C, Mo, aw, warm):
     """(N_c, warm used) of one point whose pencil workspace ``pws`` is prepared, or (-1, ...) if unproved.
 
@@ -649,28 +670,18 @@ def certify(body, E, nmodes, parent, m, pws, C, Mo, aw, warm):
         last = np.inf
         tried = np.inf  # the step size at the last proof attempt
         for step in range(1, REFINE_STEPS + 1):
-            # a step of size s leaves an error of about s^2: from VERIFY_AT on, the discs may already separate, and
-            # a proof costs less than a step, so try it before refining further (again only once the steps have
-            # shrunk a lot since the last try)
-            if 0.0 <= moved <= VERIFY_AT and moved <= tried * VERIFY_AT:
+            stop = last_step(step, moved, last)
+            if proof_due(moved, tried, stop):
                 tried = moved
                 nonreal = verify(m, aw)
                 if nonreal >= 0:
                     state[2] += 1
                     state[4] = 1 - state[5]
                     return nonreal // 2, True
-            # quadratic convergence until rounding: stop there, or when the steps no longer shrink after the first
-            # few (a cluster, or a neighbour too far for Newton's method), or grow wild
-            if step == REFINE_STEPS or not (moved > REFINE_TOL and (step < 4 or moved < 0.5 * last) and moved < DIVERGED):
+            if stop:
                 break
             last = moved
             moved = refine(aw)
-        if moved >= 0.0 and moved < tried:
-            nonreal = verify(m, aw)
-            if nonreal >= 0:
-                state[2] += 1
-                state[4] = 1 - state[5]
-                return nonreal // 2, True
     state[0] = 0
     state[4] = 0
     if not pencil.linearisation(body, E, nmodes, parent, pws, C, Mo):
