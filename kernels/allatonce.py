@@ -44,7 +44,7 @@ ETA = ball.ETA
 SCHULZ = 0.25  # ||I - Z Y|| of a stale inverse above this: LAPACK's inverse instead of Newton-Schulz steps
 SCHULZ_STEPS = 3
 REFINE_STEPS = 8  # first-order steps at most per point
-VERIFY_AT = 2.0**-10  # steps this small (largest entry of P) are followed by a proof attempt (``certify``)
+VERIFY_AT = 2.0**-2  # steps this small (largest entry of P) are followed by a proof attempt (``certify``)
 DIVERGED = 1e3  # a step moving the eigenvectors this much (largest entry of P): Newton's method diverges
 REFINE_TOL = 2.0**-20  # a step that moved the eigenvectors less than this (largest entry of P) is the last: it
 # leaves an error of about its square, near the rounding of the products

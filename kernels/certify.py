@@ -89,7 +89,7 @@ def allocate(n, nmodes, parent):
 
 
 @kernel
-def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, suspect):
+def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, suspect, with_poles):
     """Lower bound of the real roots of p from the inertia of Phi at separators.
 
     Neighbouring features (approximations that may be real, within NUDGE of
@@ -103,6 +103,12 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
     less across an interval than the near-real roots and poles inside it, the
     approximations inside are marked in ``suspect``: polishing them is usually
     all a retry needs.  ``feat`` needs 2 degree + 4 sum L + 8 entries.
+
+    ``with_poles`` False: separators between the approximations that may be real alone (and the fences of the
+    exact zero roots).  p is a polynomial, so its sign change proves a root in an interval whatever poles of Phi
+    lie there: one separator between neighbouring simple real roots is all they need, against one or two more
+    for every pole.  Repeated roots (no sign change), or a pole's jump in nu cancelling theirs, then leave
+    suspects, and the caller counts again with ``with_poles`` True.
     """
     n = body.shape[0]
     beta = pws[5]
@@ -122,11 +128,14 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
                 continue  # kappa = 2: no pole (pencil._liquid_real); its zero of prod Q is among the m exact zero roots
             feat[nr + lsum] = -beta[0, k, l]
             lsum += 1
+    if nr + lsum == 0 or (nr == 0 and not with_poles):
+        suspect[:d] = False
+        return 0  # nothing may be real: no real root is proved (and none is expected)
     roots = np.sort(feat[:nr])
     poles = np.sort(feat[nr : nr + lsum])
     sep = feat[nr + lsum :]
-    if nr + lsum == 0:
-        return 0  # nothing may be real: no real root is proved
+    # the poles that place separators; all of them count in each interval's jump of nu below
+    lsep = lsum if with_poles else 0
     lo = min(roots[0], poles[0]) if lsum and nr else (poles[0] if lsum else roots[0])
     hi = max(roots[nr - 1], poles[lsum - 1]) if lsum and nr else (poles[lsum - 1] if lsum else roots[nr - 1])
     pad = 0.25 * (hi - lo) + 1e-3 * max(abs(lo), abs(hi)) + 1e-300
@@ -141,12 +150,12 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
     # still get an interval of their own, whose sign change of p proves the root.  Otherwise fenced features get
     # no midway separator: it would only cost an inertia evaluation.
     tight = False
-    for t in range(lsum):
+    for t in range(lsep):
         tight = tight or _gap_to_root(roots, nr, poles[t]) < 2.0 * (FENCE * abs(poles[t]) + 1e-300)
     i, j = 0, 0
     last, last_fenced, started = 0.0, False, False
-    while i < nr or j < lsum:
-        pole = j < lsum and (i >= nr or poles[j] < roots[i])
+    while i < nr or j < lsep:
+        pole = j < lsep and (i >= nr or poles[j] < roots[i])
         x = poles[j] if pole else roots[i]
         fence = False
         eps = 0.0
@@ -249,7 +258,13 @@ def _attempt(z, d, m, degree, body, E, nmodes, parent, ws, sweeps):
     neighbour's roots are good enough for separators, not for disks).
     """
     pws, C, Mo, wr, wi, vdummy, _z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
-    real = max(m, _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, done))
+    # approximations from the eigenvalue problem (no sweeps) are accurate: separators between them alone
+    # usually prove every real root; a neighbour's, extrapolated, often leave suspects, so those count at once
+    # with the poles fenced
+    real = _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, done, sweeps > 0)
+    if sweeps == 0 and done[:d].any():  # an interval short of its expected roots: count again, poles fenced
+        real = _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, done, True)
+    real = max(m, real)
     near, upper = 0, 0
     for i in range(d):
         near += abs(z[i].imag) <= NUDGE * abs(z[i])

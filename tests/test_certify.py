@@ -936,6 +936,55 @@ def test_tiny_liquid_modes_are_decided_by_the_kernels_not_exactly():
     assert len(set(nc.tolist())) > 1
 
 
+def _real_bounds(pts: PointArrays, p: int, z_of):
+    """(exact real roots of p, the cheap count, the full count, suspects left by the cheap count) for the
+    approximations ``z_of(z, d, poles)`` (z: the linearisation's eigenvalues without the m exact zeros)."""
+    body, joint, g, E, kappa, nmodes, free, parent, at = pts.kernel_args()
+    n = body.shape[1]
+    ws = certify.allocate(n, nmodes, parent)
+    pws, C, Mo, wr, wi, vdummy, z, Sm, Sr, feat, done = ws[0], ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[9], ws[10], ws[11], ws[18]
+    m = pencil.prepare(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, pws, False)
+    degree = C.shape[0]
+    d = degree - m
+    assert pencil.linearisation(body[p], E[p], nmodes, parent, pws, C, Mo)
+    assert kernels.approximations.eigenvalues(C, wr, wi, vdummy, z, degree, m)
+    poles = np.array([-pws[5][0, k, l] for k in range(n) for l in range(nmodes[k])])
+    z[:d] = z_of(z[:d].copy(), d, poles)
+    args = (z, d, m, body[p], E[p], nmodes, parent, pws, feat, Sm, Sr, done)
+    cheap = max(m, certify._real_roots_at_least(*args, False))
+    suspects = int(done[:d].sum())
+    full = max(m, certify._real_roots_at_least(*args, True))
+    return exact.count_real_roots(exact_poly(pts, p)), cheap, full, suspects
+
+
+@pytest.mark.parametrize("kind,e_scale", [("mixed", (1e-5, 3e-3)), ("identical", (1e-5, 3e-3)), ("mixed", (1e-14, 3e-12)),
+                                          ("zerok", (1e-5, 3e-3))])
+def test_separators_between_roots_alone_count_no_more_than_the_exact_real_roots(kind, e_scale):
+    """The cheap count (separators between the approximations that may be real, none beside the poles) is a
+    lower bound of the real roots whatever the approximations: accurate ones (then it finds them all, or
+    leaves suspects for the count with the poles fenced), and approximations put on the poles and at random
+    (a pole's jump in nu must never be counted as a root)."""
+    rng = np.random.default_rng(seed_of("separators", kind, e_scale))
+    found = 0
+    for trial in range(10):
+        pts = random_chain(rng, int(rng.integers(2, 6)), int(rng.integers(1, 4)), bool(trial % 2), kind,
+                           npts=1, e_scale=e_scale)
+        real, cheap, full, suspects = _real_bounds(pts, 0, lambda z, d, poles: z)
+        assert cheap <= real and full <= real, (kind, trial, real, cheap, full)
+        assert cheap == real or suspects > 0, (kind, trial, real, cheap, suspects)
+        found += cheap == real
+
+        def on_poles(z, d, poles):
+            out = rng.uniform(-200, 200, d) + 0j
+            k = min(d, 2 * len(poles))
+            out[:k] = np.repeat(poles, 2)[:k] * (1 + np.tile([1e-9, -1e-9], len(poles))[:k])
+            return out
+
+        real, cheap, full, _ = _real_bounds(pts, 0, on_poles)
+        assert cheap <= real and full <= real, ("on the poles", kind, trial, real, cheap, full)
+    assert found >= 5  # the cheap count is not only safe but finds the real roots of most points
+
+
 # ---------------------------------------------------------------------------------------------
 # slow: a larger sweep and a bounds-checked run
 
