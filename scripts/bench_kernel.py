@@ -4,6 +4,7 @@
     python scripts/bench_kernel.py --quick    # seconds; run once by the test suite
     python scripts/bench_kernel.py --corners  # only the structural corners below (a few minutes)
     python scripts/bench_kernel.py --many     # many bodies: n = 12, 16, 24, 32, 0-4 modes, degree <= 128 (~15 minutes)
+    python scripts/bench_kernel.py --density  # the same chains on lines of 50, 100, 200, 400 points (~10 minutes)
 
 Point sets, for every (n, modes): random chains (realistic ranges, joints and
 liquid modes as given), each scanned along omega over a line of points in grid
@@ -203,6 +204,21 @@ def run(n: int, modes: int, kind: str, lines: int, per_line: int, rng) -> dict:
     }
 
 
+# --density: the ratio against the spacing of the grid line (2 lines from -150 to 150 rad/s, the same chains at
+# every spacing): neighbours 6.1 rad/s apart (50 points, the other sets) down to 0.75 rad/s (400 points)
+DENSITY_ROWS = ((6, 4, "mixed"), (8, 3, "ideal"), (8, 3, "kappa2"), (8, 4, "mixed"), (12, 3, "mixed"), (16, 2, "mixed"),
+                (24, 1, "mixed"), (32, 0, "identical"))
+DENSITIES = (50, 100, 200, 400)
+
+
+def density_cases(quick: bool):
+    """(n, modes, kind, lines, points per line, seed): each chain drawn from its own seed, so only the spacing
+    changes along a row's densities."""
+    if quick:
+        return [(3, 2, "mixed", 1, per, 1) for per in (8, 16)]
+    return [(n, m, k, 2, per, 1000 + i) for i, (n, m, k) in enumerate(DENSITY_ROWS) for per in DENSITIES]
+
+
 MANY = ((12, 0), (12, 2), (12, 4), (16, 0), (16, 2), (16, 4), (24, 0), (24, 1), (24, 3), (32, 0), (32, 1), (32, 2))
 
 
@@ -244,14 +260,19 @@ def main(argv=None) -> list[dict]:
     ap.add_argument("--max-degree", type=int, default=96, help="skip larger (n, modes) cases")
     ap.add_argument("--corners", action="store_true", help="only the structural corners (module docstring)")
     ap.add_argument("--many", action="store_true", help="only many bodies: n = 12..32, degree <= --max-degree")
+    ap.add_argument("--density", action="store_true", help="the ratio against the grid spacing (DENSITY_ROWS)")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(2026)
     print(f"# machine: {os.cpu_count()} cores, {platform.processor() or platform.machine()}, python {platform.python_version()}")
     print(HEADER)
     print("|" + "---|" * (HEADER.count("|") - 1))
     rows = []
-    for n, modes, kind, lines, per in cases(args.quick, args.max_degree, args.corners, args.many):
-        r = run(n, modes, kind, lines, per, rng)
+    if args.density:
+        todo = [(n, m, k, lines, per, np.random.default_rng(seed)) for n, m, k, lines, per, seed in density_cases(args.quick)]
+    else:
+        todo = [(n, m, k, lines, per, rng) for n, m, k, lines, per in cases(args.quick, args.max_degree, args.corners, args.many)]
+    for n, modes, kind, lines, per, row_rng in todo:
+        r = run(n, modes, kind, lines, per, row_rng)
         rows.append(r)
         shares = ", ".join(f"{name} {v:.1f}" for name, v in r["shares"].items() if v)
         print(

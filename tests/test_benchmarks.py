@@ -22,6 +22,14 @@ def test_bench_kernel_quick(capsys):
     assert "| n | modes |" in capsys.readouterr().out
 
 
+def test_bench_kernel_density_quick():
+    """The same chain at two spacings: only the number of points along the line changes."""
+    rows = runpy.run_path(str(SCRIPTS / "bench_kernel.py"))["main"](["--density", "--quick"])
+    assert [(r["degree"], r["points"]) for r in rows] == [(12, 8), (12, 16)]
+    for r in rows:
+        assert r["peer_us"] > 0 and r["peer_wrong"] <= r["compared"] == r["points"]
+
+
 @pytest.mark.slow
 def test_bench_atlas_quick(capsys):
     out = runpy.run_path(str(SCRIPTS / "bench_atlas.py"))["main"](["--quick"])
