@@ -49,6 +49,13 @@ NUDGE = 2.0**-10  # relative imaginary offset given to suspect real approximatio
 # cost about n^4 a point, it about D^3 (measured: BENCHMARKS.md, "All eigenvalues at once")
 ALLATONCE_BODIES = 10
 ALLATONCE_PRICE = 0.1
+# ... and from ALLATONCE_FEW bodies where D <= ALLATONCE_WIDTH n (at most 3 modes a body on average) and p has no
+# exact zero root (free chains, kappa = 2: its discs then refine warm less often): on grid lines its warm points
+# cost less than the disks' there (BENCHMARKS.md, "Issue 32, third session")
+ALLATONCE_FEW = 4
+ALLATONCE_WIDTH = 5
+COLD_RUN = 3  # this many cold starts in a row: no neighbour helps (scattered points), the disks' cold start is cheaper
+PAUSE_MAX = 256  # the all-at-once pauses double up to this many points while its cold starts keep failing to pay
 MAGNITUDE_LOW, MAGNITUDE_HIGH = 2.0**-150, 2.0**150  # parameters outside are left to exact arithmetic
 
 
@@ -74,8 +81,9 @@ def allocate(n, nmodes, parent):
     group = np.empty(degree, np.int64)
     # state: [0] the previous point was decided, [1] its degree d, [2] points left to do cold,
     # [3] zold holds the roots of the point before the previous one,
-    # [4] the workspace holds the structure (M T, K T) of the last point given
-    state = np.zeros(5, np.int64)
+    # [4] the workspace holds the structure (M T, K T) of the last point given,
+    # [5] the all-at-once certificate's cold starts in a row, [6] its last pause (points)
+    state = np.zeros(7, np.int64)
     # running means: cost of a warm start (n x n solves), its hit rate (hoped 1 until tried), cost of a cold start
     costs = np.array([0.0, 1.0, 0.0])
     zold = np.empty(degree, np.complex128)
@@ -338,7 +346,7 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     if not ok:  # deg p unproved: nothing below counts
         state[0] = 0
         return -1, UNDECIDED
-    if n >= ALLATONCE_BODIES and float(n) ** 4 >= ALLATONCE_PRICE * float(degree) ** 3:
+    if _allatonce_first(n, degree, m):
         nc = _allatonce(body, E, nmodes, parent, m, ws)
         if nc >= 0:
             state[0] = 0  # the roots in z are not this point's
@@ -399,10 +407,23 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
 
 
 @kernel
+def _allatonce_first(n, degree, m):
+    """True if the all-at-once certificate goes first for n bodies, deg p = degree and m exact zero roots (the
+    price rules above)."""
+    if n >= ALLATONCE_BODIES and float(n) ** 4 >= ALLATONCE_PRICE * float(degree) ** 3:
+        return True
+    return n >= ALLATONCE_FEW and degree <= ALLATONCE_WIDTH * n and m == 0
+
+
+@kernel
 def _allatonce(body, E, nmodes, parent, m, ws):
-    """N_c by the all-at-once certificate (docs/certification.md, section 4b), or -1; it pauses for PAUSE points
-    after a cold start that did not decide (a free chain's defective zero roots, say), since it then only adds
-    its cost to the certificates behind it."""
+    """N_c by the all-at-once certificate (docs/certification.md, section 4b), or -1.
+
+    Its cold start (eigenvectors) costs more than the disks' (eigenvalues only) and pays only through the warm
+    points after it.  So it pauses after a cold start that did not decide (a free chain's defective zero roots,
+    say) or after COLD_RUN cold starts in a row (scattered points): PAUSE points first, twice as many after each
+    pause that did not end the run, up to PAUSE_MAX; a point decided warm ends it.
+    """
     pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
     flags = aw[-1]
     if flags[3] > 0:
@@ -410,8 +431,14 @@ def _allatonce(body, E, nmodes, parent, m, ws):
         flags[0] = 0  # the decomposition kept is too old to refine
         return -1
     nc, warm = allatonce.certify(body, E, nmodes, parent, m, pws, C, Mo, aw, True)
-    if nc < 0 and not warm:
-        flags[3] = PAUSE
+    if warm:
+        state[5], state[6] = 0, 0
+    else:
+        state[5] += 1
+        if nc < 0 or state[5] >= COLD_RUN:
+            state[6] = min(2 * state[6], PAUSE_MAX) if state[6] > 0 else PAUSE
+            flags[3] = state[6]
+            state[5] = 0
     return nc
 
 

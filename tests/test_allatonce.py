@@ -86,6 +86,33 @@ def test_decide_block_uses_it_from_allatonce_bodies():
         assert nc[p] == exact_nc(pts, p)
 
 
+def test_decide_block_uses_it_for_few_modes_on_lines_and_backs_off_elsewhere():
+    """From ALLATONCE_FEW bodies with at most ALLATONCE_WIDTH - 2 modes a body and no exact zero root,
+    decide_block tries the certificate first along a line.  Scattered points (every point its own chain: each
+    a cold start) make it pause after COLD_RUN cold starts, and a free chain (exact zero roots) never takes it
+    first: the disks decide those.  Every label against exact arithmetic."""
+    n = certify.ALLATONCE_FEW
+    rng = np.random.default_rng(seed_of("few", n))
+    line = random_chain(rng, n, 2, False, "mixed", omegas=np.linspace(-100.0, 100.0, 30))
+    nc, st = run_decide(line)
+    assert np.mean(st == kernels.DECIDED_ALLATONCE) >= 0.8
+    assert nc.tolist() == [exact_nc(line, p) for p in range(30)]
+    scattered = random_chain(rng, n, 2, False, "mixed", npts=1)
+    for _ in range(29):
+        other = random_chain(rng, n, 2, False, "mixed", npts=1)
+        scattered = PointArrays(*(np.concatenate([getattr(scattered, f), getattr(other, f)]) for f in
+                                  ("body", "joint", "g", "E", "kappa")), scattered.nmodes, False)
+    nc, st = run_decide(scattered)
+    # COLD_RUN cold starts, a pause of PAUSE = 16 points, COLD_RUN more, then a pause of 32
+    assert (st == kernels.DECIDED_ALLATONCE).sum() <= 2 * certify.COLD_RUN
+    assert not np.any(st == kernels.UNDECIDED)
+    assert nc.tolist() == [exact_nc(scattered, p) for p in range(30)]
+    free = random_chain(rng, n, 2, True, "mixed", omegas=np.linspace(-100.0, 100.0, 12))
+    nc, st = run_decide(free)
+    assert not np.any(st == kernels.DECIDED_ALLATONCE)
+    assert nc.tolist() == [exact_nc(free, p) for p in range(12)]
+
+
 @pytest.mark.parametrize("n,modes,seed", [(1, 0, 1), (2, 1, 2), (3, 1, 3), (2, 2, 4)])
 def test_near_boundaries_never_wrong(n, modes, seed):
     """Next to a change of N_c (a pair that meets the real axis: a near-double root, or a pair with a tiny

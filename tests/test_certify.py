@@ -35,13 +35,13 @@ from hypothesis import strategies as st
 
 from stabmap import kernels
 from stabmap.kernels import ball, certify, elimination, pencil
-from stabmap.kernels.status import DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA
+from stabmap.kernels.status import DECIDED_ALLATONCE, DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA
 from stabmap.systems.gyroscopes import exact
 from stabmap.systems.gyroscopes.points import PointArrays
 
 import reference as ref
 
-DECIDED = (DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, DECIDED_DISKS)
+DECIDED = (DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, DECIDED_DISKS, DECIDED_ALLATONCE)
 F = Fraction
 
 
@@ -1048,7 +1048,7 @@ def test_a_point_refused_before_prepare_leaves_no_stale_structure():
     for p in range(3):
         if st[p] != kernels.UNDECIDED:
             assert nc[p] == exact_nc(pts, p), (p, nc, st)
-    assert st[2] in (DECIDED_INERTIA, DECIDED_DISKS)
+    assert st[2] in (DECIDED_INERTIA, DECIDED_DISKS, kernels.DECIDED_ALLATONCE)
 
 
 def test_root_inclusion_bound_does_not_underflow_on_clustered_roots():
