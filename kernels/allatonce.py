@@ -49,6 +49,8 @@ DIVERGED = 1e3  # a step moving the eigenvectors this much (largest entry of P):
 REFINE_TOL = 2.0**-20  # a step that moved the eigenvectors less than this (largest entry of P) is the last: it
 # leaves an error of about its square, near the rounding of the products
 CLUSTER = 2.0**-30  # eigenvalues this close (relative) are a cluster: not separated by the refinement
+SPLIT = 2.0**-2  # a pair's coupling to its conjugate above this (relative to |a + i b|) is removed to first order,
+# not solved exactly; nor below b / 2 (``refine``)
 MAX_E = 0.5  # ||I - Y B X|| proved below this, so e / (1 - e) <= 2 e
 
 
@@ -392,7 +394,7 @@ def _sylvester(H, P, lam, size, i, j):
     discs of the cluster then decide together, or not at all.
     """
     da, db = lam[i, 0] - lam[j, 0], lam[i, 1] - lam[j, 1]
-    if abs(da) + abs(db) <= CLUSTER * (abs(lam[i, 0]) + abs(lam[i, 1]) + abs(lam[j, 0]) + abs(lam[j, 1])):
+    if i != j and abs(da) + abs(db) <= CLUSTER * (abs(lam[i, 0]) + abs(lam[i, 1]) + abs(lam[j, 0]) + abs(lam[j, 1])):
         return
     if size[i] == 1 and size[j] == 1:
         P[i, j] = -H[i, j] / da
@@ -528,6 +530,7 @@ def refine(aw):
     X, Y, Z, AX, H, T, P = mats[0], mats[1], mats[2], mats[3], mats[4], mats[5], mats[7]
     n, D = An.shape[1], X.shape[0]
     _products(X, AX, Z, An, Mp, yk, yb, n, D)
+    # (``group`` is scratch here: 1 at a pair whose coupling to its conjugate is removed to first order)
     # Y ~ (B X)^-1 again: Newton-Schulz steps Y <- Y (2 I - Z Y) while they converge fast, else LAPACK's inverse.
     # (every step: the update (I + P)^-1 Y ~ (I - P) Y of the step before errs by P^2, which would stay in L)
     for _ in range(SCHULZ_STEPS):
@@ -553,7 +556,8 @@ def refine(aw):
             break
     np.dot(Y, AX, H)  # ~ X^-1 B^-1 A X
     # where two real eigenvalues met and left the axis, or a pair met it, the blocks change with them
-    if _regroup(X, Y, H, size, mats[8], D):
+    regrouped = _regroup(X, Y, H, size, mats[8], D)
+    if regrouped:
         state[5] = 1
     # the 2 x 2 diagonal blocks back to normal form [[a, b], [-b, a]] (S: H_bb S = S N), 1 x 1 ones read off
     j = 0
@@ -564,6 +568,28 @@ def refine(aw):
             continue
         p, q, r, s = H[j, j], H[j, j + 1], H[j + 1, j], H[j + 1, j + 1]
         a = 0.5 * (p + s)
+        group[j] = 0
+        # The block is [[a, b], [-b, a]] (a + i b) plus a part of modulus conj that couples a + i b with a - i b.
+        # Solved exactly (below) only where the pair may be meeting the axis (b or conj small against |a + i b|, conj
+        # near b) or was just formed by ``_regroup``; elsewhere conj is removed to first order like every other
+        # coupling (``_sylvester`` with i = j: conj / 2 b), as Newton's method in complex arithmetic does.  A conj
+        # far above b is the step seen through ill-conditioned eigenvectors (identical bodies on ideal joints,
+        # condition numbers ~ 1e5): the block's own eigenvalues are then far off, real, and solving it exactly split
+        # the pair and made the refinement diverge at any grid spacing (docs/certification.md, 4b).
+        b, conj = 0.5 * (q - r), math.hypot(0.5 * (p - s), 0.5 * (q + r))
+        size_ab = SPLIT * (abs(a) + abs(b))
+        if not regrouped and abs(b) > size_ab and (conj < 0.5 * abs(b) or conj > size_ab):
+            # made b > 0 (columns j + 1 of X, rows j + 1 of Y negated)
+            if b < 0.0:
+                for i in range(D):
+                    X[i, j + 1], H[i, j + 1] = -X[i, j + 1], -H[i, j + 1]
+                for c in range(D):
+                    Y[j + 1, c], H[j + 1, c] = -Y[j + 1, c], -H[j + 1, c]
+                b = -b
+            lam[j, 0], lam[j, 1], lam[j + 1, 0], lam[j + 1, 1] = a, b, a, b
+            group[j] = 1
+            j += 2
+            continue
         disc2 = 0.25 * (p - s) * (p - s) + q * r
         if not disc2 < 0.0:
             # the pair met the axis: two real eigenvalues, each with its real eigenvector of the block
@@ -602,7 +628,7 @@ def refine(aw):
                 if i != j and abs(da) > CLUSTER * (li + abs(lam[j, 0])):
                     P[i, j] = -H[i, j] / da
                     big = max(big, abs(P[i, j]))
-            elif i != j:
+            elif i != j or (size[i] == 2 and group[i] == 1):
                 _sylvester(H, P, lam, size, i, j)
                 for r in range(i, i + size[i]):
                     for c in range(j, j + size[j]):
