@@ -2,6 +2,7 @@
 
     python scripts/bench_allatonce.py           # the many-body rows of bench_kernel.py --many (a few minutes)
     python scripts/bench_allatonce.py --quick   # seconds; run once by the test suite
+    python scripts/bench_allatonce.py --lines 32:0:identical:400 16:0:identical:200   # cold starts per line set
 
 The points are those of ``bench_kernel.py --many`` (same seed and order: 2 lines of 50 points along omega per
 row).  Each point is certified as ``certify.certify_point`` does it, one step at a time from Python, timed in CPU
@@ -20,10 +21,11 @@ from pathlib import Path
 
 import numpy as np
 
+from stabmap import kernels
 from stabmap.kernels import allatonce, certify, pencil
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_kernel import cases, point_set  # noqa: E402
+from bench_kernel import CORNERS, cases, corner_set, float_peer, point_set  # noqa: E402
 
 
 def split(pts) -> dict:
@@ -81,10 +83,41 @@ def split(pts) -> dict:
             "steps": steps / max(1, npts - 1), "us": us, "ratio": sum(v for k, v in us.items() if k != "peer") / us["peer"]}
 
 
+def cold_starts(spec: str) -> dict:
+    """``kernels.allatonce_block`` on the point set ``spec`` = n:modes:kind:points per line (2 lines along omega from
+    -150 to 150, ``bench_kernel.point_set`` or ``corner_set``, seed 1007): its cold starts, the points it left
+    undecided and its CPU time over the float peer's."""
+    n, modes, kind, per = spec.split(":")
+    n, modes, per = int(n), int(modes), int(per)
+    rng = np.random.default_rng(1007)
+    pts = corner_set(rng, kind, 2, per, n, modes) if kind in CORNERS else point_set(rng, kind, 2, per, n, modes)
+    args = pts.kernel_args()
+    npts = args[0].shape[0]
+    nc, st = np.zeros(npts, np.int64), np.zeros(npts, np.int8)
+    kernels.allatonce_block(*pts.take(np.arange(2)).kernel_args(), nc[:2], st[:2])  # compile outside the timed call
+    t0 = time.process_time()
+    cold = kernels.allatonce_block(*args, nc, st)
+    t = time.process_time() - t0
+    _, t_peer = float_peer(pts)
+    return {"spec": spec, "points": npts, "cold": int(cold), "undecided": int((st != kernels.DECIDED_ALLATONCE).sum()),
+            "ratio": t / t_peer}
+
+
 def main(argv=None) -> list[dict]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="one small row, for the test suite")
+    ap.add_argument("--lines", nargs="+", metavar="N:MODES:KIND:PER_LINE",
+                    help="only the cold starts of the certificate alone on these point sets (2 lines each)")
     args = ap.parse_args(argv)
+    if args.lines:
+        print("| spec | points | cold starts | undecided | ratio to the float peer |")
+        print("|---|---|---|---|---|")
+        out = []
+        for spec in args.lines:
+            r = cold_starts(spec)
+            print(f"| {spec} | {r['points']} | {r['cold']} | {r['undecided']} | {r['ratio']:.2f} |", flush=True)
+            out.append(r)
+        return out
     rng = np.random.default_rng(2026)
     rows = cases(False, 128, many=True)
     if args.quick:

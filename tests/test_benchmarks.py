@@ -195,3 +195,10 @@ def test_bench_allatonce_quick(capsys):
     assert len(rows) == 1 and rows[0]["points"] == 8
     assert rows[0]["us"]["peer"] > 0 and rows[0]["decided_pct"] > 0
     assert "| n | modes | degree |" in capsys.readouterr().out
+
+
+def test_bench_allatonce_lines_quick():
+    """--lines: the certificate alone on a small line set; a line's first point is a cold start."""
+    rows = runpy.run_path(str(SCRIPTS / "bench_allatonce.py"), run_name="bench")["main"](["--lines", "12:0:mixed:6"])
+    assert [(r["spec"], r["points"]) for r in rows] == [("12:0:mixed:6", 12)]
+    assert 2 <= rows[0]["cold"] <= 12 and rows[0]["ratio"] > 0
