@@ -48,7 +48,8 @@ VERIFY_AT = 2.0**-2  # steps this small (largest entry of P) are followed by a p
 DIVERGED = 1e3  # a step moving the eigenvectors this much (largest entry of P): Newton's method diverges
 REFINE_TOL = 2.0**-20  # a step that moved the eigenvectors less than this (largest entry of P) is the last: it
 # leaves an error of about its square, near the rounding of the products
-CLUSTER = 2.0**-30  # eigenvalues this close (relative) are a cluster: not separated by the refinement
+CLUSTER = 2.0**-30  # eigenvalues this close (relative to their size plus the spectral radius) are a cluster:
+# not separated by the refinement (the radius: exact zero roots, kappa = 2, sit at rounding noise of it)
 SPLIT = 2.0**-2  # a pair's coupling to its conjugate above this (relative to |a + i b|) is removed to first order,
 # not solved exactly; nor below b / 2 (``refine``)
 MAX_E = 0.5  # ||I - Y B X|| proved below this, so e / (1 - e) <= 2 e
@@ -387,14 +388,14 @@ def _cdiv(x, d):
 
 
 @kernel
-def _sylvester(H, P, lam, size, i, j):
+def _sylvester(H, P, lam, size, i, j, radius):
     """P_ij with L_i P_ij - P_ij L_j = -H_ij for the blocks at columns i and j (closed forms, module docstring).
 
-    Left 0 for (nearly) repeated eigenvalues: there the first-order step divides noise by a tiny gap, and the
-    discs of the cluster then decide together, or not at all.
+    Left 0 for (nearly) repeated eigenvalues (``CLUSTER``; ``radius`` the largest |eigenvalue|): there the
+    first-order step divides noise by a tiny gap, and the discs of the cluster then decide together, or not at all.
     """
     da, db = lam[i, 0] - lam[j, 0], lam[i, 1] - lam[j, 1]
-    if i != j and abs(da) + abs(db) <= CLUSTER * (abs(lam[i, 0]) + abs(lam[i, 1]) + abs(lam[j, 0]) + abs(lam[j, 1])):
+    if i != j and abs(da) + abs(db) <= CLUSTER * (abs(lam[i, 0]) + abs(lam[i, 1]) + abs(lam[j, 0]) + abs(lam[j, 1]) + radius):
         return
     if size[i] == 1 and size[j] == 1:
         P[i, j] = -H[i, j] / da
@@ -618,10 +619,13 @@ def refine(aw):
     # that commutes with it and one that conjugates it (``_sylvester``), so every block has a closed form.
     P[:] = 0.0
     big = 0.0
+    radius = 0.0
+    for i in range(D):
+        radius = max(radius, abs(lam[i, 0]) + abs(lam[i, 1]))
     i = 0
     while i < D:
         j = 0
-        li = abs(lam[i, 0]) + abs(lam[i, 1])
+        li = abs(lam[i, 0]) + abs(lam[i, 1]) + radius
         while j < D:
             if size[i] == 1 and size[j] == 1:  # the common case, inline: real eigenvalues
                 da = lam[i, 0] - lam[j, 0]
@@ -629,7 +633,7 @@ def refine(aw):
                     P[i, j] = -H[i, j] / da
                     big = max(big, abs(P[i, j]))
             elif i != j or (size[i] == 2 and group[i] == 1):
-                _sylvester(H, P, lam, size, i, j)
+                _sylvester(H, P, lam, size, i, j, radius)
                 for r in range(i, i + size[i]):
                     for c in range(j, j + size[j]):
                         big = max(big, abs(P[r, c]))
