@@ -55,6 +55,7 @@ ALLATONCE_PRICE = 0.1
 ALLATONCE_FEW = 4
 ALLATONCE_WIDTH = 5
 COLD_RUN = 3  # this many cold starts in a row: no neighbour helps (scattered points), the disks' cold start is cheaper
+MANY, FEW = 2, 1  # which price rule put the all-at-once certificate first (``_allatonce_first``)
 PAUSE_MAX = 256  # the all-at-once pauses double up to this many points while its cold starts keep failing to pay
 MAGNITUDE_LOW, MAGNITUDE_HIGH = 2.0**-150, 2.0**150  # parameters outside are left to exact arithmetic
 
@@ -346,8 +347,10 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     if not ok:  # deg p unproved: nothing below counts
         state[0] = 0
         return -1, UNDECIDED
-    if _allatonce_first(n, degree, m):
-        nc = _allatonce(body, E, nmodes, parent, m, ws)
+    first = _allatonce_first(n, degree, m)
+    skipped = False
+    if first > 0:
+        nc, skipped = _allatonce(body, E, nmodes, parent, m, ws, first == FEW)
         if nc >= 0:
             state[0] = 0  # the roots in z are not this point's
             return nc, DECIDED_ALLATONCE
@@ -401,6 +404,13 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
                 nonreal = disks.nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e)
                 if real + nonreal == degree and nonreal % 2 == 0:
                     nc, status = nonreal // 2, DECIDED_DISKS
+    if status == UNDECIDED and skipped:
+        # the disks did not decide a point the all-at-once certificate skipped in a pause: it tries, cold, before
+        # the point goes to exact arithmetic (ill-conditioned identical chains, say, which only it decides)
+        nc, _ = allatonce.certify(body, E, nmodes, parent, m, pws, C, Mo, aw, False)
+        if nc >= 0:
+            state[0] = 0
+            return nc, DECIDED_ALLATONCE
     state[0] = 1 if status != UNDECIDED else 0
     state[1] = d
     return nc, status
@@ -408,38 +418,41 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
 
 @kernel
 def _allatonce_first(n, degree, m):
-    """True if the all-at-once certificate goes first for n bodies, deg p = degree and m exact zero roots (the
-    price rules above)."""
+    """Whether the all-at-once certificate goes first for n bodies, deg p = degree and m exact zero roots (the
+    price rules above): MANY (the disks cost n^4 a point), FEW (few modes a body), or 0 (not first)."""
     if n >= ALLATONCE_BODIES and float(n) ** 4 >= ALLATONCE_PRICE * float(degree) ** 3:
-        return True
-    return n >= ALLATONCE_FEW and degree <= ALLATONCE_WIDTH * n and m == 0
+        return MANY
+    if n >= ALLATONCE_FEW and degree <= ALLATONCE_WIDTH * n and m == 0:
+        return FEW
+    return 0
 
 
 @kernel
-def _allatonce(body, E, nmodes, parent, m, ws):
-    """N_c by the all-at-once certificate (docs/certification.md, section 4b), or -1.
+def _allatonce(body, E, nmodes, parent, m, ws, few):
+    """(N_c by the all-at-once certificate (docs/certification.md, section 4b) or -1, skipped in a pause).
 
-    Its cold start (eigenvectors) costs more than the disks' (eigenvalues only) and pays only through the warm
-    points after it.  So it pauses after a cold start that did not decide (a free chain's defective zero roots,
-    say) or after COLD_RUN cold starts in a row (scattered points): PAUSE points first, twice as many after each
-    pause that did not end the run, up to PAUSE_MAX; a point decided warm ends it.
+    It pauses after a cold start that did not decide (a free chain's defective zero roots, say): it would only
+    add its cost to the certificates behind it.  With few modes a body (``few``) its cold start (eigenvectors)
+    also costs more than the disks' (eigenvalues only) and pays only through the warm points after it, so it
+    pauses after COLD_RUN cold starts in a row too (scattered points).  PAUSE points first, twice as many after
+    each pause that did not end the run, up to PAUSE_MAX; a point decided warm ends it.
     """
     pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
     flags = aw[-1]
     if flags[3] > 0:
         flags[3] -= 1
         flags[0] = 0  # the decomposition kept is too old to refine
-        return -1
+        return -1, True
     nc, warm = allatonce.certify(body, E, nmodes, parent, m, pws, C, Mo, aw, True)
     if warm:
         state[5], state[6] = 0, 0
     else:
         state[5] += 1
-        if nc < 0 or state[5] >= COLD_RUN:
+        if nc < 0 or (few and state[5] >= COLD_RUN):
             state[6] = min(2 * state[6], PAUSE_MAX) if state[6] > 0 else PAUSE
             flags[3] = state[6]
             state[5] = 0
-    return nc
+    return nc, False
 
 
 @kernel
