@@ -25,7 +25,7 @@ from stabmap import kernels
 from stabmap.kernels import allatonce, certify, pencil
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_kernel import CORNERS, cases, corner_set, float_peer, point_set  # noqa: E402
+from bench_kernel import any_set, cases, float_peer, point_set  # noqa: E402
 
 
 def split(pts) -> dict:
@@ -85,12 +85,11 @@ def split(pts) -> dict:
 
 def cold_starts(spec: str) -> dict:
     """``kernels.allatonce_block`` on the point set ``spec`` = n:modes:kind:points per line (2 lines along omega from
-    -150 to 150, ``bench_kernel.point_set`` or ``corner_set``, seed 1007): its cold starts, the points it left
+    -150 to 150, ``bench_kernel.any_set``, seed 1007): its cold starts, the points it left
     undecided and its CPU time over the float peer's."""
     n, modes, kind, per = spec.split(":")
     n, modes, per = int(n), int(modes), int(per)
-    rng = np.random.default_rng(1007)
-    pts = corner_set(rng, kind, 2, per, n, modes) if kind in CORNERS else point_set(rng, kind, 2, per, n, modes)
+    pts = any_set(np.random.default_rng(1007), kind, 2, per, n, modes)
     args = pts.kernel_args()
     npts = args[0].shape[0]
     nc, st = np.zeros(npts, np.int64), np.zeros(npts, np.int8)

@@ -133,6 +133,13 @@ def corner_set(rng, corner: str, lines: int, per_line: int, n: int, modes: int) 
     return PointArrays(body, joint, pts.g, E, kappa, pts.nmodes, free, parent, at)
 
 
+def any_set(rng, kind: str, lines: int, per_line: int, n: int, modes: int) -> PointArrays:
+    """``corner_set`` for a structural corner (CORNERS), else ``point_set``."""
+    if kind in CORNERS:
+        return corner_set(rng, kind, lines, per_line, n, modes)
+    return point_set(rng, kind, lines, per_line, n, modes)
+
+
 def _subset(pts: PointArrays, sl) -> PointArrays:
     return PointArrays(pts.body[sl], pts.joint[sl], pts.g[sl], pts.E[sl], pts.kappa[sl], pts.nmodes, pts.free, pts.parent,
                        pts.at[sl])
@@ -175,7 +182,7 @@ def float_peer(pts: PointArrays) -> tuple[np.ndarray, float]:
 
 def run(n: int, modes: int, kind: str, lines: int, per_line: int, rng) -> dict:
     degree = n * (2 + modes)
-    pts = corner_set(rng, kind, lines, per_line, n, modes) if kind in CORNERS else point_set(rng, kind, lines, per_line, n, modes)
+    pts = any_set(rng, kind, lines, per_line, n, modes)
     npts = pts.body.shape[0]
     threads = os.cpu_count() or 1
     decide_threads(_subset(pts, slice(0, 4)), 1)  # compile outside the timed calls

@@ -123,11 +123,9 @@ def test_decide_block_uses_it_for_few_modes_on_lines_and_backs_off_elsewhere():
     nc, st = run_decide(line)
     assert np.mean(st == kernels.DECIDED_ALLATONCE) >= 0.8
     assert nc.tolist() == [exact_nc(line, p) for p in range(30)]
-    scattered = random_chain(rng, n, 2, False, "mixed", npts=1)
-    for _ in range(29):
-        other = random_chain(rng, n, 2, False, "mixed", npts=1)
-        scattered = PointArrays(*(np.concatenate([getattr(scattered, f), getattr(other, f)]) for f in
-                                  ("body", "joint", "g", "E", "kappa")), scattered.nmodes, False)
+    chains = [random_chain(rng, n, 2, False, "mixed", npts=1) for _ in range(30)]
+    scattered = PointArrays(*(np.concatenate([getattr(c, f) for c in chains]) for f in ("body", "joint", "g", "E", "kappa")),
+                            chains[0].nmodes, False)
     nc, st = run_decide(scattered)
     # COLD_RUN cold starts, a pause of PAUSE = 16 points, COLD_RUN more, then a pause of 32
     assert (st == kernels.DECIDED_ALLATONCE).sum() <= 2 * certify.COLD_RUN

@@ -1048,7 +1048,7 @@ def test_a_point_refused_before_prepare_leaves_no_stale_structure():
     for p in range(3):
         if st[p] != kernels.UNDECIDED:
             assert nc[p] == exact_nc(pts, p), (p, nc, st)
-    assert st[2] in (DECIDED_INERTIA, DECIDED_DISKS, kernels.DECIDED_ALLATONCE)
+    assert st[2] in (DECIDED_INERTIA, DECIDED_DISKS, DECIDED_ALLATONCE)
 
 
 def test_root_inclusion_bound_does_not_underflow_on_clustered_roots():
