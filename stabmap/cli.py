@@ -9,7 +9,7 @@ import threading
 
 import click
 
-from .errors import StabmapError
+from .errors import StabmapError, cli_spelling
 from .version import __version__
 
 
@@ -228,7 +228,8 @@ def main(argv: list[str] | None = None) -> int:
     # 'kill' (SIGTERM) stops a run as Ctrl-C does: temporary files removed, finished chunks kept for --resume.
     previous = signal.signal(signal.SIGTERM, _interrupt) if threading.current_thread() is threading.main_thread() else None
     try:
-        cli.main(args=argv, prog_name="stabmap", standalone_mode=False)
+        with cli_spelling():  # library errors name the flags of the command line (stabmap.errors)
+            cli.main(args=argv, prog_name="stabmap", standalone_mode=False)
     except StabmapError as exc:
         click.echo(f"stabmap: error: {exc}", err=True)
         return getattr(exc, "exit_status", 2)  # 2: bad input; 3: the dask scheduler was lost
