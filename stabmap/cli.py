@@ -223,12 +223,16 @@ def paper(systems, out, quick, cases, rows):
         raise click.ClickException(f"{len(done['problems'])} disagreements with the papers (DISAGREES lines above)")
 
 
+# parameters whose flag is not the parameter's name with "--" and dashes
+FLAGS = {"cases": "--case"}
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (2: bad input, 130: interrupted)."""
     # 'kill' (SIGTERM) stops a run as Ctrl-C does: temporary files removed, finished chunks kept for --resume.
     previous = signal.signal(signal.SIGTERM, _interrupt) if threading.current_thread() is threading.main_thread() else None
     try:
-        with cli_spelling():  # library errors name the flags of the command line (stabmap.errors)
+        with cli_spelling(FLAGS):  # library errors name the flags of the command line (stabmap.errors)
             cli.main(args=argv, prog_name="stabmap", standalone_mode=False)
     except StabmapError as exc:
         click.echo(f"stabmap: error: {exc}", err=True)

@@ -233,6 +233,7 @@ def query(
     """
     from .read import query as q
     from .read.report import render
+    from .store.dataset import is_critical
     from .store.files import check_new_output, open_atlas
 
     items = list(items)
@@ -256,7 +257,7 @@ def query(
         check_new_output(output, overwrite)
     ds = open_atlas(path, lazy=True)  # read chunk by chunk: bounded memory at any size
     sel = q.parse_selection(items)
-    if ds.attrs.get("stabmap_kind") == "critical values":
+    if is_critical(ds):
         from .read.table import render_table, select_lines
 
         if asked or locate or over is not None:
@@ -320,6 +321,7 @@ def plot(
     from .read import plot as figures
     from .read.query import parse_selection
     from .scene.units import in_si
+    from .store.dataset import is_critical
     from .store.files import check_new_output, open_atlas
 
     figures.check_figure_path(output)
@@ -328,7 +330,7 @@ def plot(
     chosen = parse_selection(list(sel), ranges=False, option="--sel")
     # A spin rate given with its unit (--sel omega="14000 rpm") in the file's units, rad/s.
     chosen = {k: in_si(f"--sel {k}", v, str(ds[k].attrs.get("units", ""))) if k in ds.coords else v for k, v in chosen.items()}
-    if ds.attrs.get("stabmap_kind") == "critical values":
+    if is_critical(ds):
         given = [opt for opt, v in (("--x", x), ("--y", y), ("--facet", facet), ("--max-panels", max_panels)) if v is not None]
         if given:
             raise StabmapError(f"{given[0]} applies to atlases; {path} holds critical values (fix other axes with --sel)")

@@ -82,9 +82,10 @@ class StabmapAccessor:
 
         A critical-values Dataset (``stabmap.critical``) is drawn by :func:`stabmap.plot_critical`.
         """
+        from ..store.dataset import is_critical  # not at the top: this module loads while xarray does
         from .plot import plot_atlas, plot_critical
 
-        if self._ds.attrs.get("stabmap_kind") == "critical values":
+        if is_critical(self._ds):
             return plot_critical(self._ds, path, **kw)
         return plot_atlas(self._ds, path, **kw)
 

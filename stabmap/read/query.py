@@ -38,6 +38,7 @@ import xarray as xr
 from .. import systems
 from ..errors import StabmapError
 from ..scene.units import common_unit, in_si, looks_like_rate, split
+from ..store.dataset import is_critical
 from ..store.variables import INFERRED
 from .blocks import changes, compute, first_true
 
@@ -143,7 +144,7 @@ class StableFraction:
 
 def grid_axes(ds: xr.Dataset) -> list[str]:
     """The grid axes of an atlas; a clear error for a critical-values Dataset or anything else."""
-    if ds.attrs.get("stabmap_kind") == "critical values":
+    if is_critical(ds):
         raise StabmapError(
             "this Dataset holds critical values (stabmap critical), not an atlas; its intervals are in "
             f"{ds.attrs.get('critical_along', 'omega')}_stable_lower/upper ('stabmap info FILE' lists them)"

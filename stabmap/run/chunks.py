@@ -37,7 +37,7 @@ def chunk_points_for(scene: SceneBase, seconds_per_point: float, threads: int, n
     """
     total = math.prod(scene.shape) if npoints is None else npoints
     by_time = max(MIN_CHUNK_POINTS, BLOCK_SECONDS / max(seconds_per_point, 1e-9))
-    by_memory = MAX_CHUNK_BYTES // max(1, systems.of(scene).cost(scene).bytes)
+    by_memory = MAX_CHUNK_BYTES // max(1, systems.of(scene).input_bytes(scene))
     balance = max(1, total // (8 * max(1, threads)))
     return int(max(1, min(by_time, by_memory, MAX_CHUNK_POINTS, balance)))
 

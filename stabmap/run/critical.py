@@ -42,14 +42,13 @@ import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError
-from ..store.dataset import coordinates, global_attrs
+from ..store.dataset import CRITICAL_KIND, coordinates, global_attrs
 from ..systems.base import SceneBase
 from . import runner
 from .atlas import decide_boxes, decide_grid, decide_points
 from .chunks import check_chunk_points
 from .progress import wanted
 
-KIND = "critical values"  # global attribute stabmap_kind of every critical-values Dataset
 DEFAULT_RTOL = 1e-10
 MIN_RTOL = 1e-15  # a few ulps: bisection in float64 cannot go finer anyway
 ATOL_FACTOR = 1e-6  # default atol = ATOL_FACTOR * rtol * max |scan value|, for boundaries at or near 0
@@ -472,7 +471,7 @@ def _dataset(system, scene, along, others, scan, nc, brackets, gaps, proved: str
 
 def _attrs(system, along, scan, rtol, atol, counts: _Counts, boxes: bool) -> dict:
     attrs = {
-        "stabmap_kind": KIND,
+        "stabmap_kind": CRITICAL_KIND,
         "critical_along": along,
         "critical_rtol": rtol,
         "critical_atol": atol,
