@@ -144,7 +144,7 @@ def test_cli_roundtrip_plot_and_errors(tmp_path, capsys):
     err = capsys.readouterr().err  # not a parameter at all: no advice to add it to [grid]
     assert "--along K1: unknown parameter name 'K1'" in err and "under [grid]" not in err
     assert main(["critical", str(scene), "--rtol", "0", "-o", str(bad)]) == 2
-    assert "rtol must be between" in capsys.readouterr().err
+    assert "--rtol 0.0: must be between" in capsys.readouterr().err
     assert not bad.exists()
 
 

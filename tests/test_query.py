@@ -281,7 +281,7 @@ def test_accessor_gives_the_functions_answers(top, tmp_path):
         (lambda ds: stabmap.stable_fraction(ds, c_1="x"), "c_1='x': give a number"),
         (lambda ds: stabmap.stable_fraction(ds, c_1=(1, 2, 3)), "a range is a pair"),
         (lambda ds: stabmap.stable_fraction(ds, c_1=(2, 3)), r"c_1 in \[2, 3\] holds no grid value; .* run from -0.1 to 1 m"),
-        (lambda ds: stabmap.boundaries(ds, "omegaa"), "boundaries along 'omegaa' is not an axis"),
+        (lambda ds: stabmap.boundaries(ds, "omegaa"), "along='omegaa' is not an axis"),
         (lambda ds: stabmap.boundaries(ds, "omega", omega=3), "omega=3 would fix omega, the axis searched along; give a range"),
         (lambda ds: stabmap.smallest_stable(ds, "omega", over="omega"), "over='omega' is the axis searched along"),
         (lambda ds: stabmap.smallest_stable(ds, "omega", over="c_1", c_1=0.1), "over='c_1' is also fixed"),
@@ -383,10 +383,11 @@ def test_cli_smallest_stable(atlas_file, capsys):
         ([], "give the point: omega=VALUE c_1=VALUE"),
         (["omega=1:2", "c_1=0.1"], "a range belongs to stable_fraction"),
         (["--boundaries", "c_1=0.1"], "--boundaries: name the axis to search along first"),
-        (["--boundaries", "Omega"], "'Omega' is not an axis"),
+        (["--boundaries", "Omega"], "--boundaries Omega is not an axis"),
         (["--over", "c_1"], "--over applies to --smallest-stable only"),
-        (["--smallest-stable", "omega", "--over", "K_1"], "over 'K_1' is not an axis"),
-        (["--boundaries", "omega", "--limit", "-1"], "--limit must be >= 0"),
+        (["--smallest-stable", "omega", "--over", "K_1"], "--over K_1 is not an axis"),
+        (["--smallest-stable", "omegaa"], "--smallest-stable omegaa is not an axis"),
+        (["--boundaries", "omega", "--limit", "-1"], "--limit -1: must be >= 0"),
     ],
 )
 def test_cli_bad_input_exit_2(atlas_file, capsys, args, message):

@@ -52,7 +52,7 @@ def check(systems=None, *, out: str | Path | None = None, quick: bool = False, c
     them.  Returns ``{"problems": [...], "text": str}``; ``problems`` is empty when everything agrees.
     """
     if rows is not None and rows < 1:
-        raise StabmapError(f"{given('rows', rows)}: rows must be >= 1")
+        raise StabmapError(f"{given('rows', rows)}: must be >= 1")
     named = {"cases": list(cases or ()), "rows": rows}
     named = {k: v for k, v in named.items() if v not in (None, [])}
     if systems:

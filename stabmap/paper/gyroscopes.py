@@ -276,7 +276,7 @@ def run(cases=None, *, quick: bool = False, rows: int | None = None, out: Path |
     names = cases
     rows = rows or (3 if quick else 15)
     if rows < 1:
-        raise StabmapError(f"{given('rows', rows)}: rows must be >= 1")
+        raise StabmapError(f"{given('rows', rows)}: must be >= 1")
     known = {c.name: c for c in CASES}
     unknown = [n for n in names or () if n not in known]
     if unknown:

@@ -8,7 +8,7 @@ import numpy as np
 import xarray as xr
 
 from .. import systems
-from ..errors import StabmapError
+from ..errors import StabmapError, given
 from ..scene import units
 from ..scene.units import unit_suffix
 from ..store.dataset import is_critical
@@ -176,7 +176,7 @@ def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
     """Stable intervals of a critical-values Dataset, for the first ``limit`` points of the other axes (0: all of them,
     and then every undecided gap, not only the first 4 of each point)."""
     if limit < 0:
-        raise StabmapError(f"--limit must be >= 0 (0 lists every point), got {limit}")
+        raise StabmapError(f"{given('limit', limit)}: must be >= 0 (0 lists every point)")
     gaps_shown = 4 if limit else None
     along = ds.attrs["critical_along"]
     names = [f"{along}_stable_{end}" for end in ("lower", "upper", "lower_outer", "upper_outer")]

@@ -182,6 +182,16 @@ class System(ABC):
     provenance: str | None = None
     symbols: dict[str, str] = {}
 
+    def __init__(self) -> None:
+        # What abstract members cannot say: the label is one of the variables, an integer with a fill value (it pads
+        # the tables of boundaries, smallest stable values and critical values where a line has no value).
+        label = next((v for v in self.variables if v.name == self.label), None)
+        if label is None:
+            raise TypeError(f"{type(self).__name__}: label {self.label!r} is not one of its variables")
+        if not np.issubdtype(np.dtype(label.dtype), np.integer) or label.fill is None:
+            raise TypeError(f"{type(self).__name__}: its label {self.label!r} must be an integer variable with a fill, a "
+                            "value the label never takes (e.g. fill=-2), that pads tables where a line has no value")
+
     # ------------------------------------------------------------------ scenes
     def scene_from_dict(self, table: dict, base_dir: Path | None = None) -> SceneBase:
         """The scene of a TOML table (without its ``system`` key); errors name the key and the fix.
