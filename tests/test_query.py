@@ -19,6 +19,7 @@ import xarray as xr
 
 import stabmap
 from stabmap.read.accessor import StabmapAccessor
+from stabmap.read.located import located_boundaries, located_smallest_stable
 from stabmap.cli import main
 from stabmap.systems.gyroscopes.outputs import BY_INFERRED as INFERRED
 from stabmap.read.report import render
@@ -287,6 +288,10 @@ def test_accessor_gives_the_functions_answers(top, tmp_path):
         (lambda ds: stabmap.smallest_stable(ds, "omega", over="c_1", c_1=0.1), "over='c_1' is also fixed"),
         (lambda ds: stabmap.label_at(ds, omega=(1, 2), c_1=0.1), "the label is asked at one point"),
         (lambda ds: stabmap.stable_fraction(ds.drop_vars("decided_by")), "not a stabmap atlas"),
+        (lambda ds: stabmap.smallest_stable(ds, "omegaa"), "along='omegaa' is not an axis of this atlas; its axes are: omega, c_1"),
+        # read.located: the same check, the same words
+        (lambda ds: located_boundaries(ds, "omegaa"), "along='omegaa' is not an axis of this atlas"),
+        (lambda ds: located_smallest_stable(ds, over="K_1"), "over='K_1' is not an axis of this atlas"),
     ],
 )
 def test_bad_questions_name_the_parameter(top, call, message):
