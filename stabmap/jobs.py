@@ -37,13 +37,16 @@ def check_grid(scene, source: str = "the scene") -> None:
     """An atlas scans at least one parameter: a scene without ``[grid]`` is an error, not a one-point atlas.
 
     A scene with no grid axes is almost always a forgotten or misspelt ``[grid]`` table; a single point is asked
-    for explicitly with a one-value axis, ``omega = {values = [42.0]}``.
+    for explicitly with a one-value axis, ``NAME = {values = [VALUE]}``.
     """
     if not scene.grid:
+        from . import systems
+
+        axis = systems.of(scene).default_axis  # the example names the axis the system scans first
         raise StabmapError(
             f"{source} has no [grid]: an atlas scans at least one parameter of the scene, e.g. "
-            "[grid] omega = { start = 0.0, stop = 50.0, num = 201 }; for the label at one point, give that point as "
-            "one-value axes, e.g. omega = { values = [42.0] }"
+            f"[grid] {axis} = {{ start = ..., stop = ..., num = 201 }}; for the label at one point, give that point "
+            f"as one-value axes, e.g. {axis} = {{ values = [...] }}"
         )
 
 

@@ -91,6 +91,24 @@ class Toy(System):
         a, b = np.broadcast_arrays(values.get("a", scene.a), values.get("b", scene.b))
         return {ROOTS.name: np.array([count(x, y) for x, y in zip(a.ravel(), b.ravel())], dtype=np.int8).reshape(a.shape)}
 
+    # optional: box proofs, so that atlases decide whole cells: the count is one wherever p(0), p(1), the
+    # discriminant and the vertex's distances to 0 and 1 keep strict signs (each is monotone in a and b, but a^2)
+    def box_axes(self, scene):
+        return {"a", "b"}
+
+    def prove_boxes(self, scene, lower, upper):
+        n = np.size(next(iter(lower.values())))
+        label, proved = np.zeros(n, dtype=np.int8), np.zeros(n, dtype=bool)
+        for i, box in enumerate(zip(*(np.broadcast_to(d.get(k, getattr(scene, k)), n) for k in "ab" for d in (lower, upper)))):
+            a0, a1, b0, b1 = map(Fraction, box)  # exact: a proof may not round
+            square = (0 if a0 <= 0 <= a1 else min(a0 * a0, a1 * a1), max(a0 * a0, a1 * a1))
+            ranges = [(b0, b1), (1 - a1 + b0, 1 - a0 + b1), (a0, a1), (a0 - 2, a1 - 2), (square[0] - 4 * b1, square[1] - 4 * b0)]
+            label[i], proved[i] = count(a0, b0), all(lo > 0 or hi < 0 for lo, hi in ranges)
+        return label, proved
+
+    def proved_box(self, label):
+        return {}
+
 
 SYSTEM = Toy()
 
@@ -154,8 +172,16 @@ def test_atlas_from_python_and_its_cells(atlas):
     assert {0, 1, 2} <= set(ref.ravel().tolist())
     np.testing.assert_array_equal(atlas["roots_in_unit"].transpose("a", "b").values, ref)
     assert atlas.attrs["stabmap_system"] == "toy"
-    # the toy proves no boxes: every cell is claimed at its node only, and the axes carry their cells' bounds
-    assert (atlas["cell"].values == atlas["cell"].attrs["flag_values"][list(atlas["cell"].attrs["flag_meanings"].split()).index("node_only")]).all()
+    # cells: every cell the atlas says is whole holds its node's count at every point; checked at random points
+    cell = atlas["cell"].transpose("a", "b").values
+    meanings = dict(zip(atlas["cell"].attrs["flag_meanings"].split(), atlas["cell"].attrs["flag_values"].tolist()))
+    whole = np.argwhere(cell == meanings["whole_cell"])
+    assert 0 < len(whole) < cell.size and (cell == meanings["contains_change"]).any()
+    rng = np.random.default_rng(0)
+    for i, j in whole:
+        (a0, a1), (b0, b1) = atlas["a_bounds"].values[i], atlas["b_bounds"].values[j]
+        inside = zip(rng.uniform(a0, a1, 8), rng.uniform(b0, b1, 8))
+        assert {reference(a, b) for a, b in [(a0, b0), (a1, b1), *inside]} == {ref[i, j]}
     np.testing.assert_array_equal(atlas["a_bounds"].values[1:, 0], 0.5 * (atlas.a.values[1:] + atlas.a.values[:-1]))
 
 
@@ -188,7 +214,9 @@ def test_command_line_atlas_info_query_plot(toy, tmp_path, capsys):
     text = " ".join(capsys.readouterr().out.split())  # wrapped to the terminal's width
     counts = ", ".join(f"{k}: {int((ref == k).sum())}" for k in (0, 1, 2))
     assert "roots of x^2 - a x + b in (0, 1)" in text and f"roots_in_unit (n): {counts}" in text
-    assert f"points: {ref.size}, stable: {int((ref == 0).sum())}" in text and "cells: node only 143" in text
+    assert f"points: {ref.size}, stable: {int((ref == 0).sum())}" in text
+    cells = {m: int((ds["cell"].values == v).sum()) for m, v in zip(ds["cell"].attrs["flag_meanings"].split(), ds["cell"].attrs["flag_values"])}
+    assert f"cells: node only {cells['node_only']}, whole cell {cells['whole_cell']}, contains change {cells['contains_change']}" in text
     assert main(["query", str(out), "a=1", "b=0.25"]) == 0
     assert "roots_in_unit" in (text := capsys.readouterr().out) and str(reference(1, 0.25)) in text
     assert main(["query", str(out), "--smallest-stable", "b=0.5", "--json"]) == 0  # along the toy's default axis
