@@ -86,7 +86,7 @@ def test_a_wrong_reaction_exits_1(monkeypatch, capsys):
 @pytest.mark.parametrize("argv, message", [
     (["paper", "tops"], "no paper check for system 'tops'"),
     (["paper", "gyroscopes", "--case", "paper-n9"], "unknown paper case 'paper-n9' (--case)"),
-    (["paper", "--rows", "0"], "--rows 0: rows must be >= 1"),
+    (["paper", "--rows", "0"], "--rows 0: must be >= 1"),
     (["paper", "closed", "--case", "paper-n1-free"], "--case applies to the paper check of gyroscopes, not to closed"),
 ])
 def test_bad_arguments_are_one_line_and_exit_2(argv, message, capsys):
@@ -95,7 +95,7 @@ def test_bad_arguments_are_one_line_and_exit_2(argv, message, capsys):
 
 
 def test_bad_arguments_from_python_name_the_parameters():
-    with pytest.raises(StabmapError, match=r"rows=0: rows must be >= 1"):
+    with pytest.raises(StabmapError, match=r"rows=0: must be >= 1"):
         papers.check(["gyroscopes"], rows=0)
     with pytest.raises(StabmapError, match=r"cases applies to the paper check of gyroscopes, not to closed"):
         papers.check(["closed"], cases=["paper-n1-free"])
