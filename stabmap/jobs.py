@@ -178,12 +178,12 @@ def critical(
     from .store.files import check_atlas_output, check_new_output, write_atlas
 
     check_atlas_output(output, overwrite)
-    along = systems.of(scene).default_axis if along is None else along
+    axis = systems.of(scene).default_axis if along is None else along
     if png is not None:
         check_figure_path(png)
         check_new_output(png, overwrite, param("png"))
-        others = [a.name for a in scene.grid if a.name != along]
-        if len(others) > 1 and along in {a.name for a in scene.grid}:
+        others = [a.name for a in scene.grid if a.name != axis]
+        if len(others) > 1 and axis in {a.name for a in scene.grid}:
             # A picture shows one other axis; fail before the work rather than after it.
             raise StabmapError(
                 f"--png draws one other axis, but this scene has {len(others)} ({', '.join(others)}); drop --png and draw "
