@@ -392,6 +392,7 @@ def test_cli_smallest_stable(atlas_file, capsys):
         (["--over", "c_1"], "--over applies to --smallest-stable only"),
         (["--smallest-stable", "omega", "--over", "K_1"], "--over K_1 is not an axis"),
         (["--smallest-stable", "omegaa"], "--smallest-stable omegaa is not an axis"),
+        (["--smallest-stable", "omega", "--over", "omega"], "--over omega is the axis searched along; choose another axis for --over, e.g. c_1"),
         (["--boundaries", "omega", "--limit", "-1"], "--limit -1: must be >= 0"),
     ],
 )

@@ -551,16 +551,17 @@ def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | Non
     label = system.variable(system.label)
     if over is not None:
         if over == along:
-            raise StabmapError(f"over={over!r} is the axis searched along; choose another axis for over, e.g. {next((d for d in dims if d != along), 'K_1')}")
+            raise StabmapError(f"{given('over', over)} is the axis searched along; choose another axis for {param('over')}, e.g. "
+                               f"{next((d for d in dims if d != along), 'another grid axis')}")
         over = check_axis(ds, over, dims, "over")
         if axes[over].fixed:
-            raise StabmapError(f"over={over!r} is also fixed by {over}={axes[over].requested:g}; give {over} a range (lo, hi) or leave it out")
+            raise StabmapError(f"{given('over', over)} is also fixed by {over}={axes[over].requested:g}; give {over} a range (lo, hi) or leave it out")
         extra = [d for d in others if d != over]
         if extra:
             example = ", ".join(f"{d}={float(ds[d][0]):g}" for d in extra)
             raise StabmapError(
-                f"smallest_stable over {over!r}: fix the other axes as well ({example}, or any grid value), "
-                "or leave out over to get one answer per point of every remaining axis"
+                f"{given('over', over)}: fix the other axes as well ({example}, or any grid value), "
+                f"or leave out {param('over')} to get one answer per point of every remaining axis"
             )
     found = first_true(labels == system.stable_label, labels, inferred, label.fill)  # two passes, chunk by chunk
     has, first = found.has, found.first
