@@ -12,6 +12,9 @@ import click
 from .errors import StabmapError, cli_spelling
 from .version import __version__
 
+# library parameters whose flag is not the parameter's name with "--" and dashes (stabmap.errors.cli_spelling)
+FLAGS = {"cases": "--case", "client": "--scheduler"}
+
 
 class Interrupted(click.ClickException):
     """Ctrl-C or SIGTERM: exit status 130 and what the interrupted command left behind."""
@@ -122,8 +125,8 @@ atlas's scene along the selected lines: complete, and located to 1e-10 (docs/cri
 @click.argument("items", nargs=-1, metavar="[NAME=VALUE | NAME=LO:HI]...")
 @click.option("--fraction", is_flag=True, help="the stable fraction of the slice; axes not named are counted whole")
 @click.option("--boundaries", metavar="AXIS", help="every change of the label along AXIS, between two neighbouring grid values")
-@click.option("--smallest-stable", is_flag=False, flag_value="omega", default=None, metavar="[AXIS]",
-              help="the smallest stable grid value of AXIS (default omega), for every point of the other axes")
+@click.option("--smallest-stable", is_flag=False, flag_value="", default=None, metavar="[AXIS]",
+              help="the smallest stable grid value of AXIS (default: the system's, e.g. omega), for every point of the other axes")
 @click.option("--over", metavar="NAME", help="with --smallest-stable: the one axis that labels the answer")
 @click.option("--locate", is_flag=True, help="with --boundaries or --smallest-stable: critical values of the atlas's scene, "
               "every change located to 1e-10, undecided stretches listed (computes)")
@@ -142,8 +145,10 @@ def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, roo
     """
     from . import jobs
 
-    click.echo(jobs.query(atlas, items, fraction=fraction, boundaries=boundaries, smallest_stable=smallest_stable,
-                          over=over, locate=locate, roots=roots, fmt=fmt or "text", limit=limit, output=output, overwrite=overwrite))
+    # a question's axis is the library's along: name the flag that gave it
+    with cli_spelling({**FLAGS, "along": "--boundaries" if boundaries is not None else "--smallest-stable"}):
+        click.echo(jobs.query(atlas, items, fraction=fraction, boundaries=boundaries, smallest_stable=smallest_stable,
+                              over=over, locate=locate, roots=roots, fmt=fmt or "text", limit=limit, output=output, overwrite=overwrite))
 
 
 @cli.command(short_help="Draw an atlas (or critical values) to a PNG or PDF file.")
@@ -165,7 +170,7 @@ def plot(atlas, items, output, x, y, sel, facet, max_panels, overwrite):
 
 @cli.command(short_help="Stable intervals of one parameter (the critical spin rates, say), ends to 1e-10.")
 @_options(_scene_source)
-@click.option("--along", default="omega", show_default=True, help="the scanned grid axis")
+@click.option("--along", default=None, help="the scanned grid axis (default: the system's, e.g. omega for gyroscopes)")
 @click.option("-o", "--output", required=True, help="netCDF file to write, e.g. critical.nc")
 @click.option("--png", metavar="FILE", help="also draw the stable intervals to this PNG/PDF")
 @click.option("--rtol", type=float, default=1e-10, show_default=True, help="relative width of the located ends")
@@ -228,7 +233,7 @@ def main(argv: list[str] | None = None) -> int:
     # 'kill' (SIGTERM) stops a run as Ctrl-C does: temporary files removed, finished chunks kept for --resume.
     previous = signal.signal(signal.SIGTERM, _interrupt) if threading.current_thread() is threading.main_thread() else None
     try:
-        with cli_spelling():  # library errors name the flags of the command line (stabmap.errors)
+        with cli_spelling(FLAGS):  # library errors name the flags of the command line (stabmap.errors)
             cli.main(args=argv, prog_name="stabmap", standalone_mode=False)
     except StabmapError as exc:
         click.echo(f"stabmap: error: {exc}", err=True)

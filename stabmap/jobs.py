@@ -12,7 +12,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import StabmapError
+from .errors import StabmapError, given, param
 
 
 @dataclass
@@ -37,13 +37,16 @@ def check_grid(scene, source: str = "the scene") -> None:
     """An atlas scans at least one parameter: a scene without ``[grid]`` is an error, not a one-point atlas.
 
     A scene with no grid axes is almost always a forgotten or misspelt ``[grid]`` table; a single point is asked
-    for explicitly with a one-value axis, ``omega = {values = [42.0]}``.
+    for explicitly with a one-value axis, ``NAME = {values = [VALUE]}``.
     """
     if not scene.grid:
+        from . import systems
+
+        axis = systems.of(scene).default_axis  # the example names the axis the system scans first
         raise StabmapError(
             f"{source} has no [grid]: an atlas scans at least one parameter of the scene, e.g. "
-            "[grid] omega = { start = 0.0, stop = 50.0, num = 201 }; for the label at one point, give that point as "
-            "one-value axes, e.g. omega = { values = [42.0] }"
+            f"[grid] {axis} = {{ start = ..., stop = ..., num = 201 }}; for the label at one point, give that point "
+            f"as one-value axes, e.g. {axis} = {{ values = [...] }}"
         )
 
 
@@ -80,23 +83,23 @@ def atlas(
     check_atlas_output(output, overwrite)
     if png is not None:
         check_figure_path(png)
-        check_new_output(png, overwrite, "--png")
+        check_new_output(png, overwrite, param("png"))
     check_grid(scene)
-    check_chunk_points(chunk_points, "--chunk-points")
+    check_chunk_points(chunk_points)
     if not refine:
-        given = [opt for opt, v in (("--coarse-stride", coarse_stride), ("--margin", margin)) if v is not None]
-        if given:
-            raise StabmapError(f"{given[0]} applies to adaptive atlases only; add --refine")
+        extra = [name for name, v in (("coarse_stride", coarse_stride), ("margin", margin)) if v is not None]
+        if extra:
+            raise StabmapError(f"{param(extra[0])} applies to adaptive atlases only; add {param('refine')}")
     elif resume:
-        raise StabmapError("--resume applies to dense atlases; an adaptive atlas (--refine) has no checkpoint to resume")
+        raise StabmapError(f"{param('resume')} applies to dense atlases; an adaptive atlas ({param('refine')}) has no checkpoint to resume")
     elif not prove_cells:
         raise StabmapError("--node-by-node and --refine are two ways to decide an atlas; give one of them")
     system = systems.of(scene)
     t0 = time.perf_counter()
     where = {"client": client, "workers": workers, "threads": threads, "progress": progress, "chunk_points": chunk_points}
     if refine:
-        options = {"coarse_stride": refining.check_coarse_stride(coarse_stride, "--coarse-stride")}
-        options["margin"] = refining.check_margin(refining.DEFAULT_MARGIN if margin is None else margin, "--margin")
+        options = {"coarse_stride": refining.check_coarse_stride(coarse_stride)}
+        options["margin"] = refining.check_margin(refining.DEFAULT_MARGIN if margin is None else margin)
         with _no_checkpoint():
             ds = refining.compute_refined(scene, **options, **where)
         write_atlas(ds, output)
@@ -152,7 +155,7 @@ def critical(
     scene,
     output: str | Path,
     *,
-    along: str = "omega",
+    along: str | None = None,
     rtol: float | None = None,
     png: str | Path | None = None,
     client=None,
@@ -163,21 +166,24 @@ def critical(
     listing: bool = True,
     overwrite: bool = False,
 ) -> Done:
-    """``stabmap critical``: the stable intervals of ``along`` into ``output`` (and drawn to ``png``).
+    """``stabmap critical``: the stable intervals of ``along`` (None: the system's ``default_axis``) into ``output``
+    (and drawn to ``png``).
 
     An existing ``output`` or ``png`` is an error unless ``overwrite``.
     """
+    from . import systems
     from .read.info import intervals
     from .read.plot import check_figure_path, plot_critical
     from .run import critical as located
     from .store.files import check_atlas_output, check_new_output, write_atlas
 
     check_atlas_output(output, overwrite)
+    axis = systems.of(scene).default_axis if along is None else along
     if png is not None:
         check_figure_path(png)
-        check_new_output(png, overwrite, "--png")
-        others = [a.name for a in scene.grid if a.name != along]
-        if len(others) > 1 and along in {a.name for a in scene.grid}:
+        check_new_output(png, overwrite, param("png"))
+        others = [a.name for a in scene.grid if a.name != axis]
+        if len(others) > 1 and axis in {a.name for a in scene.grid}:
             # A picture shows one other axis; fail before the work rather than after it.
             raise StabmapError(
                 f"--png draws one other axis, but this scene has {len(others)} ({', '.join(others)}); drop --png and draw "
@@ -202,7 +208,7 @@ def info(path: str | Path, limit: int = 8) -> str:
     from .store.files import open_atlas
 
     if limit < 0:
-        raise StabmapError(f"--limit must be >= 0 (0 lists every point), got {limit}")
+        raise StabmapError(f"{given('limit', limit)}: must be >= 0 (0 lists every point)")
     with open_atlas(path, lazy=True) as ds:
         return describe(ds, str(path), limit)
 
@@ -226,6 +232,7 @@ def query(
     """``stabmap query``: the label at a point, or the answer to one question about a slice (docs/query.md).
 
     ``items`` are ``NAME=VALUE`` or ``NAME=LO:HI``; a question's axis may also come first among them.
+    ``smallest_stable`` ``""``: along the system's ``default_axis``.
     ``locate``: answer --boundaries and --smallest-stable with critical values of the atlas's scene (complete,
     located to 1e-10: ``stabmap.read.located``) instead of the grid.
     A critical-values file answers with its table (``stabmap.read.table``): every stable interval, boundary and gap.
@@ -233,42 +240,43 @@ def query(
     """
     from .read import query as q
     from .read.report import render
+    from .store.dataset import is_critical
     from .store.files import check_new_output, open_atlas
 
     items = list(items)
     asked = [opt for opt, v in (("--fraction", fraction or None), ("--boundaries", boundaries), ("--smallest-stable", smallest_stable),
-                                ("--roots", roots or None)) if v]
+                                ("--roots", roots or None)) if v is not None]
     if len(asked) > 1:
         raise StabmapError(f"ask one question at a time: {' and '.join(asked)} were both given")
     if limit < 0:
-        raise StabmapError(f"--limit must be >= 0 (0 shows every row), got {limit}")
+        raise StabmapError(f"{given('limit', limit)}: must be >= 0 (0 shows every row)")
     if locate and boundaries is None and smallest_stable is None:
-        raise StabmapError("--locate applies to --boundaries and --smallest-stable, e.g. --boundaries omega --locate K_1=3")
+        raise StabmapError("--locate applies to --boundaries and --smallest-stable, e.g. --boundaries AXIS --locate NAME=VALUE")
     if over is not None and smallest_stable is None:
-        raise StabmapError("--over applies to --smallest-stable only, e.g. --smallest-stable omega --over K_1")
+        raise StabmapError("--over applies to --smallest-stable only, e.g. --smallest-stable AXIS --over NAME")
     for option, axis in (("--boundaries", boundaries), ("--smallest-stable", smallest_stable)):
         if axis is not None and "=" in axis:  # NAME=VALUE right after the option: the axis was left out
             if option == "--boundaries":
                 raise StabmapError(f"{option}: name the axis to search along first, e.g. {option} omega K_1=3")
             items.insert(0, axis)
-            smallest_stable = "omega"
+            smallest_stable = ""  # the system's default axis
     if output is not None:
         check_new_output(output, overwrite)
     ds = open_atlas(path, lazy=True)  # read chunk by chunk: bounded memory at any size
     sel = q.parse_selection(items)
-    if ds.attrs.get("stabmap_kind") == "critical values":
+    if is_critical(ds):
         from .read.table import render_table, select_lines
 
         if asked or locate or over is not None:
-            given = asked[0] if asked else "--locate" if locate else "--over"
-            raise StabmapError(f"{path} holds critical values, not an atlas, and {given} asks an atlas; 'stabmap query {path}' "
+            question = asked[0] if asked else "--locate" if locate else "--over"
+            raise StabmapError(f"{path} holds critical values, not an atlas, and {question} asks an atlas; 'stabmap query {path}' "
                                "(--csv or --json; NAME=VALUE picks lines) lists its stable intervals and boundaries")
         return _answer(render_table(select_lines(ds, sel), fmt, limit=limit), output)
     if roots:
         from .read.roots import roots as roots_at
 
         if fmt == "csv":
-            raise StabmapError("--roots prints text or --json")
+            raise StabmapError(f"{param('roots')} prints text or JSON, not {fmt.upper()}")
         found = roots_at(ds, **sel)
         return _answer(found.to_json() if fmt == "json" else found.text(), output)
     if locate:
@@ -277,11 +285,11 @@ def query(
         if boundaries is not None:
             result = located.located_boundaries(ds, boundaries, progress=progress, **sel)
         else:
-            result = located.located_smallest_stable(ds, smallest_stable, over, progress=progress, **sel)
+            result = located.located_smallest_stable(ds, smallest_stable or None, over, progress=progress, **sel)
     elif boundaries is not None:
         result = q.boundaries(ds, boundaries, **sel)
     elif smallest_stable is not None:
-        result = q.smallest_stable(ds, smallest_stable, over, **sel)
+        result = q.smallest_stable(ds, smallest_stable or None, over, **sel)
     elif fraction:
         result = q.stable_fraction(ds, **sel)
     else:
@@ -320,6 +328,7 @@ def plot(
     from .read import plot as figures
     from .read.query import parse_selection
     from .scene.units import in_si
+    from .store.dataset import is_critical
     from .store.files import check_new_output, open_atlas
 
     figures.check_figure_path(output)
@@ -328,10 +337,10 @@ def plot(
     chosen = parse_selection(list(sel), ranges=False, option="--sel")
     # A spin rate given with its unit (--sel omega="14000 rpm") in the file's units, rad/s.
     chosen = {k: in_si(f"--sel {k}", v, str(ds[k].attrs.get("units", ""))) if k in ds.coords else v for k, v in chosen.items()}
-    if ds.attrs.get("stabmap_kind") == "critical values":
-        given = [opt for opt, v in (("--x", x), ("--y", y), ("--facet", facet), ("--max-panels", max_panels)) if v is not None]
-        if given:
-            raise StabmapError(f"{given[0]} applies to atlases; {path} holds critical values (fix other axes with --sel)")
+    if is_critical(ds):
+        extra = [name for name, v in (("x", x), ("y", y), ("facet", facet), ("max_panels", max_panels)) if v is not None]
+        if extra:
+            raise StabmapError(f"{param(extra[0])} applies to atlases; {path} holds critical values (fix other axes with {param('sel')})")
         figures.plot_critical(ds, output, sel=chosen)
         return Done([f"wrote {output}"])
     options = {"x": x, "y": y, "sel": chosen, "facet": facet, "max_panels": figures.MAX_PANELS if max_panels is None else max_panels}

@@ -114,6 +114,20 @@ def test_critical_from_the_command_line_finds_the_hinge_boundary(tmp_path, capsy
     assert main(["info", str(out)]) == 0
 
 
+def test_critical_scans_the_closed_chains_default_axis_the_length_ratio(tmp_path, capsys):
+    # no --along: the closed system's default_axis, ratio, as in the test above; a scene that does not scan it is
+    # told which default was taken and how to choose another
+    out = tmp_path / "c.nc"
+    assert main(["critical", "--example", "closed-hinge", "-o", str(out), "-q"]) == 0
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["critical_along"] == "ratio"
+        leaves = (math.sqrt(17) - 1) / 4  # in space the hinge leaves its plane here (docs/closed.md)
+        assert abs(float(ds["ratio_stable_upper"].values.ravel()[0]) - leaves) <= 1e-10 * leaves
+    assert main(["critical", "--example", "closed-ring-twisted", "-o", str(tmp_path / "t.nc")]) == 2
+    assert ("--along not given, so the closed system's default axis 'ratio': not a grid axis of this scene; its grid "
+            "axes are: c2sq") in capsys.readouterr().err and not (tmp_path / "t.nc").exists()
+
+
 def test_the_critical_plot_draws_each_stretch_in_its_class_and_never_calls_absent_unstable():
     # Hinge along h2/h1: stable below sqrt 2, unstable to 2, degenerate at 2, no equilibrium above (docs/closed.md).
     from stabmap.read.plot import ABSENT_COLOUR, STABLE_COLOUR, UNSTABLE_COLOUR, critical_figure

@@ -24,6 +24,26 @@ def _maievskii_scene(num=41):
     })
 
 
+def test_bad_arguments_from_python_name_the_parameters():
+    # the messages of test_cli_roundtrip_plot_and_errors, as a Python caller wrote them
+    scene = _maievskii_scene(num=3)
+    with pytest.raises(stabmap.StabmapError, match=r"^rtol=2: must be between 1e-15"):
+        critical(scene, rtol=2)
+    with pytest.raises(stabmap.StabmapError, match=r"^along='K_0': not a grid axis of this scene; its grid axes are: omega, c_1"):
+        critical(scene, "K_0")
+    with pytest.raises(stabmap.StabmapError, match=r"^atol=-1: must be a finite number >= 0"):
+        critical(scene, atol=-1)
+
+
+def test_the_default_axis_is_the_systems():
+    # no along: the gyroscopes' default_axis, omega; a scene without it says which default it took and why
+    assert critical(_maievskii_scene(num=5), rtol=1e-6).attrs["critical_along"] == "omega"
+    scene = from_dict({"support": "fixed", "omega": 50.0, "bodies": [dict(TOP, c=0.1)], "grid": {"m_1": {"values": [0.5, 1.0]}}})
+    with pytest.raises(stabmap.StabmapError, match=r"along not given, so the gyroscopes system's default axis 'omega': not a grid "
+                                                   r"axis of this scene; its grid axes are: m_1. .*, or give along one of them"):
+        critical(scene)
+
+
 def test_maievskii_critical_spin_rates_are_bracketed_exactly():
     # C^2 w^2 >= 4 (A + m c^2) m c g: the stable set is |w| >= w*, checked in exact rationals on the binary values.
     ds = critical(_maievskii_scene(), "omega", rtol=1e-10)
@@ -144,7 +164,7 @@ def test_cli_roundtrip_plot_and_errors(tmp_path, capsys):
     err = capsys.readouterr().err  # not a parameter at all: no advice to add it to [grid]
     assert "--along K1: unknown parameter name 'K1'" in err and "under [grid]" not in err
     assert main(["critical", str(scene), "--rtol", "0", "-o", str(bad)]) == 2
-    assert "rtol must be between" in capsys.readouterr().err
+    assert "--rtol 0.0: must be between" in capsys.readouterr().err
     assert not bad.exists()
 
 

@@ -19,6 +19,7 @@ import xarray as xr
 
 import stabmap
 from stabmap.cli import main
+from stabmap.read.info import intervals
 from stabmap.read.table import critical_table, render_table
 from stabmap.systems.gyroscopes.scene import from_dict
 
@@ -224,7 +225,9 @@ def test_info_all_and_limit(crit_file, crit, capsys):
                 assert len(ends) == 2 * n and all(e in SCAN or abs(abs(e) - w) <= 1e-9 * w for e in ends)
     assert "6 stable intervals and 4 boundaries on 6 lines" in out
     code, _, err = _run(capsys, "info", crit_file, "--limit", "-1")
-    assert code == 2 and "--limit must be >= 0" in err
+    assert code == 2 and "--limit -1: must be >= 0" in err
+    with pytest.raises(stabmap.StabmapError, match=r"^limit=-1: must be >= 0"):  # the same check from Python
+        intervals(crit, limit=-1)
 
 
 def test_closed_chain_critical_table():

@@ -527,12 +527,12 @@ def test_resume_refuses_another_scene_and_other_chunks(tmp_path, slow_scene_file
     "extra,message",
     [
         (["--scheduler", "tcp://127.0.0.1:9", "--workers", "2"], "not both"),
-        (["--workers", "0"], "workers must be a whole number >= 1"),
-        (["--threads", "0"], "threads must be a whole number >= 1"),
-        (["--workers", "2", "--threads", "2"], "(--threads) sets the threads of an in-process run"),
+        (["--workers", "0"], "--workers 0: must be a whole number >= 1"),
+        (["--threads", "0"], "--threads 0: must be a whole number >= 1"),
+        (["--workers", "2", "--threads", "2"], "--threads sets the threads of an in-process run"),
         (["--refine", "--resume"], "--resume applies to dense atlases"),
         (["--margin", "1"], "--margin applies to adaptive atlases only"),
-        (["--chunk-points", "0"], "--chunk-points must be a whole number >= 1"),
+        (["--chunk-points", "0"], "--chunk-points 0: must be a whole number >= 1"),
     ],
 )
 def test_bad_cluster_options_fail_before_any_work(extra, message, tmp_path, capsys):

@@ -6,6 +6,7 @@ import pytest
 
 from stabmap import paper as papers
 from stabmap.cli import main
+from stabmap.errors import StabmapError
 from stabmap.systems.gyroscopes import paper
 from stabmap.paper import gyroscopes as paper_cases
 
@@ -84,13 +85,29 @@ def test_a_wrong_reaction_exits_1(monkeypatch, capsys):
 
 @pytest.mark.parametrize("argv, message", [
     (["paper", "tops"], "no paper check for system 'tops'"),
-    (["paper", "gyroscopes", "--case", "paper-n9"], "unknown paper case 'paper-n9'"),
-    (["paper", "--rows", "0"], "--rows must be >= 1"),
-    (["paper", "closed", "--case", "paper-n1-free"], "--case names a gyroscope paper case"),
+    (["paper", "gyroscopes", "--case", "paper-n9"], "unknown paper case 'paper-n9' (--case)"),
+    (["paper", "--rows", "0"], "--rows 0: must be >= 1"),
+    (["paper", "closed", "--case", "paper-n1-free"], "--case applies to the paper check of gyroscopes, not to closed"),
 ])
 def test_bad_arguments_are_one_line_and_exit_2(argv, message, capsys):
     assert main(argv) == 2
     assert message in capsys.readouterr().err
+
+
+def test_bad_arguments_from_python_name_the_parameters():
+    with pytest.raises(StabmapError, match=r"rows=0: must be >= 1"):
+        papers.check(["gyroscopes"], rows=0)
+    with pytest.raises(StabmapError, match=r"cases applies to the paper check of gyroscopes, not to closed"):
+        papers.check(["closed"], cases=["paper-n1-free"])
+
+
+def test_a_system_without_a_paper_check_says_so(monkeypatch):
+    # the check is found through the registry: a system whose paper is None has none, and runs no other's
+    from stabmap import systems
+
+    monkeypatch.setattr(systems.get("reactions"), "paper", None)
+    with pytest.raises(StabmapError, match="no paper check for system 'reactions': it declares none"):
+        papers.check(["reactions"])
 
 
 def test_the_command_is_listed():

@@ -19,6 +19,7 @@ import xarray as xr
 
 import stabmap
 from stabmap.read.accessor import StabmapAccessor
+from stabmap.read.located import located_boundaries, located_smallest_stable
 from stabmap.cli import main
 from stabmap.systems.gyroscopes.outputs import BY_INFERRED as INFERRED
 from stabmap.read.report import render
@@ -281,12 +282,16 @@ def test_accessor_gives_the_functions_answers(top, tmp_path):
         (lambda ds: stabmap.stable_fraction(ds, c_1="x"), "c_1='x': give a number"),
         (lambda ds: stabmap.stable_fraction(ds, c_1=(1, 2, 3)), "a range is a pair"),
         (lambda ds: stabmap.stable_fraction(ds, c_1=(2, 3)), r"c_1 in \[2, 3\] holds no grid value; .* run from -0.1 to 1 m"),
-        (lambda ds: stabmap.boundaries(ds, "omegaa"), "boundaries along 'omegaa' is not an axis"),
+        (lambda ds: stabmap.boundaries(ds, "omegaa"), "along='omegaa' is not an axis"),
         (lambda ds: stabmap.boundaries(ds, "omega", omega=3), "omega=3 would fix omega, the axis searched along; give a range"),
         (lambda ds: stabmap.smallest_stable(ds, "omega", over="omega"), "over='omega' is the axis searched along"),
         (lambda ds: stabmap.smallest_stable(ds, "omega", over="c_1", c_1=0.1), "over='c_1' is also fixed"),
         (lambda ds: stabmap.label_at(ds, omega=(1, 2), c_1=0.1), "the label is asked at one point"),
         (lambda ds: stabmap.stable_fraction(ds.drop_vars("decided_by")), "not a stabmap atlas"),
+        (lambda ds: stabmap.smallest_stable(ds, "omegaa"), "along='omegaa' is not an axis of this atlas; its axes are: omega, c_1"),
+        # read.located: the same check, the same words
+        (lambda ds: located_boundaries(ds, "omegaa"), "along='omegaa' is not an axis of this atlas"),
+        (lambda ds: located_smallest_stable(ds, over="K_1"), "over='K_1' is not an axis of this atlas"),
     ],
 )
 def test_bad_questions_name_the_parameter(top, call, message):
@@ -383,10 +388,12 @@ def test_cli_smallest_stable(atlas_file, capsys):
         ([], "give the point: omega=VALUE c_1=VALUE"),
         (["omega=1:2", "c_1=0.1"], "a range belongs to stable_fraction"),
         (["--boundaries", "c_1=0.1"], "--boundaries: name the axis to search along first"),
-        (["--boundaries", "Omega"], "'Omega' is not an axis"),
+        (["--boundaries", "Omega"], "--boundaries Omega is not an axis"),
         (["--over", "c_1"], "--over applies to --smallest-stable only"),
-        (["--smallest-stable", "omega", "--over", "K_1"], "over 'K_1' is not an axis"),
-        (["--boundaries", "omega", "--limit", "-1"], "--limit must be >= 0"),
+        (["--smallest-stable", "omega", "--over", "K_1"], "--over K_1 is not an axis"),
+        (["--smallest-stable", "omegaa"], "--smallest-stable omegaa is not an axis"),
+        (["--smallest-stable", "omega", "--over", "omega"], "--over omega is the axis searched along; choose another axis for --over, e.g. c_1"),
+        (["--boundaries", "omega", "--limit", "-1"], "--limit -1: must be >= 0"),
     ],
 )
 def test_cli_bad_input_exit_2(atlas_file, capsys, args, message):

@@ -188,6 +188,13 @@ def test_cli_boundaries_follow_the_critical_node(tmp_path, capsys):
     assert main(["query", str(out), "--boundaries", "c_x", "c_y=0.3"]) == 0
     text = capsys.readouterr().out
     assert "1 change of critical node" in text and "stabmap critical" not in text
+    # the reactions' default axis is c_x, where the centre of mass lies: the same boundary without naming it
+    ds = stabmap.open_atlas(out)
+    b = stabmap.boundaries(ds, c_y=0.3)
+    assert b.attrs["along"] == "c_x" and b.sizes["boundary"] == 1
+    lo, hi = float(b.boundary_lower[0]), float(b.boundary_upper[0])
+    line = ds["critical_node"].sel(c_y=0.3, method="nearest")
+    assert lo < hi and line.sel(c_x=lo) != line.sel(c_x=hi)
     assert main(["query", str(out), "--fraction"]) == 2
     assert "reactions atlases have none" in capsys.readouterr().err
 

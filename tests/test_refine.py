@@ -144,11 +144,11 @@ def test_threads_and_chunks_do_not_change_the_result():
 @pytest.mark.parametrize(
     "kwargs,message",
     [
-        ({"coarse_stride": 12}, "coarse_stride must be a power of two"),
-        ({"coarse_stride": 0}, "coarse_stride must be a power of two"),
-        ({"coarse_stride": 8.0}, "coarse_stride must be a whole power of two"),
-        ({"margin": -1}, "margin must be a whole number of cells >= 0"),
-        ({"threads": -2}, "threads must be a whole number >= 1"),
+        ({"coarse_stride": 12}, "coarse_stride=12: must be a power of two"),
+        ({"coarse_stride": 0}, "coarse_stride=0: must be a power of two"),
+        ({"coarse_stride": 8.0}, "coarse_stride=8.0: must be a whole power of two"),
+        ({"margin": -1}, "margin=-1: must be a whole number of cells >= 0"),
+        ({"threads": -2}, "threads=-2: must be a whole number >= 1"),
     ],
 )
 def test_bad_arguments(kwargs, message):
@@ -185,10 +185,10 @@ def test_cli_refine_file_info_query(tmp_path, capsys):
 @pytest.mark.parametrize(
     "args,message",
     [
-        (["--refine", "--coarse-stride", "12"], "--coarse-stride must be a power of two"),
+        (["--refine", "--coarse-stride", "12"], "--coarse-stride 12: must be a power of two"),
         (["--coarse-stride", "8"], "--coarse-stride applies to adaptive atlases only; add --refine"),
         (["--margin", "2"], "--margin applies to adaptive atlases only; add --refine"),
-        (["--refine", "--margin", "-1"], "--margin must be a whole number of cells >= 0"),
+        (["--refine", "--margin", "-1"], "--margin -1: must be a whole number of cells >= 0"),
     ],
 )
 def test_cli_bad_refine_options(tmp_path, capsys, args, message):

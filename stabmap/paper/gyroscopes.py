@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from stabmap.errors import StabmapError, given, param
 from stabmap.examples import example
 from stabmap.run import atlas
 from stabmap.run.critical import critical
@@ -269,15 +270,17 @@ def write_golden(directory: Path) -> list[Path]:
     return paths
 
 
-def run(names=None, *, quick: bool = False, rows: int | None = None, out: Path | None = None) -> dict:
-    """Check the cases ``names`` (default all); figures into ``out`` (None: none). Returns results, problems, text."""
+def run(cases=None, *, quick: bool = False, rows: int | None = None, out: Path | None = None) -> dict:
+    """Check the paper cases named ``cases`` (default all); figures into ``out`` (None: none). Returns results,
+    problems, text."""
+    names = cases
     rows = rows or (3 if quick else 15)
     if rows < 1:
-        raise ValueError("rows must be >= 1")
+        raise StabmapError(f"{given('rows', rows)}: must be >= 1")
     known = {c.name: c for c in CASES}
     unknown = [n for n in names or () if n not in known]
     if unknown:
-        raise KeyError(f"unknown paper case {unknown[0]!r}; choose one of: {', '.join(known)}")
+        raise StabmapError(f"unknown paper case {unknown[0]!r} ({param('cases')}); choose one of: {', '.join(known)}")
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
     cases = [c for c in CASES if not names or c.name in names]

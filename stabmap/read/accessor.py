@@ -5,7 +5,7 @@
 operation keeps working and returns plain Datasets):
 
 >>> import stabmap
->>> ds = stabmap.open_atlas("atlas.nc")
+>>> ds = stabmap.open_atlas("atlas.nc")                  # here an atlas of gyroscopes
 >>> ds.stabmap.label_at(omega=42.5, K_1=3)
 >>> ds.stabmap.stable_fraction(K_1=(0, 10))
 >>> ds.stabmap.boundaries("omega", K_1=3).to_dataframe()
@@ -47,14 +47,14 @@ class StabmapAccessor:
 
         return stable_fraction(self._ds, **sel)
 
-    def boundaries(self, along: str, /, **sel) -> xr.Dataset:
-        """Every change of the label along one axis: :func:`stabmap.boundaries`."""
+    def boundaries(self, along: str | None = None, /, **sel) -> xr.Dataset:
+        """Every change of the label along one axis (default: the system's ``default_axis``): :func:`stabmap.boundaries`."""
         from .query import boundaries
 
         return boundaries(self._ds, along, **sel)
 
-    def smallest_stable(self, along: str = "omega", over: str | None = None, **sel) -> xr.Dataset:
-        """The smallest stable grid value of ``along``: :func:`stabmap.smallest_stable`."""
+    def smallest_stable(self, along: str | None = None, over: str | None = None, **sel) -> xr.Dataset:
+        """The smallest stable grid value of ``along`` (default: the system's ``default_axis``): :func:`stabmap.smallest_stable`."""
         from .query import smallest_stable
 
         return smallest_stable(self._ds, along, over, **sel)
@@ -82,9 +82,10 @@ class StabmapAccessor:
 
         A critical-values Dataset (``stabmap.critical``) is drawn by :func:`stabmap.plot_critical`.
         """
+        from ..store.dataset import is_critical  # not at the top: this module loads while xarray does
         from .plot import plot_atlas, plot_critical
 
-        if self._ds.attrs.get("stabmap_kind") == "critical values":
+        if is_critical(self._ds):
             return plot_critical(self._ds, path, **kw)
         return plot_atlas(self._ds, path, **kw)
 

@@ -8,9 +8,10 @@ import numpy as np
 import xarray as xr
 
 from .. import systems
-from ..errors import StabmapError
+from ..errors import StabmapError, given
 from ..scene import units
 from ..scene.units import unit_suffix
+from ..store.dataset import is_critical
 from .summary import summary
 
 
@@ -68,7 +69,7 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
     come in the system's groups (per body for gyroscopes), each group's scene notes (liquid modes) beside it.
     ``limit``: lines of critical values listed (0: every line, and every gap of each; an atlas lists nothing per line).
     """
-    if ds.attrs.get("stabmap_kind") == "critical values":
+    if is_critical(ds):
         head = f"{name}: {ds.attrs.get('title', '')}: critical values along {ds.attrs['critical_along']}"
         comment = textwrap.wrap(ds.attrs["comment"], width=WIDTH, initial_indent="  ", subsequent_indent="  ")
         from .table import counts_line, critical_summary
@@ -165,10 +166,8 @@ def scene_notes(attrs: dict) -> dict[str, list[str]]:
         scene = systems.loads_scene(str(attrs["scene"]), "the atlas's scene")
     except StabmapError as exc:
         return {"": [f"(the stored scene does not load in this version: {exc})"]}
-    notes = getattr(scene, "notes", None)
     out: dict[str, list[str]] = {}
-    for note in notes() if notes is not None else []:
-        head, text = note if isinstance(note, tuple) else ("", note)
+    for head, text in scene.notes():
         out.setdefault(head, []).append(text)
     return out
 
@@ -177,7 +176,7 @@ def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
     """Stable intervals of a critical-values Dataset, for the first ``limit`` points of the other axes (0: all of them,
     and then every undecided gap, not only the first 4 of each point)."""
     if limit < 0:
-        raise StabmapError(f"--limit must be >= 0 (0 lists every point), got {limit}")
+        raise StabmapError(f"{given('limit', limit)}: must be >= 0 (0 lists every point)")
     gaps_shown = 4 if limit else None
     along = ds.attrs["critical_along"]
     names = [f"{along}_stable_{end}" for end in ("lower", "upper", "lower_outer", "upper_outer")]

@@ -15,7 +15,7 @@ import numpy as np
 import xarray as xr
 
 from .. import systems
-from ..errors import StabmapError
+from ..errors import StabmapError, given
 from ..scene.grid import Axis
 from .query import check_axis, fixed_coords, fixed_names, grid_axes, select, selection_text, stable_system
 
@@ -53,7 +53,7 @@ def _attrs(ds, crit, along: str, axes, kind: str, label, system) -> dict:
     }
 
 
-def located_boundaries(ds: xr.Dataset, along: str, /, *, progress: bool | None = None, threads: int | None = None, **sel) -> xr.Dataset:
+def located_boundaries(ds: xr.Dataset, along: str | None = None, /, *, progress: bool | None = None, threads: int | None = None, **sel) -> xr.Dataset:
     """Every change of the label along ``along`` in the selected lines, located to 1e-10 and complete.
 
     As ``query.boundaries`` (same variables and coordinates, one row per boundary), but ``boundary_lower`` and
@@ -62,7 +62,7 @@ def located_boundaries(ds: xr.Dataset, along: str, /, *, progress: bool | None =
     decided: a change may hide only there.
     """
     dims = grid_axes(ds)
-    along = check_axis(ds, along, dims, "boundaries along")
+    along = check_axis(ds, along, dims)  # None: the system's default_axis
     system = systems.of_atlas(ds.attrs)
     label = system.variable(system.label)
     crit, sub, axes = _critical(ds, along, sel, progress, threads)
@@ -99,21 +99,21 @@ def located_boundaries(ds: xr.Dataset, along: str, /, *, progress: bool | None =
     return out
 
 
-def located_smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = None, *, progress: bool | None = None,
+def located_smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | None = None, *, progress: bool | None = None,
                             threads: int | None = None, **sel) -> xr.Dataset:
     """The smallest stable value of ``along`` on each selected line, located to 1e-10 (``query.smallest_stable``'s
     layout): ``smallest_stable`` is the lower end of the first stable interval, ``unstable_below`` the value just
     below it, and ``undecided_below`` True where a stretch below it is not decided (a smaller stable value may
     lie there)."""
     dims = grid_axes(ds)
-    along = check_axis(ds, along, dims, "smallest_stable along")
+    along = check_axis(ds, along, dims)
     system = stable_system(ds, "smallest_stable")
     label = system.variable(system.label)
     if over is not None:
         over = check_axis(ds, over, dims, "over")
         extra = [d for d in dims if d not in (along, over) and d not in sel]
         if extra:
-            raise StabmapError(f"smallest_stable over {over!r}: fix the other axes as well ({', '.join(f'{d}=...' for d in extra)})")
+            raise StabmapError(f"{given('over', over)}: fix the other axes as well ({', '.join(f'{d}=...' for d in extra)})")
     crit, sub, axes = _critical(ds, along, sel, progress, threads)
     others = [d for d in crit["n_stable_intervals"].dims]
     lower = crit[f"{along}_stable_lower"].isel(interval=0).values

@@ -2,7 +2,7 @@
 
 - :func:`label_at`: the label at the grid point nearest to a point.
 - :func:`stable_fraction`: the fraction of stable grid points in a slice.
-- :func:`boundaries`: where N_c changes along one axis, bracketed by neighbouring grid values.
+- :func:`boundaries`: where the label changes along one axis, bracketed by neighbouring grid values.
 - :func:`smallest_stable`: the smallest stable grid value of one axis, for each value of another.
 - :func:`summary`: counts that describe a whole atlas.
 
@@ -15,7 +15,7 @@
 - an axis not named is kept whole.
 
 **What the answers are.** Every answer is about grid points, never about values between them. A boundary is
-known only to lie between two neighbouring grid values with different N_c; ``stabmap critical`` (stabmap.critical)
+known only to lie between two neighbouring grid values with different labels; ``stabmap critical`` (stabmap.critical)
 locates such ends to 1e-10 with proof (docs/critical.md). In an adaptive atlas (``stabmap atlas --refine``) some
 points were not computed but inferred from their grid cell's corners (``decided_by`` = inferred_from_cell_corners);
 every answer counts or flags them.
@@ -36,8 +36,9 @@ import numpy as np
 import xarray as xr
 
 from .. import systems
-from ..errors import StabmapError
+from ..errors import StabmapError, given, param
 from ..scene.units import common_unit, in_si, looks_like_rate, split
+from ..store.dataset import is_critical
 from ..store.variables import INFERRED
 from .blocks import changes, compute, first_true
 
@@ -110,10 +111,10 @@ class StableFraction:
     """The stable fraction of a slice of an atlas, with what was counted and where."""
 
     fraction: float  # stable / points
-    stable: int  # N_c = 0
+    stable: int  # the label is the system's stable_label
     points: int  # grid points in the slice
-    unstable: int  # N_c > 0
-    degenerate: int  # N_c = -1 (p identically zero); a negative label other than the system's absent/undecided_label
+    unstable: int  # another label >= 0
+    degenerate: int  # a negative label other than the system's absent/undecided_label
     inferred: int  # points not computed (decided_by = inferred_from_cell_corners), stable or not
     inferred_stable: int  # of those, how many carry the label stable
     axes: dict[str, AxisSelection]  # every grid axis of the atlas, in order
@@ -143,10 +144,10 @@ class StableFraction:
 
 def grid_axes(ds: xr.Dataset) -> list[str]:
     """The grid axes of an atlas; a clear error for a critical-values Dataset or anything else."""
-    if ds.attrs.get("stabmap_kind") == "critical values":
+    if is_critical(ds):
         raise StabmapError(
             "this Dataset holds critical values (stabmap critical), not an atlas; its intervals are in "
-            f"{ds.attrs.get('critical_along', 'omega')}_stable_lower/upper ('stabmap info FILE' lists them)"
+            f"{ds.attrs.get('critical_along', 'ALONG')}_stable_lower/upper ('stabmap info FILE' lists them)"
         )
     system = systems.of_atlas(ds.attrs)
     missing = [v for v in (system.label, system.provenance) if v is not None and v not in ds]
@@ -163,13 +164,14 @@ def _inferred(ds: xr.Dataset, system) -> xr.DataArray:
     return ds[system.provenance] == flags.value(INFERRED)
 
 
-def _not_an_axis(ds: xr.Dataset, name: str, dims: list[str], role: str = "") -> StabmapError:
+def _not_an_axis(ds: xr.Dataset, name: str, dims: list[str], what: str | None = None) -> StabmapError:
+    """``name`` is no grid axis of ``ds``; ``what`` says where it was given (default: the name itself)."""
     axes = ", ".join(dims) or "(none)"
-    role = f"{role} " if role else ""
+    what = repr(name) if what is None else what
     if name in ds.coords and ds[name].ndim == 0:
         units = ds[name].attrs.get("units", "")
-        return StabmapError(f"{role}{name!r} is fixed at {float(ds[name]):g} {units} in this atlas, not a grid axis; its axes are: {axes}")
-    return StabmapError(f"{role}{name!r} is not an axis of this atlas; its axes are: {axes}")
+        return StabmapError(f"{what} is fixed at {float(ds[name]):g} {units} in this atlas, not a grid axis; its axes are: {axes}")
+    return StabmapError(f"{what} is not an axis of this atlas; its axes are: {axes}")
 
 
 def _number(name: str, value, units: str = "") -> float:
@@ -322,7 +324,7 @@ def label_at(ds: xr.Dataset, **point: float) -> Label:
 
 
 def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
-    """The fraction of stable grid points (for gyroscopes N_c = 0) in a slice of an atlas.
+    """The fraction of stable grid points (the label equal to the system's ``stable_label``) in a slice of an atlas.
 
     Parameters
     ----------
@@ -340,21 +342,21 @@ def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
 
     Examples
     --------
-    >>> stable_fraction(ds, K_1=3)                  # over every omega, at the K_1 grid value nearest to 3
+    >>> stable_fraction(ds, K_1=3)                  # a gyroscopes' atlas: every omega, K_1 nearest to 3
     >>> stable_fraction(ds, omega=(20, 60))         # 20 <= omega <= 60, every K_1
     """
     sub, axes = select(ds, sel)
     system = stable_system(ds, "the stable fraction")
-    nc = sub[system.label].data
+    labels = sub[system.label].data
     inferred = _inferred(sub, system).data
-    stable = nc == system.stable_label
-    absent = nc == system.absent_label if system.absent_label is not None else np.zeros((), dtype=bool)
-    undecided = nc == system.undecided_label if system.undecided_label is not None else np.zeros((), dtype=bool)
+    stable = labels == system.stable_label
+    absent = labels == system.absent_label if system.absent_label is not None else np.zeros((), dtype=bool)
+    undecided = labels == system.undecided_label if system.undecided_label is not None else np.zeros((), dtype=bool)
     # One pass over the slice, chunk by chunk: every count reads the same chunks.
-    counts = compute(stable.sum(), (~stable & (nc >= 0)).sum(), ((nc < 0) & ~absent & ~undecided).sum(), inferred.sum(),
+    counts = compute(stable.sum(), (~stable & (labels >= 0)).sum(), ((labels < 0) & ~absent & ~undecided).sum(), inferred.sum(),
                      (inferred & stable).sum(), absent.sum(), undecided.sum())
     n_stable, unstable, degenerate, n_inferred, inferred_stable, n_absent, n_undecided = (int(c) for c in counts)
-    points = int(nc.size)
+    points = int(labels.size)
     return StableFraction(
         fraction=n_stable / points,
         stable=n_stable,
@@ -369,10 +371,17 @@ def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
     )
 
 
-def check_axis(ds: xr.Dataset, along, dims: list[str], role: str) -> str:
-    if not isinstance(along, str) or along not in dims:
-        raise _not_an_axis(ds, str(along), dims, role)
-    return along
+def check_axis(ds: xr.Dataset, value, dims: list[str], name: str = "along") -> str:
+    """The grid axis given to the parameter ``name``; for ``along``, None is the system's ``default_axis``."""
+    if value is None and name == "along":
+        value = systems.of_atlas(ds.attrs).default_axis
+        if value not in dims:
+            raise StabmapError(f"{param('along')} was not given and the default axis {value!r} of {ds.attrs.get('stabmap_system')} "
+                               f"atlases is not a grid axis of this one; its axes are: {', '.join(dims)}; give "
+                               f"{param('along')} one of them")
+    if not isinstance(value, str) or value not in dims:
+        raise _not_an_axis(ds, str(value), dims, given(name, value))
+    return value
 
 
 def stable_system(ds: xr.Dataset, question: str):
@@ -392,9 +401,9 @@ def _lines(sub: xr.Dataset, along: str) -> tuple[list[str], np.ndarray, object, 
     if not sub.indexes[along].is_monotonic_increasing:
         sub = sub.sortby(along)
     others = [d for d in sub[system.label].dims if d != along]
-    nc = sub[system.label].transpose(*others, along).data
+    labels = sub[system.label].transpose(*others, along).data
     inferred = _inferred(sub, system).transpose(*others, along).data
-    return others, np.asarray(sub[along].values, dtype=np.float64), nc, inferred
+    return others, np.asarray(sub[along].values, dtype=np.float64), labels, inferred
 
 
 def _coord(sub: xr.Dataset, name: str, dim: str, values) -> tuple:
@@ -410,20 +419,20 @@ def fixed_coords(sub: xr.Dataset, axes: dict[str, AxisSelection]) -> dict:
     return {k: sub[k].variable for k, a in axes.items() if a.fixed}
 
 
-def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
-    """Every change of N_c along one axis, bracketed by the two neighbouring grid values.
+def boundaries(ds: xr.Dataset, along: str | None = None, /, **sel) -> xr.Dataset:
+    """Every change of the label along one axis, bracketed by the two neighbouring grid values.
 
     For every line along ``along`` (one per grid point of the other axes, or of the slice ``sel`` selects), each
-    pair of neighbouring grid values with different N_c is one boundary. The change lies somewhere between the
+    pair of neighbouring grid values with different labels is one boundary. The change lies somewhere between the
     two values, not at either: ``stabmap critical`` locates it to 1e-10 (docs/critical.md). Changes hidden
-    between two grid values with equal N_c (a thin band) are not seen.
+    between two grid values with equal labels (a thin band) are not seen.
 
     Parameters
     ----------
     ds : xarray.Dataset
         An atlas.
-    along : str
-        The grid axis to search along (e.g. ``"omega"``).
+    along : str, optional
+        The grid axis to search along (default: the system's ``default_axis``).
     **sel
         Selection of the other axes (number: nearest grid value; (lo, hi): a range); ``along`` itself may only
         take a range, which limits the search.
@@ -434,24 +443,24 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
         A tidy table, one entry per boundary along the dimension ``boundary`` (``.to_dataframe()`` gives a
         pandas table). Coordinates: the other axes' grid values of each boundary's line; axes fixed by
         ``sel`` are scalar coordinates (the scene's fixed parameters stay in the atlas). Variables: ``boundary_lower``/``boundary_upper`` (the bracketing grid
-        values, lower < upper, in the units of ``along``), ``n_complex_pairs_below``/``n_complex_pairs_above``
-        (N_c at them), ``inferred_below``/``inferred_above`` (True where that side was not computed but
+        values, lower < upper, in the units of ``along``), ``<label>_below``/``<label>_above``
+        (the label at them, e.g. ``n_complex_pairs_below``), ``inferred_below``/``inferred_above`` (True where that side was not computed but
         inferred from cell corners). Attributes: ``along``, ``n_lines``, ``n_lines_with_boundary``,
         ``selection`` and ``comment``.
 
     Examples
     --------
-    >>> b = boundaries(ds, "omega", K_1=(0, 10))
+    >>> b = boundaries(ds, "omega", K_1=(0, 10))                    # a gyroscopes' atlas
     >>> b.to_dataframe()                                            # one row per boundary
     >>> b.where(b.n_complex_pairs_above == 0, drop=True)            # only the changes to stable
     """
     dims = grid_axes(ds)
-    along = check_axis(ds, along, dims, "boundaries along")
+    along = check_axis(ds, along, dims)
     sub, axes = select(ds, sel, along=along)
-    others, x, nc, inferred = _lines(sub, along)
+    others, x, labels, inferred = _lines(sub, along)
     lab = systems.of_atlas(ds.attrs).label
-    shape = nc.shape[:-1]
-    where, below, above, inferred_below, inferred_above = changes(nc, inferred)  # chunk by chunk
+    shape = labels.shape[:-1]
+    where, below, above, inferred_below, inferred_above = changes(labels, inferred)  # chunk by chunk
     position, k = where[:-1], where[-1]
     line = np.ravel_multi_index(position, shape) if others else np.zeros(k.size, dtype=np.intp)
     units = str(ds[along].attrs.get("units", ""))
@@ -497,21 +506,22 @@ def boundaries(ds: xr.Dataset, along: str, /, **sel) -> xr.Dataset:
     return out
 
 
-def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = None, **sel) -> xr.Dataset:
-    """The smallest grid value of ``along`` at which the rotation is stable, for each value of ``over``.
+def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | None = None, **sel) -> xr.Dataset:
+    """The smallest grid value of ``along`` at which the system is stable, for each value of ``over``.
 
     Parameters
     ----------
     ds : xarray.Dataset
         An atlas.
     along : str
-        The axis searched, from its smallest grid value up (default ``"omega"``: the smallest stable spin rate).
+        The axis searched, from its smallest grid value up (default: the system's ``default_axis``, e.g. the
+        gyroscopes' spin rate).
     over : str, optional
         The axis that labels the answer. Every other axis must then be fixed by a number in ``sel``. Without
         ``over``, the answer has every axis that ``sel`` leaves (one value per grid point of them).
     **sel
         Selection (number: nearest grid value; (lo, hi): a range). A range of ``along`` limits the search,
-        e.g. ``omega=(0, None)`` for the smallest stable *positive* spin rate.
+        e.g. ``omega=(0, None)`` for the gyroscopes' smallest stable *positive* spin rate.
 
     Returns
     -------
@@ -522,36 +532,38 @@ def smallest_stable(ds: xr.Dataset, /, along: str = "omega", over: str | None = 
         - ``unstable_below``: the grid value just below it, not stable; NaN where ``smallest_stable`` is the
           first grid value searched (stable from the start of the scan: the true threshold may lie lower) or
           where nothing is stable. [unstable_below, smallest_stable] brackets the threshold;
-        - ``n_complex_pairs_below``: N_c at ``unstable_below`` (-2 where there is none);
+        - ``<label>_below`` (e.g. ``n_complex_pairs_below``): the label at ``unstable_below`` (its fill value where
+          there is none);
         - ``stable_to_scan_end``: True where every grid value from ``smallest_stable`` to the end of the searched
           range is stable (False: an unstable band follows further up);
         - ``inferred``/``inferred_below``: True where that point was not computed but inferred from cell corners.
 
     Examples
     --------
-    >>> s = smallest_stable(ds, "omega", over="K_1")
+    >>> s = smallest_stable(ds, "omega", over="K_1")  # a gyroscopes' atlas
     >>> s.smallest_stable.plot()                    # the smallest stable spin rate against K_1
     """
     dims = grid_axes(ds)
-    along = check_axis(ds, along, dims, "smallest_stable along")
+    along = check_axis(ds, along, dims)
     sub, axes = select(ds, sel, along=along)
-    others, x, nc, inferred = _lines(sub, along)
+    others, x, labels, inferred = _lines(sub, along)
     system = stable_system(ds, "smallest_stable")
     label = system.variable(system.label)
     if over is not None:
         if over == along:
-            raise StabmapError(f"over={over!r} is the axis searched along; choose another axis for over, e.g. {next((d for d in dims if d != along), 'K_1')}")
+            raise StabmapError(f"{given('over', over)} is the axis searched along; choose another axis for {param('over')}, e.g. "
+                               f"{next((d for d in dims if d != along), 'another grid axis')}")
         over = check_axis(ds, over, dims, "over")
         if axes[over].fixed:
-            raise StabmapError(f"over={over!r} is also fixed by {over}={axes[over].requested:g}; give {over} a range (lo, hi) or leave it out")
+            raise StabmapError(f"{given('over', over)} is also fixed by {over}={axes[over].requested:g}; give {over} a range (lo, hi) or leave it out")
         extra = [d for d in others if d != over]
         if extra:
             example = ", ".join(f"{d}={float(ds[d][0]):g}" for d in extra)
             raise StabmapError(
-                f"smallest_stable over {over!r}: fix the other axes as well ({example}, or any grid value), "
-                "or leave out over to get one answer per point of every remaining axis"
+                f"{given('over', over)}: fix the other axes as well ({example}, or any grid value), "
+                f"or leave out {param('over')} to get one answer per point of every remaining axis"
             )
-    found = first_true(nc == system.stable_label, nc, inferred, label.fill)  # two passes, chunk by chunk
+    found = first_true(labels == system.stable_label, labels, inferred, label.fill)  # two passes, chunk by chunk
     has, first = found.has, found.first
     below = np.maximum(first - 1, 0)
     has_below = has & (first > 0)

@@ -23,6 +23,7 @@ from ..scene.text import parse
 from ..scene.values import Parameter
 from ..systems import loads_scene
 from ..store import files
+from ..store.dataset import is_critical
 
 
 def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
@@ -35,7 +36,7 @@ def scene_attrs(ds: xr.Dataset) -> dict:
     """The global attributes to change so that ``ds``'s stored scene reproduces its grid: ``{}`` when it does already
     (a whole atlas, critical values, a file without a scene); else ``scene`` rewritten and a ``history`` line."""
     text = ds.attrs.get("scene")
-    if text is None or ds.attrs.get("stabmap_kind") == "critical values":
+    if text is None or is_critical(ds):
         return {}
     # The grid alone first (a stored scene holds plain numbers): a whole atlas is written without validating its
     # scene again, which for a cavity chooses its modes over the grid (0.4 s for the bundled cavity example).

@@ -7,7 +7,7 @@ import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError
-from ..store.dataset import edges
+from ..store.dataset import edges, is_critical
 from ..store.variables import CELL
 
 
@@ -31,7 +31,7 @@ def summary(ds: xr.Dataset) -> dict:
     ``decided_by``).  An atlas with cells (``stabmap.run.cells``) adds ``cell`` (counts by flag meaning) and
     ``cell_volume`` (each meaning's share of the scanned volume, cells weighted by their size).
     """
-    if ds.attrs.get("stabmap_kind") == "critical values":  # its own counts: intervals, boundaries, gaps per line
+    if is_critical(ds):  # its own counts: intervals, boundaries, gaps per line
         from .table import critical_summary
 
         return critical_summary(ds)

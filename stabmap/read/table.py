@@ -22,14 +22,10 @@ import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError
+from ..store.dataset import CRITICAL_KIND as KIND
+from ..store.dataset import is_critical
 
-KIND = "critical values"  # the stabmap_kind attribute of a critical-values Dataset (stabmap.run.critical.KIND)
 ROWS = ("boundary", "stable_interval", "undecided_gap", "no_stable_interval")  # the ``row`` kinds, in this order at equal lower ends
-
-
-def is_critical(ds: xr.Dataset) -> bool:
-    """True for a critical-values Dataset (``stabmap critical``), False for an atlas."""
-    return ds.attrs.get("stabmap_kind") == KIND
 
 
 def check_critical(ds: xr.Dataset, question: str) -> str:

@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from .. import systems
-from ..errors import StabmapError
+from ..errors import StabmapError, given
 from ..systems.base import SceneBase
 
 TASK_SECONDS = 0.5  # aimed-for run time of one task on one core
@@ -37,7 +37,7 @@ def chunk_points_for(scene: SceneBase, seconds_per_point: float, threads: int, n
     """
     total = math.prod(scene.shape) if npoints is None else npoints
     by_time = max(MIN_CHUNK_POINTS, BLOCK_SECONDS / max(seconds_per_point, 1e-9))
-    by_memory = MAX_CHUNK_BYTES // max(1, systems.of(scene).cost(scene).bytes)
+    by_memory = MAX_CHUNK_BYTES // max(1, systems.of(scene).input_bytes(scene))
     balance = max(1, total // (8 * max(1, threads)))
     return int(max(1, min(by_time, by_memory, MAX_CHUNK_POINTS, balance)))
 
@@ -68,11 +68,11 @@ def tile_locations(shape: tuple[int, ...], tile: tuple[int, ...], seed: int = 0)
     return [tuple((int(i) * t, min(n, (int(i) + 1) * t)) for i, t, n in zip(at, tile, shape)) for at in zip(*picks)]
 
 
-def check_chunk_points(value, option: str = "chunk_points") -> int | None:
+def check_chunk_points(value) -> int | None:
     if value is None:
         return None
     if isinstance(value, bool) or not float(value).is_integer() or value < 1:
-        raise StabmapError(f"{option} must be a whole number >= 1 (points per task), got {value!r}")
+        raise StabmapError(f"{given('chunk_points', value)}: must be a whole number >= 1 (points per task)")
     return int(value)
 
 

@@ -1,12 +1,13 @@
-"""Critical values of one scanned parameter: the ends of the intervals where the rotation is stable.
+"""Critical values of one scanned parameter: the ends of the intervals where the system is stable.
 
-``critical(scene, along="omega")`` answers "how fast must it spin?" for every
-point of the scene's other grid axes, without a dense grid along ``along``:
+``critical(scene, along)`` finds, for every point of the scene's other grid axes, the values of ``along``
+(default: the system's ``default_axis``) where the system is stable, without a dense grid along ``along``.
+"The label" is the system's ``System.label``, and "stable" its ``stable_label``:
 
-1. **Scan.** N_c is decided at every value of the ``along`` grid axis (the
+1. **Scan.** The label is decided at every value of the ``along`` grid axis (the
    user's ``num`` sets where the search starts), for every point of the other axes.
 2. **Proof between scan values.** Every scan step is a segment whose two ends
-   have proved N_c.  A box proof (``System.prove_boxes``) shows that N_c is the
+   have proved labels.  A box proof (``System.prove_boxes``) shows that the label is the
    same at every value of a segment; segments it cannot prove are halved (one
    batch of certified decisions and box proofs per step, in tasks through the
    run's runner: threads here or a dask cluster) and their halves tried again.
@@ -21,11 +22,10 @@ point of the scene's other grid axes, without a dense grid along ``along``:
    gap*, and is listed.  A gap next to a bracket joins it
    (the bracket's width stays below the tolerance).
 4. **Intervals.** The brackets and the proved segments between them
-   partition the scan range outside the gaps; each maximal piece with N_c = 0
+   partition the scan range outside the gaps; each maximal piece with the stable label
    is a stable interval, flagged where a gap lies inside it.
 
-N_c stands for the system's label (``System.label``; for gyroscopes the number
-of complex root pairs), and "stable" for its ``stable_label``.  A system that
+A system that
 proves no boxes (``System.box_axes`` without ``along``) leaves every scan step
 with equal ends as a gap, and says so: its changes are searched for only where
 adjacent scan values differ (``POINTS_ONLY``; docs/critical.md).
@@ -41,15 +41,14 @@ import numpy as np
 import xarray as xr
 
 from .. import systems
-from ..errors import StabmapError
-from ..store.dataset import coordinates, global_attrs
+from ..errors import StabmapError, given, param
+from ..store.dataset import CRITICAL_KIND, coordinates, global_attrs
 from ..systems.base import SceneBase
 from . import runner
 from .atlas import decide_boxes, decide_grid, decide_points
 from .chunks import check_chunk_points
 from .progress import wanted
 
-KIND = "critical values"  # global attribute stabmap_kind of every critical-values Dataset
 DEFAULT_RTOL = 1e-10
 MIN_RTOL = 1e-15  # a few ulps: bisection in float64 cannot go finer anyway
 ATOL_FACTOR = 1e-6  # default atol = ATOL_FACTOR * rtol * max |scan value|, for boundaries at or near 0
@@ -80,20 +79,20 @@ POINTS_ONLY = (
 
 @dataclass
 class _Brackets:
-    """Intervals (lo, hi] of the scanned parameter, each with certified, different N_c at its two ends."""
+    """Intervals (lo, hi] of the scanned parameter, each with the labels proved at its two ends."""
 
     owner: np.ndarray  # int64: flat index into the other axes
     lo: np.ndarray
     hi: np.ndarray
-    nc_lo: np.ndarray  # int16
-    nc_hi: np.ndarray
+    label_lo: np.ndarray  # int16
+    label_hi: np.ndarray
 
     def take(self, idx) -> _Brackets:
-        return _Brackets(self.owner[idx], self.lo[idx], self.hi[idx], self.nc_lo[idx], self.nc_hi[idx])
+        return _Brackets(self.owner[idx], self.lo[idx], self.hi[idx], self.label_lo[idx], self.label_hi[idx])
 
     @staticmethod
     def concat(parts: list[_Brackets]) -> _Brackets:
-        return _Brackets(*(np.concatenate([getattr(p, f) for p in parts]) for f in ("owner", "lo", "hi", "nc_lo", "nc_hi")))
+        return _Brackets(*(np.concatenate([getattr(p, f) for p in parts]) for f in ("owner", "lo", "hi", "label_lo", "label_hi")))
 
     def __len__(self) -> int:
         return self.lo.size
@@ -118,22 +117,30 @@ class _Counts:
             self.provenance[v] = self.provenance.get(v, 0) + c
 
 
-def check_along(scene: SceneBase, along: str) -> int:
-    """Index of the grid axis ``along``; a StabmapError naming the axes if it is not one."""
+def check_along(scene: SceneBase, along: str | None) -> tuple[int, str]:
+    """Index and name of the grid axis ``along`` (None: the system's ``default_axis``); a StabmapError naming the
+    axes if it is not one."""
     names = [a.name for a in scene.grid]
+    default = along is None
+    along = systems.of(scene).default_axis if default else along
     if along not in names:
         have = ", ".join(names) if names else "none (the scene has no [grid])"
+        # without along, say which default was taken, and how to choose another
+        what = (f"{param('along')} not given, so the {scene.system} system's default axis {along!r}" if default
+                else given("along", along))
         try:
             scene.parameter(along)
         except StabmapError as exc:  # not a name this scene could scan at all: say that, not "add it to [grid]"
-            raise StabmapError(f"--along {along}: {exc}; its grid axes are: {have}") from None
+            raise StabmapError(f"{what}: {exc}; its grid axes are: {have}") from None
         raise StabmapError(
-            f"--along {along}: not a grid axis of this scene; its grid axes are: {have}. "
+            f"{what}: not a grid axis of this scene; its grid axes are: {have}. "
             f"Add {along} = {{ start = ..., stop = ..., num = ... }} under [grid] to scan it"
+            + (f", or give {param('along')} one of them" if default and names else "")
         )
     if len(scene.grid[names.index(along)].values) < 2:
-        raise StabmapError(f"grid axis {along!r} has 1 value; critical values need a scan of at least 2 values (set num)")
-    return names.index(along)
+        raise StabmapError(f"{given('along', along)}: grid axis {along!r} has 1 value; critical values need a scan of at "
+                           "least 2 values (set num)")
+    return names.index(along), along
 
 
 def check_rtol(rtol) -> float:
@@ -141,14 +148,15 @@ def check_rtol(rtol) -> float:
     ok = not isinstance(rtol, bool) and isinstance(rtol, (int, float, np.floating)) and math.isfinite(rtol)
     if not ok or not MIN_RTOL <= rtol < 1:
         raise StabmapError(
-            f"rtol must be between {MIN_RTOL:g} (float64 resolution) and 1 (excluded), got {rtol!r}; the default is {DEFAULT_RTOL:g}"
+            f"{given('rtol', rtol)}: must be between {MIN_RTOL:g} (float64 resolution) and 1 (excluded); the default "
+            f"is {DEFAULT_RTOL:g}"
         )
     return float(rtol)
 
 
 def critical(
     scene: SceneBase,
-    along: str = "omega",
+    along: str | None = None,
     *,
     rtol: float = DEFAULT_RTOL,
     atol: float | None = None,
@@ -158,7 +166,7 @@ def critical(
     progress: bool | None = None,
     chunk_points: int | None = None,
 ) -> xr.Dataset:
-    """The intervals of ``along`` where the rotation is stable, ends located to ``rtol``.
+    """The intervals of ``along`` where the system is stable (its ``stable_label``), ends located to ``rtol``.
 
     Parameters
     ----------
@@ -167,7 +175,7 @@ def critical(
         values are the scan (so ``num`` sets how fine a feature can be found),
         and the other grid axes are the dimensions of the result.
     along : str
-        The scanned parameter, any grid axis name (default ``"omega"``).
+        The scanned parameter, any grid axis name (default: the system's ``default_axis``).
     rtol : float
         Located ends satisfy hi - lo <= max(rtol * max(|lo|, |hi|), atol)
         (default 1e-10; between 1e-15 and 1).
@@ -185,27 +193,27 @@ def critical(
         Dimensions: the other grid axes, ``interval`` and ``boundary``;
         ``stabmap_kind = "critical values"``. Layout: docs/critical.md.
     """
-    index = check_along(scene, along)
-    rtol = check_rtol(rtol)
-    chunk_points = check_chunk_points(chunk_points)
     system = systems.of(scene)
     if system.stable_label is None:
         raise StabmapError(f"critical values are the ends of stable intervals; {system.name} atlases have no stability")
+    index, along = check_along(scene, along)
+    rtol = check_rtol(rtol)
+    chunk_points = check_chunk_points(chunk_points)
     scan = np.sort(scene.grid[index].array)
     if atol is None:
         atol = ATOL_FACTOR * rtol * float(np.abs(scan).max())
     if not (math.isfinite(atol) and atol >= 0):
-        raise StabmapError(f"atol must be a finite number >= 0, got {atol!r}")
+        raise StabmapError(f"{given('atol', atol)}: must be a finite number >= 0")
     others = tuple(a for d, a in enumerate(scene.grid) if d != index)
     counts = _Counts()
     t0 = time.perf_counter()
     labels = system.labels_only(scene)  # critical values need the label alone, not the system's other outputs
     with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run:
-        nc = _scan(run, labels, index, progress, chunk_points, counts)
+        label = _scan(run, labels, index, progress, chunk_points, counts)
         boxes = along in system.box_axes(labels)
-        brackets, gaps = _search(run, labels, along, others, _steps(nc, scan), boxes, rtol, atol, chunk_points, counts)
+        brackets, gaps = _search(run, labels, along, others, _steps(label, scan), boxes, rtol, atol, chunk_points, counts)
     brackets, gaps = _join(brackets, gaps, rtol, atol)
-    ds = _dataset(system, scene, along, others, scan, nc, brackets, gaps, _proved(system))
+    ds = _dataset(system, scene, along, others, scan, label, brackets, gaps, _proved(system))
     ds.attrs.update(_attrs(system, along, scan, rtol, atol, counts, boxes))
     ds.attrs["history"] += _history(along, counts, time.perf_counter() - t0)
     return ds
@@ -215,17 +223,17 @@ def _scan(run, scene, index: int, progress, chunk_points, counts: _Counts) -> np
     """The label on the whole grid, as (other axes..., along) with the along values increasing."""
     system = systems.of(scene)
     arrays = decide_grid(run, scene, progress=progress, chunk_points=chunk_points, prove_cells=False)  # its own boxes follow
-    nc = np.moveaxis(arrays[system.label], index, -1)
+    label = np.moveaxis(arrays[system.label], index, -1)
     if scene.grid[index].values[0] > scene.grid[index].values[-1]:
-        nc = nc[..., ::-1]
-    counts.scan_points = nc.size
+        label = label[..., ::-1]
+    counts.scan_points = label.size
     counts.decided(system, arrays)
-    return np.ascontiguousarray(nc)
+    return np.ascontiguousarray(label)
 
 
-def _steps(nc: np.ndarray, scan: np.ndarray) -> _Brackets:
+def _steps(label: np.ndarray, scan: np.ndarray) -> _Brackets:
     """Every scan step of every point of the other axes, with the labels at its ends."""
-    flat = nc.reshape(-1, scan.size)
+    flat = label.reshape(-1, scan.size)
     owner, step = np.indices(flat[:, :-1].shape)
     owner, step = owner.ravel(), step.ravel()
     return _Brackets(owner.astype(np.int64), scan[step], scan[step + 1], flat[owner, step], flat[owner, step + 1])
@@ -257,7 +265,7 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
     unpaid = np.zeros(npoints, dtype=bool)  # points whose box proofs failed broadly (PAYS)
     brackets, gaps = [], []
     for _ in range(MAX_ITERATIONS):
-        same = np.flatnonzero(active.nc_lo == active.nc_hi)  # a segment whose ends differ has no one label to prove
+        same = np.flatnonzero(active.label_lo == active.label_hi)  # a segment whose ends differ has no one label to prove
         if boxes and same.size:
             tried = active.take(same)
             label, proved = decide_boxes(run, scene, *_corners(others, shape, along, tried), chunk_points=chunk_points)
@@ -267,12 +275,12 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
             spent += now
             broad = now >= np.maximum(PAYS_MIN, steps // 4)
             unpaid |= broad & (np.bincount(tried.owner[proved], minlength=npoints) < PAYS * now)
-            if np.any(proved & (label != tried.nc_lo)):  # pragma: no cover - two proofs disagree
+            if np.any(proved & (label != tried.label_lo)):  # pragma: no cover - two proofs disagree
                 raise AssertionError(f"a box proof of {system.label} contradicts the proofs at its ends")
             keep = np.ones(len(active), dtype=bool)
             keep[same[proved]] = False
             active = active.take(keep)
-        differ = active.nc_lo != active.nc_hi
+        differ = active.label_lo != active.label_hi
         small = _converged(active, rtol / 4, atol / 4)
         stop = small | ((spent >= budget) | unpaid)[active.owner] | (not boxes)
         brackets.append(active.take(differ & small))
@@ -285,10 +293,10 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
         counts.bisection_points += mid.size
         counts.decided(system, results)
         counts.iterations += 1
-        nc_mid = results[system.label]
+        label_mid = results[system.label]
         active = _Brackets.concat([
-            _Brackets(active.owner, active.lo, mid, active.nc_lo, nc_mid),
-            _Brackets(active.owner, mid, active.hi, nc_mid, active.nc_hi),
+            _Brackets(active.owner, active.lo, mid, active.label_lo, label_mid),
+            _Brackets(active.owner, mid, active.hi, label_mid, active.label_hi),
         ])
     else:  # pragma: no cover - float64 bisection always reaches neighbouring doubles first
         raise RuntimeError("bisection did not converge")
@@ -340,7 +348,7 @@ def _join(brackets: _Brackets, gaps: _Brackets, rtol: float, atol: float) -> tup
         starts[1:] = (gaps.owner[1:] != gaps.owner[:-1]) | (gaps.lo[1:] != gaps.hi[:-1])
         first = np.flatnonzero(starts)
         last = np.append(first[1:], len(gaps)) - 1
-        gaps = _Brackets(gaps.owner[first], gaps.lo[first], gaps.hi[last], gaps.nc_lo[first], gaps.nc_hi[last])
+        gaps = _Brackets(gaps.owner[first], gaps.lo[first], gaps.hi[last], gaps.label_lo[first], gaps.label_hi[last])
     return brackets, gaps
 
 
@@ -355,8 +363,8 @@ class _Table:
     upper_outer: np.ndarray
     b_lower: np.ndarray
     b_upper: np.ndarray
-    nc_below: np.ndarray
-    nc_above: np.ndarray
+    label_below: np.ndarray
+    label_above: np.ndarray
     start: np.ndarray  # the label at the first scan value: with the boundaries, the label everywhere in the scan
     n_gaps: np.ndarray
     gap_lower: np.ndarray
@@ -364,9 +372,9 @@ class _Table:
     whole: np.ndarray  # int8 per stable interval: 1 proved stable throughout, 0 a gap lies inside, -1 pad
 
 
-def _table(nc: np.ndarray, scan: np.ndarray, b: _Brackets, gaps: _Brackets, stable: int, fill: int) -> _Table:
+def _table(label: np.ndarray, scan: np.ndarray, b: _Brackets, gaps: _Brackets, stable: int, fill: int) -> _Table:
     """Stable intervals, boundaries and undecided gaps of every point of the other axes."""
-    flat = nc.reshape(-1, scan.size)
+    flat = label.reshape(-1, scan.size)
     npoints = flat.shape[0]
     gaps = gaps.take(np.lexsort((gaps.lo, gaps.owner)))
     gstarts = np.concatenate([[0], np.cumsum(np.bincount(gaps.owner, minlength=npoints))])
@@ -389,25 +397,25 @@ def _table(nc: np.ndarray, scan: np.ndarray, b: _Brackets, gaps: _Brackets, stab
             whole[p, i] = not np.any((g.hi > row[0]) & (g.lo < row[1]))
     slot = np.arange(len(b)) - starts[b.owner]
     bounds = np.full((2, npoints, nb), np.nan)
-    counts = np.full((2, npoints, nb), fill, dtype=nc.dtype)
+    counts = np.full((2, npoints, nb), fill, dtype=label.dtype)
     bounds[0, b.owner, slot], bounds[1, b.owner, slot] = b.lo, b.hi
-    counts[0, b.owner, slot], counts[1, b.owner, slot] = b.nc_lo, b.nc_hi
+    counts[0, b.owner, slot], counts[1, b.owner, slot] = b.label_lo, b.label_hi
     n_gaps = np.diff(gstarts).astype(np.int32)
     return _Table(n_int, *ends, *bounds, *counts, flat[:, 0].copy(), n_gaps, *gap_ends, whole)
 
 
-def _stable_intervals(nc_start: int, scan: np.ndarray, b: _Brackets, stable: int) -> list[tuple[float, float, float, float]]:
+def _stable_intervals(label_start: int, scan: np.ndarray, b: _Brackets, stable: int) -> list[tuple[float, float, float, float]]:
     """(lower, upper, lower_outer, upper_outer) of each stable interval of one point; NaN outer: scan end.
 
     The sorted brackets and the scan steps between them partition the scan
-    range, so the N_c between bracket i-1 and bracket i is bracket i's lower-end N_c.
+    range, so the label between bracket i-1 and bracket i is bracket i's lower-end label.
     """
     k = len(b)
-    if k and not np.array_equal(b.nc_hi[:-1], b.nc_lo[1:]):  # pragma: no cover - guaranteed by construction
+    if k and not np.array_equal(b.label_hi[:-1], b.label_lo[1:]):  # pragma: no cover - guaranteed by construction
         raise AssertionError("brackets do not chain")
     out = []
     for i in range(k + 1):
-        if (nc_start if i == 0 else b.nc_hi[i - 1]) != stable:
+        if (label_start if i == 0 else b.label_hi[i - 1]) != stable:
             continue
         lower, lower_outer = (scan[0], np.nan) if i == 0 else (b.hi[i - 1], b.lo[i - 1])
         upper, upper_outer = (scan[-1], np.nan) if i == k else (b.lo[i], b.hi[i])
@@ -420,12 +428,12 @@ def _proved(system) -> str:
     return "proved" if system.proves_labels else "decided"
 
 
-def _dataset(system, scene, along, others, scan, nc, brackets, gaps, proved: str = "proved") -> xr.Dataset:
+def _dataset(system, scene, along, others, scan, labels, brackets, gaps, proved: str = "proved") -> xr.Dataset:
     info = system.parameter(scene, along)
     label = system.variable(system.label)
     dims = tuple(a.name for a in others)
     shape = tuple(len(a.values) for a in others)
-    t = _table(nc, scan, brackets, gaps, system.stable_label, label.fill)
+    t = _table(labels, scan, brackets, gaps, system.stable_label, label.fill)
     iv, bd, gp = dims + ("interval",), dims + ("boundary",), dims + ("gap",)
     lab = label.name
 
@@ -450,8 +458,8 @@ def _dataset(system, scene, along, others, scan, nc, brackets, gaps, proved: str
             "NaN where the interval ends at the scan range end (it may continue above)")),
         "boundary_lower": (bd, grid(t.b_lower), along_attrs(f"lower end of the bracket of a change of {lab}", f"{lab}_below holds here, {proved}; NaN pads")),
         "boundary_upper": (bd, grid(t.b_upper), along_attrs(f"upper end of the bracket of a change of {lab}", f"{lab}_above holds here, {proved}; a change lies in (lower, upper]; NaN pads")),
-        f"{lab}_below": (bd, grid(t.nc_below), count_attrs(f"{lab} at boundary_lower")),
-        f"{lab}_above": (bd, grid(t.nc_above), count_attrs(f"{lab} at boundary_upper")),
+        f"{lab}_below": (bd, grid(t.label_below), count_attrs(f"{lab} at boundary_lower")),
+        f"{lab}_above": (bd, grid(t.label_above), count_attrs(f"{lab} at boundary_upper")),
         f"{along}_stable_whole": (iv, grid(t.whole), {
             "long_name": "stable at every value of the interval", "units": "1",
             "flag_values": np.array([-1, 0, 1], dtype=np.int8), "flag_meanings": "pad gap_inside proved_throughout",
@@ -472,7 +480,7 @@ def _dataset(system, scene, along, others, scan, nc, brackets, gaps, proved: str
 
 def _attrs(system, along, scan, rtol, atol, counts: _Counts, boxes: bool) -> dict:
     attrs = {
-        "stabmap_kind": KIND,
+        "stabmap_kind": CRITICAL_KIND,
         "critical_along": along,
         "critical_rtol": rtol,
         "critical_atol": atol,

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import systems
-from ..errors import StabmapError
+from ..errors import StabmapError, given
 from ..store.dataset import atlas_dataset, empty_arrays
 from ..store.variables import CELL
 from ..systems.base import SceneBase
@@ -52,25 +52,26 @@ def default_coarse_stride(n: int) -> int:
     return 1 << (cells.bit_length() - 1) if cells >= 1 else 1
 
 
-def check_coarse_stride(value, option: str = "coarse_stride") -> int | None:
-    """Validate a user's coarse stride (None: choose per axis); errors name ``option``."""
+def check_coarse_stride(value) -> int | None:
+    """Validate a user's coarse stride (None: choose per axis)."""
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise StabmapError(f"{option} must be a whole power of two such as 8 or 16, got {value!r}")
+        raise StabmapError(f"{given('coarse_stride', value)}: must be a whole power of two such as 8 or 16")
     if value < 1 or value & (value - 1):
         lower = 1 << (max(1, int(value)).bit_length() - 1)
         raise StabmapError(
-            f"{option} must be a power of two (1, 2, 4, 8, 16, ...) so that halving it reaches every grid point; "
-            f"got {value}, use e.g. {lower} or {2 * lower}"
+            f"{given('coarse_stride', value)}: must be a power of two (1, 2, 4, 8, 16, ...) so that "
+            f"halving it reaches every grid point; use e.g. {lower} or {2 * lower}"
         )
     return int(value)
 
 
-def check_margin(value, option: str = "margin") -> int:
-    """Validate a safety margin in cells; errors name ``option``."""
+def check_margin(value) -> int:
+    """Validate a safety margin in cells."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise StabmapError(f"{option} must be a whole number of cells >= 0 (default 2; 0 and 1 are cheaper and miss more), got {value!r}")
+        raise StabmapError(f"{given('margin', value)}: must be a whole number of cells >= 0 (default 2; 0 and 1 are "
+                           "cheaper and miss more)")
     return int(value)
 
 
@@ -240,7 +241,7 @@ def _step(ev: _Evaluator, level: _Level, active: np.ndarray, margin: int, box: t
     Returns the cells to split: those whose corners disagree or include a point
     an earlier fill got wrong, grown by ``margin`` cells.
     """
-    computed, nc = ev.computed[box], ev.label[box]
+    computed, label = ev.computed[box], ev.label[box]
     need = np.zeros(tuple(idx.size for idx in level.nodes), dtype=bool)
     for sl in level.corners():
         need[sl] |= active
@@ -254,11 +255,11 @@ def _step(ev: _Evaluator, level: _Level, active: np.ndarray, margin: int, box: t
             wrong_nodes = np.zeros(need.shape, dtype=bool)
             wrong_nodes[tuple(s[bad] for s in sel)] = True
             wrong = _any_corner(level, wrong_nodes)
-    lo, hi = _corner_range(level, level.at_nodes(nc))
+    lo, hi = _corner_range(level, level.at_nodes(label))
     split = _dilate((active & (lo != hi)) | wrong, margin)
     if level.has_interior:
-        mask = level.on_grid(active & ~split, nc.shape) & ~computed
-        nc[mask] = level.on_grid(lo, nc.shape)[mask]
+        mask = level.on_grid(active & ~split, label.shape) & ~computed
+        label[mask] = level.on_grid(lo, label.shape)[mask]
         ev.filled[box] |= mask
     return split
 
@@ -317,9 +318,9 @@ def compute_refined(
     """Compute the atlas of ``scene`` adaptively: coarse lattice first, refined where labels change.
 
     The Dataset has the same grid, variables and layout as ``compute_atlas``.
-    Computed points carry their proof in ``decided_by``; points filled from
-    their cell's corners carry ``decided_by = 3`` (inferred_from_cell_corners).
-    The result equals the dense atlas unless a feature (a region of other N_c)
+    Computed points carry their proof in the system's provenance flag; points filled from
+    their cell's corners say ``inferred_from_cell_corners`` there (``System.inferred``).
+    The result equals the dense atlas unless a feature (a region of another label)
     lies inside a cell whose corners agree and comes within ``margin`` cells of
     no disagreeing cell: see docs/refine.md.
 
@@ -349,7 +350,8 @@ def compute_refined(
     chunk_points = check_chunk_points(chunk_points)
     system = systems.of(scene)
     if system.inferred(np.zeros(0, dtype=np.int64)) is None:  # the system cannot say what a filled point holds
-        raise StabmapError(f"adaptive refinement (--refine) is not available for {system.name} atlases; compute a dense one")
+        raise StabmapError(f"adaptive refinement is not available for {system.name} atlases (the system infers no labels "
+                           "from cell corners: System.inferred); compute a dense one")
     shape = scene.shape
     strides = tuple(coarse_stride or default_coarse_stride(n) for n in shape)
     total = math.prod(shape)

@@ -29,7 +29,7 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, CancelledError, ThreadPoolExecutor, wait
 from typing import Protocol
 
-from ..errors import StabmapError
+from ..errors import StabmapError, given, param
 from ..version import __version__
 from .chunks import TASK_SECONDS
 from .tasks import run_task
@@ -49,11 +49,12 @@ class SchedulerLost(StabmapError):
     exit_status = 3
 
 
-def check_threads(threads, option: str = "threads") -> int:
+def check_threads(threads, name: str = "threads") -> int:
+    """A count of threads (or of worker processes: ``name`` the parameter that gave it); None: one per core."""
     if threads is None:
         return os.cpu_count() or 1
     if isinstance(threads, bool) or not float(threads).is_integer() or threads < 1:
-        raise StabmapError(f"{option} must be a whole number >= 1, got {threads!r}")
+        raise StabmapError(f"{given(name, threads)}: must be a whole number >= 1")
     return int(threads)
 
 
@@ -61,12 +62,12 @@ def check_where(client=None, workers: int | None = None, threads: int | None = N
     """Fail before any work on a contradictory choice of where to run."""
     if client is not None and workers is not None:
         raise StabmapError(
-            "give a scheduler (--scheduler ADDRESS, client=) for an existing cluster or a number of local "
-            "workers (--workers N, workers=), not both"
+            f"give a scheduler ({param('client')}) for an existing cluster or a number of local "
+            f"workers ({param('workers')}), not both"
         )
     if (client is not None or workers is not None) and threads is not None:
         raise StabmapError(
-            "threads (--threads) sets the threads of an in-process run; on a cluster each worker has its own "
+            f"{param('threads')} sets the threads of an in-process run; on a cluster each worker has its own "
             "(dask worker --nthreads)"
         )
     if workers is not None:
@@ -307,7 +308,7 @@ def local_cluster(workers: int) -> Iterator:
         raise StabmapError(
             f"could not start a local cluster of {workers} worker processes ({exc}); from a Python script, run it "
             "under 'if __name__ == \"__main__\":' (the workers import the script), or start 'dask scheduler' and "
-            "'dask worker' yourself and pass their address (client=, --scheduler)"
+            f"'dask worker' yourself and pass their address ({param('client')})"
         ) from None
     with cluster, Client(cluster, set_as_default=False) as client:
         yield client

@@ -12,6 +12,12 @@ from ..version import __version__
 
 BOUNDS_DIM = "bnds"  # the CF bounds variables' second dimension: a cell's two edges
 FORMAT_VERSION = 5  # 4: stabmap_system; every variable of the system written as declared; 5: cell and axis bounds
+CRITICAL_KIND = "critical values"  # the global attribute stabmap_kind of every critical-values Dataset
+
+
+def is_critical(ds) -> bool:
+    """Whether ``ds`` holds critical values (``stabmap.run.critical``) rather than an atlas."""
+    return ds.attrs.get("stabmap_kind") == CRITICAL_KIND
 
 
 def edges(values) -> np.ndarray:

@@ -35,7 +35,19 @@ def get(name: str) -> System:
 
 
 def of(scene: SceneBase) -> System:
-    """The system of a scene."""
+    """The system of a scene.
+
+    A system that is not in ``SYSTEMS`` here but was registered in the process that made the scene (a cluster's
+    worker receives scenes of systems its own registry never saw: a plug-in added at run time) is the ``SYSTEM``
+    of the module that defines the scene's type, or of a package above it.
+    """
+    if scene.system not in SYSTEMS:
+        module = type(scene).__module__
+        while module:
+            found = getattr(importlib.import_module(module), "SYSTEM", None)
+            if isinstance(found, System) and found.name == scene.system:
+                return found
+            module = module.rpartition(".")[0]
     return get(scene.system)
 
 

@@ -5,18 +5,28 @@ chunking, running (threads or a dask cluster), checkpoints, files, ``info``,
 ``query`` and ``plot`` are written once; a system fills in the parts that
 belong to its physics:
 
-- its **scene**: a frozen dataclass with ``title`` and ``grid`` fields (plus
-  its own), validated in ``__post_init__`` (one place for scenes built in
-  Python and read from TOML), and ``to_dict`` giving the TOML table back;
-- ``scene_from_dict``: the TOML table of a scene file -> that dataclass;
-- ``parameter``: units, long name and limits of every name its grid may scan;
-- ``evaluate``: the decision at a block of points, as plain arrays;
-- ``variables``: its outputs, declared once with CF metadata and flags.
+- its **scene** (``System.scene_type``, a ``SceneBase`` subclass): a frozen dataclass with ``title`` and ``grid``
+  fields (plus its own), validated in ``__post_init__`` (one place for scenes built in Python and read from
+  TOML); ``from_dict`` reads a scene file's table, ``to_dict`` gives it back, ``parameter`` names the units
+  and limits of every name its grid may scan, ``fixed_values`` the scalars that are not grid axes, ``notes``
+  what it chose for itself;
+- ``evaluate``: the decision at a block of points, as plain arrays; ``input_bytes``: what one point's inputs
+  weigh;
+- ``variables``: its outputs, declared once with CF metadata and flags, and the ``label`` among them;
+- ``default_axis``: the grid axis that critical values and the queries scan unless told otherwise;
+- ``paper``: the module of its paper's check for ``stabmap paper`` (or None).
+
+Both classes are abstract base classes (``abc``), not ``typing.Protocol``: a system inherits some forty
+defaults (no box proofs, no refinement, no extra dimensions, ...) that a Protocol would make every system
+restate, and an ABC refuses to instantiate a system that leaves a required member out, at import, with the
+member's name, where a Protocol would only be checked by a type checker.  Required class attributes are
+abstract properties that a subclass overrides with a plain class attribute.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from abc import ABC, abstractmethod
+from dataclasses import replace
 from pathlib import Path
 from typing import ClassVar
 
@@ -28,7 +38,7 @@ from ..scene.values import Parameter
 from ..store.variables import CELL, Variable
 
 
-class SceneBase:
+class SceneBase(ABC):
     """What every system's scene dataclass shares (its own fields: ``title: str`` and ``grid: tuple[Axis, ...]``)."""
 
     system: ClassVar[str]  # the name of its System
@@ -39,9 +49,28 @@ class SceneBase:
     def shape(self) -> tuple[int, ...]:
         return tuple(len(a.values) for a in self.grid)
 
+    @classmethod
+    @abstractmethod
+    def from_dict(cls, table: dict, base_dir: Path | None = None) -> "SceneBase":
+        """The scene of a scene file's TOML table (its ``system`` key removed); errors name the key and the fix.
+        Relative file names in the table are taken from ``base_dir``."""
+
+    @abstractmethod
     def to_dict(self) -> dict:
         """The scene's TOML table, without the ``system`` key."""
-        raise NotImplementedError
+
+    @abstractmethod
+    def parameter(self, name: str) -> Parameter:
+        """Units, long name and limits of the scannable ``name``; a StabmapError for a name this scene cannot scan."""
+
+    @abstractmethod
+    def fixed_values(self) -> dict[str, float]:
+        """The scalar parameters that are not grid axes, by their scannable names (an atlas's scalar coordinates)."""
+
+    def notes(self) -> list[tuple[str, str]]:
+        """What the scene chose for itself that its file does not state, for ``stabmap info``: (group, text), the
+        group a heading of ``System.fixed_groups`` (``""``: the whole scene).  Default: nothing."""
+        return []
 
     def with_grid(self, grid: tuple[Axis, ...]) -> "SceneBase":
         """The same scene on ``grid`` (a subset of its own, ``read.subset``), with every choice this scene made from
@@ -53,16 +82,12 @@ class SceneBase:
         return text.dumps({"system": self.system, **self.to_dict()})
 
 
-@dataclass(frozen=True)
-class Cost:
-    """What one point costs, for sizing the tasks: seconds on one core, and bytes of its inputs."""
-
-    seconds: float
-    bytes: int
-
-
-class System:
+class System(ABC):
     """A system: one subpackage of ``stabmap.systems`` holds a subclass and registers its instance.
+
+    Required (abstract): ``name``, ``title``, ``references``, ``variables``, ``label``, ``label_symbol``,
+    ``label_title``, ``scene_type``, ``default_axis``, ``evaluate`` and ``input_bytes``; every other member has
+    a default.
 
     Attributes
     ----------
@@ -102,15 +127,53 @@ class System:
         refinement (``inferred``) has ``store.variables.INFERRED`` among its meanings.
     symbols : dict
         Mathtext symbols of parameter names for figures (``{"omega": r"\\omega"}``; ``m_2`` -> ``$m_{2}$``).
+    scene_type : type
+        The system's scene, a ``SceneBase`` subclass.
+    default_axis : str
+        The grid axis that ``critical``, ``smallest_stable`` and ``boundaries`` scan when not told which (e.g.
+        the spin rate ``"omega"``).
+    paper : str or None
+        The module (``stabmap.paper.<name>``) whose ``run(out=..., quick=..., **options)`` is this system's
+        ``stabmap paper`` check; None: the system has none.
     """
 
-    name: str
-    title: str
-    references: str
-    variables: tuple[Variable, ...]
-    label: str
-    label_symbol: str
-    label_title: str
+    @property
+    @abstractmethod
+    def name(self) -> str: ...
+
+    @property
+    @abstractmethod
+    def title(self) -> str: ...
+
+    @property
+    @abstractmethod
+    def references(self) -> str: ...
+
+    @property
+    @abstractmethod
+    def variables(self) -> tuple[Variable, ...]: ...
+
+    @property
+    @abstractmethod
+    def label(self) -> str: ...
+
+    @property
+    @abstractmethod
+    def label_symbol(self) -> str: ...
+
+    @property
+    @abstractmethod
+    def label_title(self) -> str: ...
+
+    @property
+    @abstractmethod
+    def scene_type(self) -> type[SceneBase]: ...
+
+    @property
+    @abstractmethod
+    def default_axis(self) -> str: ...
+
+    paper: str | None = None
     stable_label: int | None = None
     absent_label: int | None = None
     undecided_label: int | None = None
@@ -119,16 +182,21 @@ class System:
     provenance: str | None = None
     symbols: dict[str, str] = {}
 
-    # ------------------------------------------------------------------ scenes
-    # The module of the system's scene, if it has ``from_dict(table, base_dir)`` and ``fixed_values(scene)``:
-    # the three members below then need no code in the subclass.
-    scene_module = None
+    def __init__(self) -> None:
+        # What abstract members cannot say: the label is one of the variables, an integer with a fill value (it pads
+        # the tables of boundaries, smallest stable values and critical values where a line has no value).
+        label = next((v for v in self.variables if v.name == self.label), None)
+        if label is None:
+            raise TypeError(f"{type(self).__name__}: label {self.label!r} is not one of its variables")
+        if not np.issubdtype(np.dtype(label.dtype), np.integer) or label.fill is None:
+            raise TypeError(f"{type(self).__name__}: its label {self.label!r} must be an integer variable with a fill, a "
+                            "value the label never takes (e.g. fill=-2), that pads tables where a line has no value")
 
+    # ------------------------------------------------------------------ scenes
     def scene_from_dict(self, table: dict, base_dir: Path | None = None) -> SceneBase:
-        """The scene of a TOML table (without its ``system`` key); errors name the key and the fix."""
-        if self.scene_module is None:
-            raise NotImplementedError
-        return self.scene_module.from_dict(table, base_dir)
+        """The scene of a TOML table (without its ``system`` key); errors name the key and the fix.
+        Default: ``scene_type.from_dict``."""
+        return self.scene_type.from_dict(table, base_dir)
 
     def parameter(self, scene: SceneBase, name: str) -> Parameter:
         """Units, long name and limits of the scannable ``name``; a StabmapError for a name this scene cannot scan."""
@@ -136,7 +204,7 @@ class System:
 
     def fixed_values(self, scene: SceneBase) -> dict[str, float]:
         """The scene's scalar parameters that are not grid axes, by their scannable names (scalar coordinates)."""
-        return {} if self.scene_module is None else self.scene_module.fixed_values(scene)
+        return scene.fixed_values()
 
     def derived_coords(self, scene: SceneBase) -> dict[str, tuple]:
         """Auxiliary coordinates computed from the grid, ``{name: (dims, values, attrs)}``, dims among the grid
@@ -182,17 +250,17 @@ class System:
         """Grid axes that should vary fastest within a block (e.g. those that leave the expensive set-up alone)."""
         return ()
 
-    def cost(self, scene: SceneBase) -> Cost:
-        """The cost of one point, for the default task size."""
-        raise NotImplementedError
+    @abstractmethod
+    def input_bytes(self, scene: SceneBase) -> int:
+        """Bytes of one point's inputs to ``evaluate`` (its share of a block's arrays): caps the chunks' size."""
 
+    @abstractmethod
     def evaluate(self, scene: SceneBase, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Decide points: ``values`` maps grid-axis names to arrays that broadcast to the points' shape S.
 
         Returns every variable of ``variables``, each an array of shape S + its own ``dims``.
         Axes not in ``values`` take the scene's fixed values.
         """
-        raise NotImplementedError
 
     def prove_boxes(self, scene: SceneBase, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
         """(label, proved) of each box: ``proved[i]`` says that the label is ``label[i]`` at every point of box i.

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..base import Cost, System
+from ..base import System
 from . import proofs, space_proofs
 from . import scene as _scene
 from .decide import ABSENT, DEGENERATE, STABLE, UNDECIDED, decide
@@ -48,7 +48,9 @@ class Closed(System):
     proves_labels = True  # every class is proved or flagged undecided (proofs.py, docs/closed.md)
     provenance = "decided_by"
     symbols = {"ratio": "h_2/h_1", "n": "n", "j": "j", "twist": "m", "h": "h", "h1": "h_1", "c1sq": "c_1^2", "c2sq": "c_2^2"}
-    scene_module = _scene
+    scene_type = Scene
+    default_axis = "ratio"  # h2/h1: where the families' equilibria change stability (docs/closed.md)
+    paper = "stabmap.paper.closed"
 
     def attrs(self, scene: Scene) -> dict:
         fam = scene.fam
@@ -77,19 +79,8 @@ class Closed(System):
     def dims(self, scene: Scene) -> dict[str, int]:
         return {"body": scene.n_max, "loop": len(scene.fam.loops) or 1}
 
-    def cost(self, scene: Scene) -> Cost:
-        # Measured on one core (scripts/bench_closed.py, BENCHMARKS.md): in the plane a two-length family costs
-        # 0.1-0.2 ms a ratio, almost all of it the proof in ball arithmetic (points of one ratio share it), a ring
-        # 10-25 us a point (exact, no balls); in space the out-of-plane block adds 3-4x for the families and 0.4 ms
-        # for a ring, and a twisted ring's whole spatial Hessian costs about 0.2 ms n^2.
-        n = scene.n_max
-        if not scene.spatial:
-            seconds = 6e-6 + 4e-7 * n if scene.ring else 1.6e-4
-        elif scene.ring:
-            seconds = 2e-4 * n * n if scene.values_of("twist").max() else 4e-4 + 1e-5 * n
-        else:
-            seconds = 5e-4
-        return Cost(seconds=seconds, bytes=8 * (10 + 4 * n))
+    def input_bytes(self, scene: Scene) -> int:
+        return 8 * (10 + 4 * scene.n_max)  # the point's scalars and its lengths, angles and forces along the chain
 
     def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         shape = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()

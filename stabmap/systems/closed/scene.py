@@ -106,6 +106,13 @@ class Scene(SceneBase):
         """The parameter a grid axis called ``name`` scans, or a StabmapError saying why it cannot be scanned."""
         return _parameter(name, self.family, bool(self.lengths))
 
+    @classmethod
+    def from_dict(cls, table: dict, base_dir: str | Path | None = None) -> "Scene":
+        return from_dict(table, base_dir)
+
+    def fixed_values(self) -> dict[str, float]:
+        return fixed_values(self)
+
     def to_dict(self) -> dict:
         out = {"title": self.title, "family": self.family}
         if self.model != "spatial":

@@ -14,8 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..base import Cost, System
-from . import scene as _scene
+from ..base import System
 from .outputs import ALL_VARIABLES, BY_BOX, BY_INFERRED, FREQUENCY_VARIABLES, GROWTH_VARIABLES, N_COMPLEX_PAIRS, VARIABLES, stability_from_pairs
 from .scene import Body, Scene
 
@@ -23,18 +22,6 @@ REFERENCES = (
     "Yu. N. Kononov, On the motion of a system of coupled rigid bodies with cavities containing "
     "liquid (in Russian), Donetsk State University, received 22.11.1999: equations (22)-(34)"
 )
-
-
-def points_per_second(degree: int) -> float:
-    """Rough single-core speed of the certified kernels by polynomial degree (fit to BENCHMARKS.md).
-
-    Degree 16 and up are slower per point: the Sturm sequence loses sign
-    certainty more often and the root-inclusion step runs.
-    """
-    degree = max(2, degree)
-    if degree <= 12:
-        return 3.0e6 / degree**1.3
-    return 4.0e7 / degree**2.8
 
 
 class Gyroscopes(System):
@@ -49,7 +36,9 @@ class Gyroscopes(System):
     provenance = "decided_by"
     symbols = {"omega": r"\omega", "g": "g", "m": "m", "A": "A", "C": "C", "c": "c", "s": "s", "K": "K", "density": r"\rho",
                "M_alpha": r"M_\alpha", "S_g": "S_g", "C_over_A": "C/A", "aspect": "h/a"}
-    scene_module = _scene
+    scene_type = Scene
+    default_axis = "omega"  # "how fast must it spin?"
+    paper = "stabmap.paper.gyroscopes"
 
     def derived_coords(self, scene: Scene) -> dict[str, tuple]:
         from .ratios import coordinates
@@ -112,12 +101,11 @@ class Gyroscopes(System):
         spins = {"omega", "S_g"} if scene.hold.S_g == "M_alpha" else {"omega"}  # S_g moves the spin by default
         return tuple(d for d, a in enumerate(scene.grid) if a.name in spins or a.name.startswith("omega_"))
 
-    def cost(self, scene: Scene) -> Cost:
+    def input_bytes(self, scene: Scene) -> int:
         from .points import point_arrays
 
         one = point_arrays(scene, {})
-        inputs = sum(a.nbytes for a in (one.body, one.joint, one.g, one.E, one.kappa, one.at)) + 8
-        return Cost(seconds=1.0 / points_per_second(scene.degree), bytes=inputs)
+        return sum(a.nbytes for a in (one.body, one.joint, one.g, one.E, one.kappa, one.at)) + 8
 
     def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         from .decide import decide

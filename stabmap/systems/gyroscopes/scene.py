@@ -111,6 +111,13 @@ class Scene(SceneBase):
         """The parameter a grid axis called ``name`` scans, or a StabmapError saying why it cannot be scanned."""
         return _axis_name(name, self.n, self.support, self.topology is not None).parameter
 
+    @classmethod
+    def from_dict(cls, table: dict, base_dir: str | Path | None = None) -> "Scene":
+        return from_dict(table, base_dir)
+
+    def fixed_values(self) -> dict[str, float]:
+        return fixed_values(self)
+
     def notes(self) -> list[tuple[str, str]]:
         """The liquid of each body for ``stabmap info``, as (``"body k"``, text): the modes given (E [kg m^2],
         kappa [1]) and what a cavity chose for itself that the file does not state (the modes it keeps)."""

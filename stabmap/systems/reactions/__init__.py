@@ -14,8 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..base import Cost, System
-from . import scene as _scene
+from ..base import System
 from .outputs import (
     COMPONENT_DIM,
     COMPONENTS,
@@ -31,11 +30,6 @@ REFERENCES = (
     "of a constrained rigid body (in Russian), Uchenye Zapiski TsAGI 18(6), 1987: equations (1)-(17); the "
     "collinear case corrected (docs/reactions.md)"
 )
-# CPU seconds per point (scripts/reactions_figure.py --bench: 8.9, 1.2 and 1.3 us, and 37 us where every point is
-# exact): a layout factored per point when two or more node coordinates are scanned; with one, per value of it;
-# with none, once per block. A rank-deficient layout (n <= 2, collinear nodes, releases that free the body)
-# has every point decided in exact arithmetic.
-SECONDS_LAYOUT, SECONDS_LOAD, SECONDS_EXACT = 1e-5, 2e-6, 5e-5
 
 
 class Reactions(System):
@@ -49,7 +43,9 @@ class Reactions(System):
     stable_label = None
     provenance = DECIDED_BY.name
     symbols = {"F": "F", "M": "M", "c": "c", "g": "g", "a": "a", "omega": r"\omega", "alpha": r"\alpha", "x": "x", "y": "y", "z": "z"}
-    scene_module = _scene
+    scene_type = Scene
+    default_axis = "c_x"  # where the centre of mass lies decides which node carries the most
+    paper = "stabmap.paper.reactions"
 
     def attrs(self, scene: Scene) -> dict:
         attrs = {"n_nodes": scene.n, "load_given_as": scene.kind}
@@ -76,19 +72,8 @@ class Reactions(System):
             COMPONENT_DIM: (np.array(COMPONENTS, dtype=object), {"long_name": "Cartesian component in the nodes' frame"}),
         }
 
-    def cost(self, scene: Scene) -> Cost:
-        from .exact import Layout
-        from .solver import prepare_releases
-
-        layouts = sum(scene.key(a.name)[0] == "node" for a in scene.grid)
-        seconds = SECONDS_LAYOUT if layouts >= 2 else SECONDS_LOAD
-        if scene.n <= 2:
-            seconds = SECONDS_EXACT
-        elif not layouts:
-            rows = prepare_releases(scene.n, [(r.node, r.direction) for r in scene.releases])
-            if Layout(np.array(scene.nodes, dtype=np.float64), rows).rank < 6 + len(rows):
-                seconds = SECONDS_EXACT
-        return Cost(seconds=seconds, bytes=8 * (3 * scene.n + 6))
+    def input_bytes(self, scene: Scene) -> int:
+        return 8 * (3 * scene.n + 6)  # the nodes' positions, F and M
 
     def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         from .load import load, node_positions

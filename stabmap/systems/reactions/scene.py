@@ -117,6 +117,13 @@ class Scene(SceneBase):
         """The parameter a grid axis called ``name`` scans, or a StabmapError saying why it cannot be scanned."""
         return parameters.parse(name, self.n, self.kind)[1]
 
+    @classmethod
+    def from_dict(cls, table: dict, base_dir: str | Path | None = None) -> "Scene":
+        return from_dict(table, base_dir)
+
+    def fixed_values(self) -> dict[str, float]:
+        return fixed_values(self)
+
     def key(self, name: str) -> tuple:
         return parameters.parse(name, self.n, self.kind)[0]
 

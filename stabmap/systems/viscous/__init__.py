@@ -10,9 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import StabmapError
-from ..base import Cost
-from ..gyroscopes import Gyroscopes, points_per_second
-from ..gyroscopes import scene as _scene
+from ..gyroscopes import Gyroscopes
 from .outputs import ALL_VARIABLES, ASYMPTOTIC_STABILITY, BY, GROWTH_VARIABLES, UNDECIDED, VARIABLES
 
 REFERENCES = (
@@ -20,20 +18,6 @@ REFERENCES = (
     "equations (1)-(18); F. L. Chernousko, Motion of a rigid body with cavities containing a viscous fluid, Moscow, "
     "1968 (NASA TT F-13 227, 1972)"
 )
-
-
-class _ViscousScenes:
-    """The gyroscopes' scene module, refusing a scene without a viscous liquid under ``system = "viscous"``."""
-
-    @staticmethod
-    def from_dict(table, base_dir=None):
-        scene = _scene.from_dict(table, base_dir)
-        if not scene.viscous:
-            raise StabmapError('system = "viscous" needs a viscous liquid: give a body\'s cavity a viscosity [m2 s-1] '
-                               '(docs/viscous.md), or remove system = "viscous" for the ideal liquid')
-        return scene
-
-    fixed_values = staticmethod(_scene.fixed_values)
 
 
 class Viscous(Gyroscopes):
@@ -49,7 +33,15 @@ class Viscous(Gyroscopes):
     stable_word = "asymptotically stable"
     provenance = "decided_by"
     symbols = {**Gyroscopes.symbols, "viscosity": r"\nu"}
-    scene_module = _ViscousScenes
+    paper = "stabmap.paper.viscous"
+
+    def scene_from_dict(self, table, base_dir=None):
+        # the gyroscopes' scenes, refusing one without a viscous liquid under system = "viscous"
+        scene = super().scene_from_dict(table, base_dir)
+        if not scene.viscous:
+            raise StabmapError('system = "viscous" needs a viscous liquid: give a body\'s cavity a viscosity [m2 s-1] '
+                               '(docs/viscous.md), or remove system = "viscous" for the ideal liquid')
+        return scene
 
     def outputs(self, scene) -> tuple:
         return VARIABLES + (GROWTH_VARIABLES if scene.growth_rate else ())
@@ -64,12 +56,6 @@ class Viscous(Gyroscopes):
 
     def dim_coords(self, scene) -> dict:
         return {}
-
-    def cost(self, scene) -> Cost:
-        base = super().cost(scene)
-        # the frozen chain's decision, its roots, and one polynomial per viscous cavity (BENCHMARKS.md, viscous)
-        liquid = sum(1 for b in scene.bodies if b.cavity is not None and b.cavity.viscous)
-        return Cost(seconds=(2 + liquid) / points_per_second(scene.degree), bytes=base.bytes)
 
     def evaluate(self, scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         from .decide import evaluate
