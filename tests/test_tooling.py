@@ -130,3 +130,11 @@ def test_a_source_copy_without_git_or_build_gets_the_fallback(tmp_path):
     out = subprocess.run([sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True, cwd=tmp_path)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == fallback
+
+
+def test_the_readme_installs_the_lint_tools_ci_pins():
+    """The README's Development section installs the very lint group .ci/run reads from pyproject.toml."""
+    pinned = tomllib.loads((ROOT / "pyproject.toml").read_text())["dependency-groups"]["lint"]
+    line = next(x for x in (ROOT / "README.md").read_text().splitlines() if x.startswith("pip install 'ruff"))
+    assert re.findall(r"'([^']+)'", line.split("#")[0]) == pinned
+    assert "dependency-groups" in (ROOT / ".ci" / "run").read_text()
