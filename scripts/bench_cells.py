@@ -16,7 +16,7 @@ of the cells way, the share of cells in each class, and the peer's labels that d
 Scenes of the degree ladder: a seeded random fixed chain of n bodies with ``modes`` liquid modes each (the
 parameter ranges of scripts/bench_kernel.py), scanned over omega in [1, 100] x K_1 in [0, 40] (c_1 for n = 1).
 
-Stress set (quick mode: E = 1e-6 only): the two-body chain of ../shared/REGIONS.md with its liquid's E from 1e-3 down to 1e-8
+Stress set (quick mode: E = 1e-6 only): the two-body chain of the narrow-window case, `WINDOW` in tests/systems.py with its liquid's E from 1e-3 down to 1e-8
 (unstable bands down to 1e-6 rad/s wide), scanned along omega at 100 values: every boundary (critical values,
 located to 1e-10 and checked against the exact discriminant by tests/test_boxes.py) must lie in a cell that is
 not whole_cell, and whole cells must hold their label at random interior points in exact arithmetic.
@@ -45,7 +45,7 @@ from stabmap.store.variables import CELL
 from stabmap.systems.gyroscopes.scene import from_dict
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_critical import REGIONS  # noqa: E402  (the two-body chain of ../shared/REGIONS.md)
+from bench_critical import REGIONS  # noqa: E402  (the narrow-window case of tests/systems.py)
 from float_peer import float_atlas  # noqa: E402
 
 LADDER = [(3, 0), (2, 1), (3, 2), (4, 2), (6, 2), (6, 4), (8, 4)]  # degrees 6, 6, 12, 16, 24, 36, 48

@@ -1,6 +1,6 @@
 """Critical values: what box proofs between scan values cost and prove, against node bisection alone, in one run.
 
-    python scripts/bench_critical.py            # the case of ../shared/REGIONS.md and four bundled scenes (about a minute)
+    python scripts/bench_critical.py            # the narrow-window case (tests/systems.py's WINDOW) and four bundled scenes (about a minute)
     python scripts/bench_critical.py --quick    # two small scenes; seconds; run once by the test suite
 
 Each scene runs ``stabmap.critical`` along omega three ways, on all cores, kernels loaded before any timing:
@@ -28,9 +28,9 @@ import stabmap
 from stabmap.scene.grid import resample
 from stabmap.systems.gyroscopes import boxes
 
-# ../shared/REGIONS.md: a stable window 0.108 rad/s wide near omega = 12 between scan values 1 rad/s apart
+# The narrow-window case (WINDOW in tests/systems.py): a stable window 0.108 rad/s wide near omega = 12 between scan values 1 rad/s apart
 REGIONS = """
-title = "two tops with small liquid modes: a narrow stable window (REGIONS.md)"
+title = "two tops with small liquid modes: a narrow stable window"
 support = "fixed"
 g = 9.81
 joints = [10.0]
@@ -70,7 +70,7 @@ def _way(way: str):
 
 
 def scenes(quick: bool) -> list[tuple[str, object]]:
-    out = [("REGIONS.md case", stabmap.loads_scene(REGIONS))]
+    out = [("narrow-window case", stabmap.loads_scene(REGIONS))]
     for name in (QUICK if quick else FULL):
         scene = stabmap.example(name)
         out.append((name, resample(scene, **QUICK[name]) if quick else scene))

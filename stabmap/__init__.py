@@ -19,10 +19,10 @@ import importlib
 
 import wrapt
 
-from .errors import StabmapError
-from .version import __version__
+from .errors import StabmapError as StabmapError
+from .version import __version__ as __version__
 
-_API = {
+_API: dict[str, str | tuple[str, str]] = {
     "Axis": "stabmap.scene.grid",
     "Body": "stabmap.systems.gyroscopes.scene",
     "Hold": "stabmap.systems.gyroscopes.ratios",
@@ -58,7 +58,8 @@ def __getattr__(name: str):
         return importlib.import_module(_MODULES[name])
     if name not in _API:
         raise AttributeError(f"module 'stabmap' has no attribute {name!r}")
-    module, attr = _API[name] if isinstance(_API[name], tuple) else (_API[name], name)
+    where = _API[name]
+    module, attr = where if isinstance(where, tuple) else (where, name)
     value = getattr(importlib.import_module(module), attr)
     globals()[name] = value
     return value

@@ -1,12 +1,12 @@
-"""Independent references for the closed-chain tests, written from CLOSED.md section 1 and nothing of stabmap.
+"""Independent references for the closed-chain tests, written from the model of docs/closed.md (section 1, from seed 000) and nothing of stabmap.
 
-- ``closed_form``: each family's angles and loop forces at 40 digits (mpmath), typed from CLOSED.md;
+- ``closed_form``: each family's angles and loop forces at 40 digits (mpmath), typed from docs/closed.md (section 2);
 - ``residual``: the general equations (22), (24) per body and loop, at any precision;
 - ``project``, ``tangent_basis``, ``probe``: the energy U restricted to the closed configurations, probed by
   second differences along curves that stay closed (Gauss-Newton back onto the closures).  The probe never
   uses the forces or a Hessian formula: its inertia is the index and nullity of U on the constraint manifold.
 - ``newton``: Newton's method on the general equations (mpmath), from any start.
-- ``hessian``, ``hessian_inertia``: CLOSED.md's Hessian formula on the same tangent basis, at any precision (the
+- ``hessian``, ``hessian_inertia``: docs/closed.md's Hessian formula on the same tangent basis, at any precision (the
   probe's second differences cannot resolve eigenvalues much below its step; this can, at enough digits).
 """
 
@@ -40,7 +40,7 @@ def loops_of(family: str, n: int):
 
 
 def closed_form(family: str, lengths, c1sq=1, h=None, j=1):
-    """(theta, forces) of CLOSED.md's closed form; forces: one (R_y, R_z) per loop.  None where it does not exist."""
+    """(theta, forces) of docs/closed.md's closed form; forces: one (R_y, R_z) per loop.  None where it does not exist."""
     L = [mp.mpf(x) for x in lengths]
     c1sq = mp.mpf(c1sq)
     h = min(L) if h is None else mp.mpf(h)
@@ -62,7 +62,7 @@ def closed_form(family: str, lengths, c1sq=1, h=None, j=1):
         p = 1 - 2 * a + mp.sqrt(1 - 4 * a)
         t = mp.asin(mp.sqrt((p**2 - 1) / (p**2 - 4 * a**2)))
         s = mp.asin(2 * a * mp.sin(t))
-        assert abs(mp.cos(s) - p * mp.cos(t)) < mp.mpf(10) ** (-30)  # CLOSED.md: cos s = p cos t, s acute
+        assert abs(mp.cos(s) - p * mp.cos(t)) < mp.mpf(10) ** (-30)  # docs/closed.md: cos s = p cos t, s acute
         return [t, -s, t, pi - t, pi + s, pi - t], [((2 - p - 2 * a) * mp.sin(t) / a1, mp.mpf(0))]
     t_ok = L[2] < 2 * L[0]
     if not t_ok:
@@ -202,7 +202,7 @@ def newton(theta, forces, lengths, loops, c1sq=1, h=None, steps: int = 40):
 
 
 def hessian(theta, lengths, forces, loops, c1sq=1, h=None):
-    """CLOSED.md's Hessian of U - sum R . closure: (c1^2/h) (cyclic Laplacian with weights cos(theta_k -
+    """docs/closed.md's Hessian of U - sum R . closure: (c1^2/h) (cyclic Laplacian with weights cos(theta_k -
     theta_(k-1))) + diag(h_k (R_z cos theta_k - R_y sin theta_k)), each body with its loop's force."""
     n = len(theta)
     L = [mp.mpf(x) for x in lengths]

@@ -74,7 +74,7 @@ def engine_enclosure(system: dict) -> list[tuple[Fraction, Fraction]]:
     return [(Fraction(h) + Fraction(lo), Fraction(r)) for h, lo, r in out[0]]
 
 
-# ../shared/REGIONS.md: a two-body fixed chain with small liquid modes, a stable window 0.108 rad/s wide near
+# The narrow-window case: a two-body fixed chain with small liquid modes, a stable window 0.108 rad/s wide near
 # omega = 12 between scan values 1 rad/s apart.  Exact boundaries (roots of the discriminant in omega):
 # 11.909452, 12.017778, 13.838770.
 WINDOW = {

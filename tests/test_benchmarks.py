@@ -116,7 +116,7 @@ def test_bench_progress_quick(capsys):
 def test_bench_critical_quick(capsys):
     out = runpy.run_path(str(SCRIPTS / "bench_critical.py"))["main"](["--quick"])
     rows = {(r["scene"], r["way"]): r for r in out["rows"]}
-    window = "REGIONS.md case"
+    window = "narrow-window case"
     # node bisection alone misses the window between two scan values; the box proofs at nodes find it
     # (three boundaries) and leave no gap; the plain enclosure proves none of the scan steps there, and stops
     assert rows[(window, "points only")]["boundaries"] == 1 and rows[(window, "points only")]["box_proofs"] == 0

@@ -1,7 +1,7 @@
 """Box proofs: a label proved at every point of a box of parameters (kernels/boxcount.py, docs/certification.md).
 
 Every claim is checked in exact rational arithmetic (python-flint) at points inside the box, and the critical
-values of the case that motivated them (../shared/REGIONS.md) against the exact roots of the discriminant.
+values of the case that motivated them (the narrow window, WINDOW in tests/systems.py) against the exact roots of the discriminant.
 """
 
 from __future__ import annotations

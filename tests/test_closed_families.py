@@ -95,7 +95,7 @@ def test_exact_closed_forms_with_sympy():
     a = sp.symbols("a", positive=True)
     (root,) = sp.solve(sp.Eq(1 - 2 * a + sp.sqrt(1 - 4 * a), 1), a)
     assert sp.simplify(root - (sp.sqrt(2) - 1) / 2) == 0
-    # p is the larger root of (41), p^2 + 2p(2a - 1) + 4a^2 = 0 (CLOSED.md), real up to a = 1/4.
+    # p is the larger root of (41), p^2 + 2p(2a - 1) + 4a^2 = 0 (docs/closed.md), real up to a = 1/4.
     p = 1 - 2 * a + sp.sqrt(1 - 4 * a)
     assert sp.simplify(sp.expand(p**2 + 2 * p * (2 * a - 1) + 4 * a**2)) == 0
     # the ring closes for alternating lengths and even n: sum of h_k w^k = 0 for w = exp(2 pi i j / n), j < n/2
@@ -122,7 +122,7 @@ def test_solve_matches_the_closed_forms_and_satisfies_the_equations_to_1e_12(fam
 def test_every_reported_equilibrium_satisfies_the_general_equations(family, r, h1, c1sq):
     L = [float(x) for x in ref.lengths_of(family, r, h1=h1)]
     eq = planar_solve(family, L, c1sq=c1sq)
-    # CLOSED.md's ranges are open; at the closing end the family folds onto a line and is reported (degenerate).
+    # docs/closed.md's ranges are open; at the closing end the family folds onto a line and is reported (degenerate).
     end = {"figure-eight-4": L[1] == L[0], "hinge": L[2] == 2 * L[0], "hinge-straight": L[2] == 2 * L[0]}.get(family, False)
     assert eq.exists == (ref.closed_form(family, L) is not None or end)
     assert not end or eq.stability == "degenerate"

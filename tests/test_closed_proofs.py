@@ -1,7 +1,7 @@
 """Closed chains: every label proved, or flagged undecided (stabmap/systems/closed/proofs.py, docs/closed.md).
 
-The references are independent (tests/closed_reference.py, written from CLOSED.md): the closed forms at 60 digits
-(mpmath) from the exact binary value of the ratio, CLOSED.md's Hessian on an orthonormal tangent basis (an
+The references are independent (tests/closed_reference.py, written from docs/closed.md): the closed forms at 60 digits
+(mpmath) from the exact binary value of the ratio, docs/closed.md's Hessian on an orthonormal tangent basis (an
 eigenvalue counts as zero below 1e-40), the energy probe (no forces, no Hessian formula) where its step resolves
 the eigenvalues, and Newton on the general equations.  Labels are compared at random ratios, 1e-7, 1e-10 and
 1e-13 (relative) either side of every boundary and at the doubles next to it; with the precision ladder cut to

@@ -1,4 +1,4 @@
-"""``stabmap paper``: the papers' checks as a command of the installed tool (stabmap/paper.py)."""
+"""``stabmap paper``: the papers' checks as a command of the installed tool (stabmap/paper/)."""
 
 from __future__ import annotations
 

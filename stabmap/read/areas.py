@@ -60,8 +60,8 @@ def area_shares(labels, cells, wy: np.ndarray, wx: np.ndarray, stable: int) -> l
 
     from .blocks import as_dask, compute
 
-    sums = []
-    for label, cell in zip(labels, cells):
+    sums: list = []  # dask arrays, one per map and mask
+    for label, cell in zip(labels, cells, strict=True):
         label = as_dask(label)
         cell = as_dask(cell).rechunk(label.chunks)
         wxd = da.from_array(np.asarray(wx, dtype=float), chunks=(label.chunks[1],))[None, :]
@@ -72,6 +72,7 @@ def area_shares(labels, cells, wy: np.ndarray, wx: np.ndarray, stable: int) -> l
     total = float(np.sum(wy)) * float(np.sum(wx))
     out = []
     for p in range(len(labels)):
-        parts = [float(np.dot(wy, rows[4 * p + k])) / total for k in range(4)]
-        out.append(AreaShares(*parts, undecided=max(0.0, 1.0 - sum(parts))))
+        stable_, unstable, other, change = (float(np.dot(wy, rows[4 * p + k])) / total for k in range(4))
+        undecided = max(0.0, 1.0 - (stable_ + unstable + other + change))
+        out.append(AreaShares(stable_, unstable, other, change, undecided))
     return out

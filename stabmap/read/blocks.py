@@ -54,7 +54,7 @@ def changes(values, flags) -> tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarr
     vs, fs = v.to_delayed(), f.to_delayed()
     parts = []
     for block in np.ndindex(*v.numblocks):  # each chunk with the last point of the one before it along the line
-        offset = tuple(int(s[b]) for s, b in zip(starts, block))
+        offset = tuple(int(s[b]) for s, b in zip(starts, block, strict=True))
         before = block[:-1] + (block[-1] - 1,) if block and block[-1] > 0 else None
         parts.append(dask.delayed(_block_changes)(vs[block], fs[block], before and vs[before], before and fs[before], offset))
     found = compute(*parts)
@@ -75,7 +75,7 @@ def _block_changes(v, f, v_before, f_before, offset):
         offset = offset[:-1] + (offset[-1] - 1,)
     where = np.nonzero(v[..., 1:] != v[..., :-1])
     above = where[:-1] + (where[-1] + 1,)
-    return tuple(w + o for w, o in zip(where, offset)), v[where], v[above], f[where], f[above]
+    return tuple(w + o for w, o in zip(where, offset, strict=True)), v[where], v[above], f[where], f[above]
 
 
 @dataclass(frozen=True)
@@ -129,8 +129,8 @@ class Blocks:
 
     ``low``/``high``: the smallest and largest label in each block (equal where every point of the block has one
     label); ``mixed_stability``: the block holds stable and not stable points; ``any_flag``: the bitwise OR of
-    the flags (small non-negative integers, bit codes, or booleans) of the block's points, None without flags. ``counts``: how often each label occurs in the whole
-    map, at full resolution. With factors (1, 1) the blocks are the points themselves.
+    the flags (small non-negative integers, bit codes, or booleans) of the block's points, None without flags.
+    ``counts``: how often each label occurs in the whole map, at full resolution. With factors (1, 1) the blocks are the points themselves.
     """
 
     factors: tuple[int, int]
@@ -152,7 +152,8 @@ class Blocks:
 
 def block_factors(shape: tuple[int, int], pixels: tuple[int, int]) -> tuple[int, int]:
     """Points per block along each axis so that a map of ``shape`` has at most ``pixels`` blocks along each."""
-    return tuple(max(1, math.ceil(n / max(1, p))) for n, p in zip(shape, pixels))
+    (ny, nx), (py, px) = shape, pixels
+    return max(1, math.ceil(ny / max(1, py))), max(1, math.ceil(nx / max(1, px)))
 
 
 def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -> Blocks:
@@ -163,15 +164,15 @@ def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -
     by one task, so every chunk is read once and dropped at once: one pass, a few chunks in memory. With
     factors (1, 1) the blocks are the points.
     """
-    factors = tuple(int(k) for k in factors)
+    factors = (int(factors[0]), int(factors[1]))
     v = as_dask(values)
     f = None if flags is None else as_dask(flags)
     shape = v.shape
-    pad = [(0, -n % k) for n, k in zip(shape, factors)]
+    pad = [(0, -n % k) for n, k in zip(shape, factors, strict=True)]
     if any(p for _, p in pad):
         v = da.pad(v, pad, mode="edge")
         f = None if f is None else da.pad(f, pad, mode="edge")
-    chunks = tuple(_multiple(c, k, n) for c, k, n in zip(v.chunksize, factors, v.shape))
+    chunks = tuple(_multiple(c, k, n) for c, k, n in zip(v.chunksize, factors, v.shape, strict=True))
     v = v.rechunk(chunks)
     f = None if f is None else f.rechunk(chunks)
     starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in v.chunks]
@@ -179,11 +180,11 @@ def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -
     vs, fs = v.to_delayed(), None if f is None else f.to_delayed()
     tasks = []
     for block in np.ndindex(*grid):
-        valid = tuple(int(min(c[b], n - s[b])) for c, s, b, n in zip(v.chunks, starts, block, shape))
+        valid = tuple(int(min(c[b], n - s[b])) for c, s, b, n in zip(v.chunks, starts, block, shape, strict=True))
         tasks.append(dask.delayed(_reduce_block)(vs[block], None if fs is None else fs[block], valid, stable=stable, factors=factors))
     done = compute(*tasks)
     parts = np.empty(grid, dtype=object)
-    for block, (reduced, _) in zip(np.ndindex(*grid), done):
+    for block, (reduced, _) in zip(np.ndindex(*grid), done, strict=True):
         parts[block] = reduced
     low, high, mixed_stable, flagged = (np.block([[p[k] for p in row] for row in parts]) for k in range(4))
     return Blocks(factors, low.astype(v.dtype), high.astype(v.dtype), mixed_stable.astype(bool), None if flags is None else flagged,
@@ -227,6 +228,6 @@ def _block_counts(values) -> list:
 def _merge(parts) -> dict[int, int]:
     out: dict[int, int] = {}
     for labels, n in parts:
-        for u, c in zip(labels, n):
+        for u, c in zip(labels, n, strict=True):
             out[int(u)] = out.get(int(u), 0) + int(c)
     return dict(sorted(out.items()))

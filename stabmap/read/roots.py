@@ -84,7 +84,8 @@ def roots(source, /, **point: float) -> Roots:
         raise StabmapError(f"{unknown[0]!r} is not a grid axis of this scene; its axes are: {', '.join(axes) or '(none)'}")
     missing = [a for a in axes if a not in point]
     if missing:
-        raise StabmapError(f"give a value for every axis; missing: {', '.join(missing)} (e.g. {missing[0]}={scene.grid[axes.index(missing[0])].values[0]:g})")
+        example = f"{missing[0]}={scene.grid[axes.index(missing[0])].values[0]:g}"
+        raise StabmapError(f"give a value for every axis; missing: {', '.join(missing)} (e.g. {example})")
     values = {}
     for k, v in point.items():
         try:

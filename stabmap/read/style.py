@@ -19,16 +19,18 @@ from ..errors import StabmapError
 
 def _flag_classes(da: xr.DataArray) -> list[tuple[int, str, str]]:
     """(value, colour, name) of each flag of a CF flag variable."""
-    from .plot import colour, ABSENT_COLOUR, DEGENERATE_COLOUR, STABLE_COLOUR, UNDECIDED_COLOUR, UNSTABLE_COLOUR
+    from .plot import ABSENT_COLOUR, DEGENERATE_COLOUR, STABLE_COLOUR, UNDECIDED_COLOUR, UNSTABLE_COLOUR, colour
 
     values = [int(v) for v in np.atleast_1d(da.attrs["flag_values"])]
     meanings = str(da.attrs["flag_meanings"]).split()
     if len(values) != len(meanings):
-        raise StabmapError(f"{da.name}: {len(values)} flag_values but {len(meanings)} flag_meanings; the variable's attributes are damaged")
-    by_meaning = {"stable": STABLE_COLOUR, "unstable": UNSTABLE_COLOUR[0], "degenerate": DEGENERATE_COLOUR, "absent": ABSENT_COLOUR, "undecided": UNDECIDED_COLOUR}
+        raise StabmapError(f"{da.name}: {len(values)} flag_values but {len(meanings)} flag_meanings; "
+                           "the variable's attributes are damaged")
+    by_meaning = {"stable": STABLE_COLOUR, "unstable": UNSTABLE_COLOUR[0], "degenerate": DEGENERATE_COLOUR, "absent": ABSENT_COLOUR,
+                  "undecided": UNDECIDED_COLOUR}
     if any(m in by_meaning for m in meanings):  # classes of stability: the colours of the maps
-        return [(v, by_meaning.get(m, colour(i + 1, stable=None)), m) for i, (v, m) in enumerate(zip(values, meanings))]
-    return [(v, colour(i, stable=None), m.replace("_", " ")) for i, (v, m) in enumerate(zip(values, meanings))]
+        return [(v, by_meaning.get(m, colour(i + 1, stable=None)), m) for i, (v, m) in enumerate(zip(values, meanings, strict=True))]
+    return [(v, colour(i, stable=None), m.replace("_", " ")) for i, (v, m) in enumerate(zip(values, meanings, strict=True))]
 
 
 def _label_system(da: xr.DataArray, system):

@@ -21,9 +21,9 @@ from ..errors import StabmapError
 from ..scene.grid import Axis, parse_axes
 from ..scene.text import parse
 from ..scene.values import Parameter
-from ..systems import loads_scene
 from ..store import files
 from ..store.dataset import is_critical
+from ..systems import loads_scene
 
 
 def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
@@ -65,7 +65,7 @@ def scene_attrs(ds: xr.Dataset) -> dict:
         cut.append(axis.name)
     if not cut:
         return {}
-    now = dt.datetime.now(dt.timezone.utc).replace(microsecond=0).isoformat()
+    now = dt.datetime.now(dt.UTC).replace(microsecond=0).isoformat()
     history = str(ds.attrs.get("history", "")).rstrip("\n")
     line = f"{now} part of an atlas: scene grid rewritten to the part along {', '.join(cut)}"
     return {"scene": scene.with_grid(tuple(grid)).to_toml(), "history": f"{history}\n{line}" if history else line}

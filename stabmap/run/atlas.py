@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -97,7 +98,7 @@ def decide_points(run: runner.Runner, scene: SceneBase, values: dict[str, np.nda
     second.  ``on_progress(points_done)`` is called as tasks finish (refinement's progress line).
     """
     npts = len(next(iter(values.values())))
-    out = {}
+    out: dict = {}
     done = [0]
 
     def keep(bounds, result):
@@ -265,8 +266,8 @@ def compute_to_file(
         if checkpoint is None:
             raise runner.SchedulerLost(f"{exc}; nothing was saved yet: run the same command again on a working cluster") from None
         raise runner.SchedulerLost(
-            f"{exc}; {len(checkpoint.done()):,} of {len(chunk_locations(checkpoint.shape, checkpoint.chunks)):,} chunks are saved in {str(where)!r}: start a "
-            "scheduler and workers and run the same command with --resume (and the new --scheduler ADDRESS)"
+            f"{exc}; {len(checkpoint.done()):,} of {len(chunk_locations(checkpoint.shape, checkpoint.chunks)):,} chunks are saved "
+            f"in {str(where)!r}: start a scheduler and workers and run the same command with --resume (and the new --scheduler ADDRESS)"
         ) from None
     arrays, store = checkpoint.arrays()
     with store:
@@ -333,7 +334,9 @@ class _Layout:
     def _probe(self, tile: tuple[int, ...] | None) -> float:
         """Seconds per point, timed on the probe's points (on the runner: a worker, or a thread here); on whole tiles
         where ``tile`` is given (an atlas decided cell by cell)."""
-        measured = []
+        measured: list = []  # (points, seconds) of the one probe task
+        task: Callable
+        job: dict | list
         if tile is None:
             task, job = probe, probe_points(self.scene, point_order(self.scene))
         else:
@@ -353,7 +356,7 @@ class _Layout:
         order = [todo[k] for k in np.random.default_rng(0).permutation(len(todo))]
 
         def handle(chunks, blocks):
-            for i, block in zip(chunks, blocks):
+            for i, block in zip(chunks, blocks, strict=True):
                 on_result(i, block)
             rate.add(sum(sizes[i] for i in chunks))
             self._show(rate)

@@ -91,7 +91,7 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
         tile = chunk.tile_of(lo)
         got, proved, tried, along = chunk.prove(lo, hi, tile)
         for b in np.flatnonzero(proved):
-            where = tuple(slice(a, z) for a, z in zip(lo[b], hi[b]))
+            where = tuple(slice(a, z) for a, z in zip(lo[b], hi[b], strict=True))
             label[where], cell[where], known[where] = got[b], WHOLE_CELL, True
         one = np.all(hi - lo == 1, axis=1)
         failed_cell[tuple(lo[one & tried & ~proved].T)] = True
@@ -167,16 +167,16 @@ class _Chunk:
     def __init__(self, scene: SceneBase, location):
         self.scene, self.system = scene, systems.of(scene)
         self.names = [a.name for a in scene.grid]
-        self.nodes = [a.array[s:e] for a, (s, e) in zip(scene.grid, location)]
-        self.edges = [edges(a.array)[s : e + 1] for a, (s, e) in zip(scene.grid, location)]
+        self.nodes = [a.array[s:e] for a, (s, e) in zip(scene.grid, location, strict=True)]
+        self.edges = [edges(a.array)[s : e + 1] for a, (s, e) in zip(scene.grid, location, strict=True)]
         self.provable = provable(scene)
         self.cost = self.system.box_cost(scene) if self.provable else 1.0
         # tiles: index along each axis of the chunk's cells; tiles numbered in C order of the chunk's tile grid
         size = tile_shape(scene)
-        self.axis_tile = [(np.arange(s, e) // t) - s // t for (s, e), t in zip(location, size)]
+        self.axis_tile = [(np.arange(s, e) // t) - s // t for (s, e), t in zip(location, size, strict=True)]
         self.tile_grid = tuple(int(a[-1]) + 1 for a in self.axis_tile)
         starts = [np.flatnonzero(np.diff(a, prepend=-1)) for a in self.axis_tile]
-        stops = [np.append(st[1:], len(a)) for st, a in zip(starts, self.axis_tile)]
+        stops = [np.append(st[1:], len(a)) for st, a in zip(starts, self.axis_tile, strict=True)]
         self._tiles = (np.array(list(itertools.product(*starts)), dtype=np.int64).reshape(-1, len(location)),
                        np.array(list(itertools.product(*stops)), dtype=np.int64).reshape(-1, len(location)))
         cells = np.prod(self._tiles[1] - self._tiles[0], axis=1)
@@ -203,14 +203,14 @@ class _Chunk:
 
     def values(self, index: np.ndarray) -> dict[str, np.ndarray]:
         """Grid-axis values of the nodes ``index`` (rows of chunk indices)."""
-        return {name: v[index[:, d]] for d, (name, v) in enumerate(zip(self.names, self.nodes))}
+        return {name: v[index[:, d]] for d, (name, v) in enumerate(zip(self.names, self.nodes, strict=True))}
 
     def prove(self, lo: np.ndarray, hi: np.ndarray, tile: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(label, proved, tried, along) of the boxes of cells [lo, hi) (chunk indices per axis) in the tiles ``tile``
         (``tile_of(lo)``), each tried while its tile's budget lasts (in the given order within a tile); along (boxes,
         axes): the axes a box not proved is worth cutting along (``System.prove_and_cut_boxes``)."""
-        return self._prove({n: e[lo[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))},
-                           {n: e[hi[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges))}, tile)
+        return self._prove({n: e[lo[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges, strict=True))},
+                           {n: e[hi[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges, strict=True))}, tile)
 
     def _prove(self, lower: dict, upper: dict, tile: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         npts = tile.size
@@ -252,7 +252,7 @@ class _Chunk:
             sides = [np.array(s) for s in itertools.product((0, 1), repeat=d)]
             corners = np.concatenate([nodes[near] + s for s in sides])
             unique, back = np.unique(corners, axis=0, return_inverse=True)
-            at = {n: e[unique[:, k]] for k, (n, e) in enumerate(zip(self.names, self.edges))}
+            at = {n: e[unique[:, k]] for k, (n, e) in enumerate(zip(self.names, self.edges, strict=True))}
             corner_label = self.system.evaluate(self.system.labels_only(self.scene), at)[self.system.label].reshape(-1)[back.reshape(-1)]
             changed = np.any(corner_label.reshape(len(sides), -1) != node_label[near][None, :], axis=0)
             cell[near[changed]] = CONTAINS_CHANGE
@@ -280,7 +280,9 @@ class _Chunk:
 
     def _sub_boxes(self, nodes: np.ndarray, owner: np.ndarray):
         """The 2^d boxes between each node and its cell's corners (one per corner), with the cell that owns them."""
-        lower, upper, owners = {n: [] for n in self.names}, {n: [] for n in self.names}, []
+        lower: dict[str, list[np.ndarray]] = {n: [] for n in self.names}
+        upper: dict[str, list[np.ndarray]] = {n: [] for n in self.names}
+        owners = []
         d = nodes.shape[1] if nodes.size else len(self.names)
         for side in itertools.product((0, 1), repeat=d):
             for k, name in enumerate(self.names):
@@ -294,7 +296,9 @@ class _Chunk:
 
     def _halve(self, lower: dict, upper: dict, owner: np.ndarray):
         """Boxes given by their corners, cut in two along every axis they span."""
-        out_lo, out_hi, owners = {n: [] for n in self.names}, {n: [] for n in self.names}, []
+        out_lo: dict[str, list[np.ndarray]] = {n: [] for n in self.names}
+        out_hi: dict[str, list[np.ndarray]] = {n: [] for n in self.names}
+        owners = []
         for side in itertools.product((0, 1), repeat=len(self.names)):
             keep = np.ones(owner.size, dtype=bool)
             for k, name in enumerate(self.names):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Callable
 
 
 def wanted(progress: bool | None) -> bool:
@@ -26,7 +27,7 @@ class ProgressLine:
         self.last = 0.0
         self.shown = False
         self.note: str | None = None  # "compiling kernels (once, ~20 s)" once that is what happens
-        self.redraw = None
+        self.redraw: Callable[[], None] | None = None
         self._force = False
         self._notice = None
         if enabled:

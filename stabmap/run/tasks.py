@@ -67,7 +67,7 @@ def block_values(scene: SceneBase, location, order: tuple[int, ...] | None = Non
     values = {}
     for pos, d in enumerate(order):
         start, stop = location[d]
-        view = [None] * len(location)
+        view: list[slice | None] = [None] * len(location)
         view[pos] = slice(None)
         values[scene.grid[d].name] = scene.grid[d].array[start:stop][tuple(view)]
     return values
@@ -104,7 +104,7 @@ def probe(scene: SceneBase, values: dict[str, np.ndarray]) -> tuple[int, float]:
     """
     npts = len(next(iter(values.values()))) if values else 1
     stop = npts
-    for timed in (False, True):
+    for _pass in ("untimed", "timed"):  # the second pass's numbers are returned
         done, spent, n = 0, 0.0, 1
         while done < stop and spent < PROBE_SECONDS:
             end = min(stop, done + n)

@@ -41,7 +41,7 @@ class Checkpoint:
         self.path, self.scene_toml, self.prove_cells = Path(path), scene_toml, prove_cells
         self.shape, self.chunks = tuple(shape), tuple(chunks)
         self.dims = dims  # the dimensions of every variable, the grid's first
-        self._arrays = None  # the store's arrays, opened at the first save (Zarr region writes)
+        self._arrays: dict | None = None  # the store's arrays, opened at the first save (Zarr region writes)
 
     @classmethod
     def create(cls, path: Path, system, scene, chunks: tuple[int, ...], prove_cells: bool = True) -> Checkpoint:
@@ -49,7 +49,7 @@ class Checkpoint:
         how its chunks are decided (``stabmap.run.atlas.compute``), kept for a resumed run."""
         import dask.array as da
 
-        nchunks = int(np.prod([-(-n // c) for n, c in zip(scene.shape, chunks)], dtype=np.int64))
+        nchunks = int(np.prod([-(-n // c) for n, c in zip(scene.shape, chunks, strict=True)], dtype=np.int64))
         extra = system.dims(scene)
         lazy = {}
         for v in system.atlas_outputs(scene):
@@ -97,15 +97,16 @@ class Checkpoint:
 
     def save(self, index: int, location: tuple[tuple[int, int], ...], block: dict[str, np.ndarray]) -> None:
         """Write chunk ``index``, the grid region ``location`` ((start, stop) per axis), then mark it finished."""
-        if self._arrays is None:
+        arrays = self._arrays
+        if arrays is None:
             import zarr
 
             group = zarr.open_group(str(self.path), mode="r+")
-            self._arrays = {name: group[name] for name in [*self.dims, DONE]}
+            arrays = self._arrays = {name: group[name] for name in [*self.dims, DONE]}
         region = tuple(slice(a, b) for a, b in location)
         for name, values in block.items():
-            self._arrays[name][region] = values
-        self._arrays[DONE][index] = 1
+            arrays[name][region] = values
+        arrays[DONE][index] = 1
 
     def arrays(self):
         """Every variable as a dask array read chunk by chunk, and the open Dataset to close after use."""

@@ -62,7 +62,7 @@ def coordinates(system, scene, skip: tuple[str, ...] = ()) -> dict:
 
 def global_attrs(system, scene, kind: str) -> dict:
     """CF global attributes of every file stabmap writes, with the scene that made it."""
-    now = dt.datetime.now(dt.timezone.utc).replace(microsecond=0).isoformat()
+    now = dt.datetime.now(dt.UTC).replace(microsecond=0).isoformat()
     return {
         "Conventions": "CF-1.10",
         "title": scene.title or kind,

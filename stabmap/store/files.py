@@ -239,7 +239,7 @@ def read_chunks(ds: xr.Dataset, points: int | None = None) -> dict[str, int]:
         rest = math.prod(chunks) // chunks[i]
         k = max(1, points // max(1, rest * chunks[i]))
         chunks[i] = min(shape[i], chunks[i] * k)
-    out = dict(zip(big.dims, chunks))
+    out = dict(zip(big.dims, chunks, strict=True))
     for v in variables:  # dimensions of other variables (e.g. per node) are read whole
         out.update({d: out.get(d, n) for d, n in v.sizes.items()})
     return out

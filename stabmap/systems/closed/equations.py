@@ -61,8 +61,8 @@ def twist_residual(theta, phi, lengths, force_x, c1sq, c2sq, h) -> np.ndarray:
     gradient of U - R . closure (``space.spatial``, units of c1^2/h) divided by 2 + h_k |R| h / c1^2."""
     out = np.empty(len(theta))
     for p, (th, ph, hk, fx, c1, c2, hh) in enumerate(zip(theta, phi, lengths, force_x, np.broadcast_to(c1sq, len(theta)),
-                                                          np.broadcast_to(c2sq, len(theta)), np.broadcast_to(h, len(theta)))):
-        quats = [space.body_frame(np.cos(a / 2), np.sin(a / 2), np.cos(b / 2), np.sin(b / 2)) for a, b in zip(th, ph)]
+                                                          np.broadcast_to(c2sq, len(theta)), np.broadcast_to(h, len(theta)), strict=True)):
+        quats = [space.body_frame(np.cos(a / 2), np.sin(a / 2), np.cos(b / 2), np.sin(b / 2)) for a, b in zip(th, ph, strict=True)]
         rho = (fx * hh / c1, 0.0, 0.0)
         _, g, _, _ = space.spatial(quats, list(hk), rho, c2 / c1, hessian=False)
         out[p] = np.max(np.abs(g).reshape(-1, 3).max(-1) / (2.0 + hk * abs(rho[0])))

@@ -34,7 +34,11 @@ class Family:
     ratio_range: str  # where it exists, as text
 
     def n_bodies(self, n: int | None = None) -> int:
-        return self.n if self.n is not None else int(n)
+        if self.n is not None:
+            return self.n
+        if n is None:
+            raise TypeError(f"the family {self.name!r} takes any number of bodies: give n")
+        return int(n)
 
     def loop_of(self, n: int | None = None) -> np.ndarray:
         """The loop (0-based) of each body."""

@@ -350,7 +350,7 @@ def prove_ring(lengths: list[fmpq], j: int) -> Verdict:
 def pattern_ratio(lengths: list[fmpq], pattern) -> fmpq | None:
     """h2/h1 when the lengths follow the pattern exactly (every h1 body equal, every h2 body equal); else None."""
     first = {kind: lengths[pattern.index(kind)] for kind in (1, 2)}
-    if any(x != first[kind] for x, kind in zip(lengths, pattern)):
+    if any(x != first[kind] for x, kind in zip(lengths, pattern, strict=True)):
         return None
     return first[2] / first[1]
 
@@ -358,8 +358,8 @@ def pattern_ratio(lengths: list[fmpq], pattern) -> fmpq | None:
 def ratio_hull_absent(family: str, lengths: list[fmpq], pattern) -> bool:
     """Lengths off the pattern by rounding: whether every ratio between the smallest and the largest h2/h1 they
     allow lies where the family is absent (its existence is monotone in the ratio)."""
-    h1 = [x for x, k in zip(lengths, pattern) if k == 1]
-    h2 = [x for x, k in zip(lengths, pattern) if k == 2]
+    h1 = [x for x, k in zip(lengths, pattern, strict=True) if k == 1]
+    h2 = [x for x, k in zip(lengths, pattern, strict=True) if k == 2]
     return all(pattern_existence(family, r) == "absent" for r in (min(h2) / max(h1), max(h2) / min(h1)))
 
 

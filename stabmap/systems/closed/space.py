@@ -105,7 +105,7 @@ def matrix(q):
 
 
 def _add(a, b, f=1):
-    return tuple(x + f * y for x, y in zip(a, b))
+    return tuple(x + f * y for x, y in zip(a, b, strict=True))
 
 
 def spatial(quats, lengths, force, gamma, hessian: bool = True):

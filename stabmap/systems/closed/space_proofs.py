@@ -23,9 +23,23 @@ import numpy as np
 from flint import arb, fmpq
 
 from . import proofs, space
-from .proofs import (ABSENT_VERDICT, BY_BALLS, PRECISIONS, UNDECIDED, UNDECIDED_VERDICT, Verdict, Verdicts,
-                     bordered_inertia, exact, exact_inertia, in_space, out_of_plane_inertia, planar_only, precision,
-                     scaled_rows)
+from .proofs import (
+    ABSENT_VERDICT,
+    BY_BALLS,
+    PRECISIONS,
+    UNDECIDED,
+    UNDECIDED_VERDICT,
+    Verdict,
+    Verdicts,
+    bordered_inertia,
+    exact,
+    exact_inertia,
+    in_space,
+    out_of_plane_inertia,
+    planar_only,
+    precision,
+    scaled_rows,
+)
 
 
 def gamma_of(c1sq: float, c2sq: float) -> fmpq:
@@ -120,7 +134,7 @@ def prove_ratios(fam, n: int, j: int, m: int, ratio, gamma) -> Verdicts:
     planar: dict[float, Verdict] = {}
     done: dict[tuple, Verdict] = {}
     out = []
-    for r, g in zip(ratio.tolist(), gammas):
+    for r, g in zip(ratio.tolist(), gammas, strict=True):
         key = (r, g)
         if key not in done:
             q = exact(r)

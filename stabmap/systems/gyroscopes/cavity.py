@@ -187,7 +187,7 @@ def _candidates(q_max: float, n_modes: int, threshold: float) -> list[tuple[int,
 
 def _modes_at(q: np.ndarray, which: list[tuple[int, int, int]]):
     """Scaled E and kappa, (len(q), len(which)), of the listed (n, j, branch) modes."""
-    n, j, branch = (np.array(col) for col in zip(*which))
+    n, j, branch = (np.array(col) for col in zip(*which, strict=True))
     e = np.empty((len(q), len(which)))
     kappa = np.empty_like(e)
     for sign in (+1, -1):
@@ -204,7 +204,7 @@ def cylinder_modes(radius: float, half_height: float, density: float, n_max: int
     """
     _check_size(radius, half_height, density)
     n, j = np.meshgrid(np.arange(1, n_max + 1), np.arange(1, j_max + 1), indexing="ij")
-    out = {"E": [], "kappa": [], "xi": []}
+    out: dict[str, list[np.ndarray]] = {"E": [], "kappa": [], "xi": []}
     for sign in (+1, -1):
         e, kappa, xi = _cylinder(np.float64(half_height / radius), n, j, sign)
         out["E"].append(density * radius**5 * e)

@@ -151,7 +151,8 @@ def _free_inertia_and_mu(ch: Chain):
             ch.A[1] + (m[1] * (m[0] + m[2]) * c2**2 - 2 * m[1] * m[2] * c2 * s2 + m[2] * (m[0] + m[1]) * s2**2) / mt,
             ch.A[2] + m[2] * (m[0] + m[1]) / mt * c3**2,
         ]
-        mu = {(0, 1): m[0] * c1 / mt * (m[1] * c2 + m[2] * s2), (0, 2): m[0] * m[2] / mt * c1 * c3, (1, 2): m[2] * c3 / mt * (m[0] * s2 + (s2 - c2) * m[1])}
+        mu = {(0, 1): m[0] * c1 / mt * (m[1] * c2 + m[2] * s2), (0, 2): m[0] * m[2] / mt * c1 * c3,
+              (1, 2): m[2] * c3 / mt * (m[0] * s2 + (s2 - c2) * m[1])}
         return A_prime, mu
     if _identical(ch):
         c, mass = ch.c[0], ch.m[0]
@@ -225,7 +226,8 @@ def factors(ch: Chain, case: str) -> list[list]:
         return [F_polynomial(ch.A[0], ch.C[0], ch.omega[0], ZERO, ch.E[0], ch.kappa[0])]
     if case == "identical-free":
         # (34): F~ = 1/2, -1/2 with F~ = (A + mc^2/2 + ...)/(mc^2); (33): F~ = 2/3, 1/3, -7/3 with A + 2mc^2/3.
-        shift, roots = {2: (flint.fmpq(1, 2), (flint.fmpq(1, 2), flint.fmpq(-1, 2))), 3: (flint.fmpq(2, 3), (flint.fmpq(2, 3), flint.fmpq(1, 3), flint.fmpq(-7, 3)))}[ch.n]
+        shift, roots = {2: (flint.fmpq(1, 2), (flint.fmpq(1, 2), flint.fmpq(-1, 2))),
+                        3: (flint.fmpq(2, 3), (flint.fmpq(2, 3), flint.fmpq(1, 3), flint.fmpq(-7, 3)))}[ch.n]
         mc2 = ch.m[0] * ch.c[0] ** 2
         return [F_polynomial(ch.A[0] + (shift - r) * mc2, ch.C[0], ch.omega[0], ZERO, ch.E[0], ch.kappa[0]) for r in roots]
     if case == "split":
@@ -288,7 +290,7 @@ def closed_form_boundaries(fs: list[list], lo: float, hi: float) -> list[tuple[f
                         if lo < x < hi:
                             candidates.add(x)
     edges = [lo] + sorted(candidates) + [hi]
-    mids = [(a + b) / 2 for a, b in zip(edges[:-1], edges[1:])]
+    mids = [(a + b) / 2 for a, b in zip(edges[:-1], edges[1:], strict=True)]
     counts = [closed_form_pairs([at(f, x) for f in fs]) for x in mids]
     return [(x, counts[i], counts[i + 1]) for i, x in enumerate(edges[1:-1]) if counts[i] != counts[i + 1]]
 

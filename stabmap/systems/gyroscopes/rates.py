@@ -93,6 +93,7 @@ def exact_roots(points: PointArrays, p: int, D: int) -> tuple[np.ndarray, np.nda
     z, r = np.full(D, complex(np.nan, np.nan)), np.full(D, np.nan)
     k = np.full(D, -1, dtype=np.int8)
     rate = np.zeros(3)
+    assert points.at is not None  # PointArrays fills it in __post_init__
     poly = exact.char_poly(points.body[p], points.joint[p], points.g[p], points.E[p], points.kappa[p], points.nmodes,
                            points.free, points.parent, points.at[p])
     if poly == 0:

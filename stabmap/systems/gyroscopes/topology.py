@@ -120,7 +120,7 @@ def check_parent(parent, where: str = "topology.parent") -> tuple[int, ...]:
 
 def children(parent) -> list[list[int]]:
     """children[i] lists the bodies whose parent is i (i = 0..n, 0 the base), in increasing order."""
-    out = [[] for _ in range(len(parent) + 1)]
+    out: list[list[int]] = [[] for _ in range(len(parent) + 1)]
     for k, p in enumerate(parent, start=1):
         out[p].append(k)
     return out
@@ -159,7 +159,7 @@ def check_arcs(i_plus, i_minus) -> None:
     n = len(i_plus)
     if len(i_minus) != n:
         raise StabmapError(f"i+ has {n} arcs but i- has {len(i_minus)}")
-    for a, (u, v) in enumerate(zip(i_plus, i_minus), start=1):
+    for a, (u, v) in enumerate(zip(i_plus, i_minus, strict=True), start=1):
         if not (0 <= u <= n and 0 <= v <= n) or u == v:
             raise StabmapError(f"arc {a} = ({u}, {v}) must join two different vertices of 0..{n}")
     reached = _reach(i_plus, i_minus)
@@ -177,7 +177,7 @@ def _reach(i_plus, i_minus) -> dict[int, tuple[int, int]]:
     todo = [0]
     while todo:
         v = todo.pop()
-        for a, (x, y) in enumerate(zip(i_plus, i_minus), start=1):
+        for a, (x, y) in enumerate(zip(i_plus, i_minus, strict=True), start=1):
             for here, there in ((x, y), (y, x)):
                 if here == v and there not in reached:
                     reached[there] = (a, v)

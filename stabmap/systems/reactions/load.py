@@ -65,6 +65,7 @@ def load(scene: Scene, values: dict[str, np.ndarray]) -> tuple[np.ndarray, np.nd
     if scene.load is not None:
         return factor * vector(scene, "F", values), factor * vector(scene, "M", values)
     b = scene.body
+    assert b is not None  # the scene's own check: a load or a body
     m = np.asarray(values.get("mass", b.mass), dtype=np.float64)[..., None]
     c, g, a, omega, alpha = (vector(scene, p, values) for p in ("c", "g", "a", "omega", "alpha"))
     I = np.array(b.inertia, dtype=np.float64)

@@ -153,7 +153,7 @@ def check_releases(releases, n: int, where: str = "releases") -> tuple[tuple[int
         node, direction = pair
         if isinstance(node, bool) or not isinstance(node, Integral):
             raise StabmapError(f"{here}: the node index must be a whole number 0..{n - 1}, got {node!r}")
-        if not 0 <= node < n:
+        if not 0 <= int(node) < n:
             raise StabmapError(f"{here}: node {node} does not exist; the nodes are numbered 0..{n - 1}")
         e = check_vector(direction, f"{here} direction")
         if e.shape != (3,):

@@ -1,0 +1,1 @@
+"""Reading saved atlases: info, query, tables and plots (docs/query.md, docs/plots.md)."""

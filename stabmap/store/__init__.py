@@ -1,0 +1,1 @@
+"""Storing atlases: the output variables' type, the Dataset, files and the checkpoint of --resume."""
