@@ -32,10 +32,10 @@ from stabmap.errors import StabmapError, given, param
 from stabmap.examples import example
 from stabmap.run import atlas
 from stabmap.run.critical import critical
-from stabmap.systems.gyroscopes import paper
-from stabmap.store.files import write_atlas
-from stabmap.systems.gyroscopes.points import point_arrays
 from stabmap.scene.grid import Axis, resample
+from stabmap.store.files import write_atlas
+from stabmap.systems.gyroscopes import paper
+from stabmap.systems.gyroscopes.points import point_arrays
 
 RTOL = 1e-8  # engine ends are located to 1e-10 and discriminant roots to ~1e-15; this leaves room for both
 

@@ -94,9 +94,8 @@ class StabmapAccessor:
         ``n_complex_pairs``) in stabmap's colours: ``ds.stability.plot(**ds.stabmap.style("stability"))``
         (:func:`stabmap.read.style.style`)."""
         from .. import systems
-        from .style import style
-
         from ..errors import StabmapError
+        from .style import style
 
         system = systems.of_atlas(self._ds.attrs)
         name = name or system.label

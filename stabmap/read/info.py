@@ -14,7 +14,6 @@ from ..scene.units import unit_suffix
 from ..store.dataset import is_critical
 from .summary import summary
 
-
 WIDTH = 100  # characters a line of ``stabmap info`` may take
 
 

@@ -37,7 +37,7 @@ def _critical(ds: xr.Dataset, along: str, sel: dict, progress: bool | None, thre
     line = dataclasses.replace(scene, grid=tuple(grid))
     crit = critical(line, along, rtol=RTOL, progress=progress, threads=threads)
     fixed = [d for d in grid_axes(ds) if d != along and axes[d].fixed]
-    return crit.isel({d: 0 for d in fixed}), sub, axes
+    return crit.isel(dict.fromkeys(fixed, 0)), sub, axes
 
 
 def _attrs(ds, crit, along: str, axes, kind: str, label, system) -> dict:
@@ -139,7 +139,7 @@ def located_smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: s
             "smallest_stable": var(np.where(has, lower, np.nan), f"smallest stable {along}", units=units),
             "unstable_below": var(np.where(has, outer, np.nan), f"{along} just below it, not stable", units=units),
             f"{label.name}_below": var(np.where(has, nb, label.fill).astype(label.dtype), f"{label.name} just below smallest_stable", units="1"),
-            "stable_to_scan_end": var(has & (n_int == 1) & np.isnan(upper_outer), f"stable from smallest_stable to the end of the range"),
+            "stable_to_scan_end": var(has & (n_int == 1) & np.isnan(upper_outer), "stable from smallest_stable to the end of the range"),
             "undecided_below": var(undecided_below, "a stretch below smallest_stable is not decided (critical values' gaps)"),
             "inferred": var(np.zeros(lower.shape, dtype=bool), "not computed (never, here)"),
             "inferred_below": var(np.zeros(lower.shape, dtype=bool), "not computed (never, here)"),

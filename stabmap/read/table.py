@@ -263,7 +263,7 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
     CSV and JSON hold every row; their headers carry the units (``omega_lower [rad s-1]``), NaN and the fields that
     do not apply to a row are empty (JSON ``null``). ``limit`` caps the rows of the text (0: all).
     """
-    from .report import FORMATS, short_number, json_text, more_rows_line, plain_value, text_table
+    from .report import FORMATS, json_text, more_rows_line, plain_value, short_number, text_table
 
     if fmt not in FORMATS:
         raise StabmapError(f"format {fmt!r}: choose one of {', '.join(FORMATS)}")

@@ -144,7 +144,7 @@ class Runner:
             self._looked = now
             try:
                 nthreads = self.client.nthreads()
-            except Exception as exc:  # noqa: BLE001 - a lost scheduler shows in the client's status
+            except Exception as exc:
                 self._check_scheduler(exc)
                 nthreads = None
             if nthreads is not None:
@@ -323,5 +323,5 @@ def wait_for_workers(client) -> None:
             f"the dask scheduler at {client.scheduler.address} has no workers after {WORKER_TIMEOUT:.0f} s; "
             f"start some with 'dask worker {client.scheduler.address}'"
         ) from None
-    except Exception as exc:  # noqa: BLE001 - the scheduler went away while we waited
+    except Exception as exc:
         raise SchedulerLost(f"lost the dask scheduler at {client.scheduler.address} ({type(exc).__name__})") from None

@@ -51,7 +51,7 @@ class SceneBase(ABC):
 
     @classmethod
     @abstractmethod
-    def from_dict(cls, table: dict, base_dir: Path | None = None) -> "SceneBase":
+    def from_dict(cls, table: dict, base_dir: Path | None = None) -> SceneBase:
         """The scene of a scene file's TOML table (its ``system`` key removed); errors name the key and the fix.
         Relative file names in the table are taken from ``base_dir``."""
 
@@ -72,7 +72,7 @@ class SceneBase(ABC):
         group a heading of ``System.fixed_groups`` (``""``: the whole scene).  Default: nothing."""
         return []
 
-    def with_grid(self, grid: tuple[Axis, ...]) -> "SceneBase":
+    def with_grid(self, grid: tuple[Axis, ...]) -> SceneBase:
         """The same scene on ``grid`` (a subset of its own, ``read.subset``), with every choice this scene made from
         its grid kept as it is, so that each point is decided as before."""
         return replace(self, grid=tuple(grid))

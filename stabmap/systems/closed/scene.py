@@ -107,7 +107,7 @@ class Scene(SceneBase):
         return _parameter(name, self.family, bool(self.lengths))
 
     @classmethod
-    def from_dict(cls, table: dict, base_dir: str | Path | None = None) -> "Scene":
+    def from_dict(cls, table: dict, base_dir: str | Path | None = None) -> Scene:
         return from_dict(table, base_dir)
 
     def fixed_values(self) -> dict[str, float]:

@@ -112,7 +112,7 @@ class Scene(SceneBase):
         return _axis_name(name, self.n, self.support, self.topology is not None).parameter
 
     @classmethod
-    def from_dict(cls, table: dict, base_dir: str | Path | None = None) -> "Scene":
+    def from_dict(cls, table: dict, base_dir: str | Path | None = None) -> Scene:
         return from_dict(table, base_dir)
 
     def fixed_values(self) -> dict[str, float]:

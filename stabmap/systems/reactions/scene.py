@@ -118,7 +118,7 @@ class Scene(SceneBase):
         return parameters.parse(name, self.n, self.kind)[1]
 
     @classmethod
-    def from_dict(cls, table: dict, base_dir: str | Path | None = None) -> "Scene":
+    def from_dict(cls, table: dict, base_dir: str | Path | None = None) -> Scene:
         return from_dict(table, base_dir)
 
     def fixed_values(self) -> dict[str, float]:
