@@ -1,4 +1,4 @@
-"""Suite-wide collection rules."""
+"""Suite-wide collection rules, and the scenes and atlases many modules share (tests/scenes.py)."""
 
 from __future__ import annotations
 
@@ -14,3 +14,25 @@ def pytest_collection_modifyitems(config, items):
     if covered:
         config.hook.pytest_deselected(items=covered)
         items[:] = [item for item in items if item not in covered]
+
+
+# ------------------------------------------------------------------------------------------- shared scenes
+# The scenes are typed in tests/scenes.py (a module can import them at import time, for parametrize); here are the
+# objects built from them once per session.
+
+
+@pytest.fixture(scope="session")
+def two_tops_scene():
+    import stabmap
+    from scenes import TWO_TOPS
+
+    return stabmap.loads_scene(TWO_TOPS)
+
+
+@pytest.fixture(scope="session")
+def two_tops_atlas(two_tops_scene):
+    """The two tops' atlas, computed once for every module that reads it (read only: tests copy before changing)."""
+    import stabmap
+
+    return stabmap.compute_atlas(two_tops_scene, threads=2, chunk_points=10, progress=False)
+

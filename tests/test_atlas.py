@@ -14,43 +14,19 @@ import reference as ref
 import stabmap
 from stabmap.cli import main
 from systems import engine_point, reference_args
+from scenes import TWO_TOPS, two_tops
 
-SCENE = """
-title = "two tops, small grid"
-support = "fixed"
-g = 9.81
-omega = 50.0
-joints = [20.0]
-
-[[bodies]]
-m = 1.0
-A = 0.02
-C = 0.03
-c = 0.10
-s = 0.25
-fluid = { E = [1e-3], kappa = [1.31] }
-
-[[bodies]]
-m = 0.5
-A = 0.01
-C = 0.015
-c = 0.08
-omega = 45.0
-
-[grid]
-omega = { start = 1.0, stop = 150.0, num = 9 }
-m_2 = { start = 0.1, stop = 5.0, num = 7, scale = "log" }
-"""
+SCENE = TWO_TOPS
 
 
-@pytest.fixture(scope="module")
-def scene():
-    return stabmap.loads_scene(SCENE)
+@pytest.fixture
+def scene(two_tops_scene):
+    return two_tops_scene
 
 
-@pytest.fixture(scope="module")
-def atlas(scene):
-    return stabmap.compute_atlas(scene, threads=2, chunk_points=10, progress=False)
+@pytest.fixture
+def atlas(two_tops_atlas):
+    return two_tops_atlas
 
 
 def test_dataset_layout(atlas):
@@ -68,13 +44,8 @@ def test_dataset_layout(atlas):
 
 
 def test_atlas_equals_point_by_point_and_reference(atlas, scene):
-    system = {
-        "support": "fixed", "g": 9.81, "joints": [20.0],
-        "bodies": [
-            {"m": 1.0, "A": 0.02, "C": 0.03, "c": 0.10, "s": 0.25, "fluid": {"E": [1e-3], "kappa": [1.31]}},
-            {"m": 0.5, "A": 0.01, "C": 0.015, "c": 0.08, "omega": 45.0},
-        ],
-    }
+    system = two_tops()
+    system["bodies"][1]["omega"] = 45.0
     for i, omega in enumerate(atlas["omega"].values):
         for j, m2 in enumerate(atlas["m_2"].values):
             system["omega"] = float(omega)

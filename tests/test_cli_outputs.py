@@ -15,23 +15,10 @@ import stabmap
 from stabmap.cli import cli, main
 from stabmap.kernels import options
 from stabmap.run.progress import ProgressLine, Rate
+from scenes import top_toml
 
-SCENE = """
-title = "one top, small grid"
-support = "fixed"
-g = 9.81
-omega = 20.0
-
-[[bodies]]
-m = 1.0
-A = 0.02
-C = 0.03
-c = 0.10
-
-[grid]
-omega = { start = 1.0, stop = 60.0, num = 6 }
-c_1 = { start = 0.02, stop = 0.30, num = 4 }
-"""
+SCENE = top_toml('omega = { start = 1.0, stop = 60.0, num = 6 }\nc_1 = { start = 0.02, stop = 0.30, num = 4 }\n',
+                 head='title = "one top, small grid"\nomega = 20.0\n')
 
 
 def _digest(path) -> str:

@@ -13,15 +13,11 @@ from stabmap.cli import main
 from stabmap.run.critical import critical
 from stabmap.systems.gyroscopes.scene import from_dict
 from systems import reference_args
-
-TOP = {"m": 1.0, "A": 0.02, "C": 0.03}
+from scenes import maievskii_w2, top_system, two_tops
 
 
 def _maievskii_scene(num=41):
-    return from_dict({
-        "support": "fixed", "g": 9.81, "bodies": [dict(TOP, c=0.1)],
-        "grid": {"omega": {"start": -60.0, "stop": 60.0, "num": num}, "c_1": {"values": [0.05, 0.1, 0.2, 0.3]}},
-    })
+    return from_dict(top_system({"omega": {"start": -60.0, "stop": 60.0, "num": num}, "c_1": {"values": [0.05, 0.1, 0.2, 0.3]}}))
 
 
 def test_bad_arguments_from_python_name_the_parameters():
@@ -49,8 +45,7 @@ def test_maievskii_critical_spin_rates_are_bracketed_exactly():
     ds = critical(_maievskii_scene(), "omega", rtol=1e-10)
     assert list(ds["n_stable_intervals"].values) == [2, 2, 2, 2]
     for j, c in enumerate(ds["c_1"].values):
-        m, A, C, g, c = (Fraction(x) for x in (TOP["m"], TOP["A"], TOP["C"], 9.81, float(c)))
-        w2 = 4 * (A + m * c * c) * m * c * g / (C * C)
+        w2 = maievskii_w2(c)
         # upper interval: [w*, 60]; its lower end is certified stable, the outer value certified unstable
         lower = ds["omega_stable_lower"][j, 1].item()
         outer = ds["omega_stable_lower_outer"][j, 1].item()
@@ -63,13 +58,11 @@ def test_maievskii_critical_spin_rates_are_bracketed_exactly():
 
 
 def _liquid_pair():
-    return {
-        "support": "fixed", "g": 9.81, "joints": [5.0],
-        "bodies": [
-            {"m": 1.0, "A": 0.02, "C": 0.03, "c": 0.10, "s": 0.25, "fluid": {"E": [1e-3], "kappa": [1.31]}},
-            {"m": 0.5, "A": 0.01, "C": 0.015, "c": 0.08, "fluid": {"E": [4e-4], "kappa": [-2.2]}},
-        ],
-    }
+    """The two tops on a softer joint, with liquid in both."""
+    system = two_tops(joints=[5.0])
+    del system["omega"]
+    system["bodies"][1]["fluid"] = {"E": [4e-4], "kappa": [-2.2]}
+    return system
 
 
 def test_every_boundary_is_a_real_change_of_the_exact_count():
@@ -122,11 +115,8 @@ def test_stable_ends_stay_stable_when_one_scan_step_holds_several_changes():
     # Two ideal-jointed tops: N_c is 2 below omega ~ 9.1, 1 up to ~ 25.0, then 0.  A scan of two values puts both
     # changes into one step; the located lower end of the stable interval must still be a stable value, with
     # an unstable one within rtol below it (a plain bisection would have converged on the 2 -> 1 change).
-    system = {
-        "support": "fixed", "g": 9.81, "joints": [0.0],
-        "bodies": [{"m": 1.0, "A": 0.02, "C": 0.03, "c": 0.10, "s": 0.25}, {"m": 0.5, "A": 0.01, "C": 0.015, "c": 0.08}],
-        "grid": {"omega": {"values": [0.5, 150.0]}},
-    }
+    system = two_tops(joints=[0.0], grid={"omega": {"values": [0.5, 150.0]}})
+    del system["omega"], system["bodies"][0]["fluid"]
     ds = critical(from_dict(system), "omega")
     assert int(ds["n_stable_intervals"]) == 1
     lower, outer = ds["omega_stable_lower"][0].item(), ds["omega_stable_lower_outer"][0].item()
@@ -135,10 +125,7 @@ def test_stable_ends_stay_stable_when_one_scan_step_holds_several_changes():
 
 
 def test_three_axes_give_two_output_dimensions():
-    scene = from_dict({
-        "support": "fixed", "g": 9.81, "bodies": [dict(TOP, c=0.1)],
-        "grid": {"c_1": {"values": [0.1, 0.2]}, "omega": {"start": 0.5, "stop": 60.0, "num": 20}, "m_1": {"values": [1.0, 2.0, 3.0]}},
-    })
+    scene = from_dict(top_system({"c_1": {"values": [0.1, 0.2]}, "omega": {"start": 0.5, "stop": 60.0, "num": 20}, "m_1": {"values": [1.0, 2.0, 3.0]}}))
     ds = critical(scene, "omega")
     assert ds["omega_stable_lower"].dims == ("c_1", "m_1", "interval")
     assert ds["n_stable_intervals"].shape == (2, 3)
@@ -169,10 +156,7 @@ def test_cli_roundtrip_plot_and_errors(tmp_path, capsys):
 
 
 def test_plot_with_two_other_axes_asks_for_sel(tmp_path):
-    scene = from_dict({
-        "support": "fixed", "g": 9.81, "bodies": [dict(TOP, c=0.1)],
-        "grid": {"c_1": {"values": [0.1, 0.2]}, "omega": {"start": 0.5, "stop": 60.0, "num": 10}, "m_1": {"values": [1.0, 2.0]}},
-    })
+    scene = from_dict(top_system({"c_1": {"values": [0.1, 0.2]}, "omega": {"start": 0.5, "stop": 60.0, "num": 10}, "m_1": {"values": [1.0, 2.0]}}))
     ds = critical(scene, "omega")
     from stabmap.read.plot import plot_critical
 
@@ -185,10 +169,7 @@ def test_plot_with_two_other_axes_asks_for_sel(tmp_path):
 def test_boundary_at_exactly_zero_uses_the_absolute_floor(tmp_path):
     # At omega = 0 a top is stable iff c <= 0 (p = (A + m c^2) lam^2 + m c g), so the boundary is c = 0 exactly, where
     # no relative width can be reached. Also: a decreasing scan, an axis other than omega, no other axis, its plot.
-    scene = from_dict({
-        "support": "fixed", "g": 9.81, "omega": 0.0, "bodies": [dict(TOP, c=0.1)],
-        "grid": {"c_1": {"start": 0.2, "stop": -0.2, "num": 40}},
-    })
+    scene = from_dict(top_system({"c_1": {"start": 0.2, "stop": -0.2, "num": 40}}, omega=0.0))
     ds = critical(scene, "c_1", rtol=1e-10)
     atol = 1e-6 * 1e-10 * 0.2
     assert ds.attrs["critical_atol"] == pytest.approx(atol) and ds["c_1_stable_lower"].dims == ("interval",)
@@ -281,10 +262,7 @@ def test_a_coarse_scan_finds_every_boundary_of_a_fine_one():
 
 def test_cli_png_with_two_other_axes_fails_before_the_work(tmp_path, capsys):
     scene = tmp_path / "three.toml"
-    scene.write_text(from_dict({
-        "support": "fixed", "g": 9.81, "bodies": [dict(TOP, c=0.1)],
-        "grid": {"c_1": {"values": [0.1, 0.2]}, "omega": {"start": 0.5, "stop": 60.0, "num": 10}, "m_1": {"values": [1.0, 2.0]}},
-    }).to_toml())
+    scene.write_text(from_dict(top_system({"c_1": {"values": [0.1, 0.2]}, "omega": {"start": 0.5, "stop": 60.0, "num": 10}, "m_1": {"values": [1.0, 2.0]}})).to_toml())
     out = tmp_path / "c.nc"
     assert main(["critical", str(scene), "-o", str(out), "--png", str(tmp_path / "c.png")]) == 2
     assert "--sel m_1=VALUE" in capsys.readouterr().err and not out.exists()

@@ -22,36 +22,22 @@ from stabmap.cli import main
 from stabmap.read.info import intervals
 from stabmap.read.table import critical_table, render_table
 from stabmap.systems.gyroscopes.scene import from_dict
+from scenes import maievskii_stable, maievskii_w2, top_system
 
-TOP = {"A": 0.02, "C": 0.03}
-G = 9.81
 SCAN = (-60.0, 60.0)
 C1 = [-0.1, 0.1, 1.0]  # hanging (stable everywhere), an ordinary top, one whose critical rate lies beyond the scan
 M1 = [0.5, 2.0]
 
 
-def _w2(c: float, m: float) -> Fraction:
-    """The squared critical spin rate 4 (A + m c^2) m c g / C^2, exact on the binary values."""
-    A, C, g, c, m = (Fraction(x) for x in (TOP["A"], TOP["C"], G, c, m))
-    return 4 * (A + m * c * c) * m * c * g / (C * C)
-
-
-def _stable(omega: float, c: float, m: float) -> bool:
-    return Fraction(omega) ** 2 >= _w2(c, m)
-
-
 def _expected_intervals(c: float, m: float) -> int:
     """How many stable intervals [-60, 60] holds: 1 (stable throughout), 2 (|w| >= w*) or 0 (w* beyond 60)."""
-    w2 = _w2(c, m)
+    w2 = maievskii_w2(c, m)
     return 1 if w2 <= 0 else 2 if w2 <= Fraction(SCAN[1]) ** 2 else 0
 
 
 @pytest.fixture(scope="module")
 def crit():
-    scene = from_dict({
-        "support": "fixed", "g": G, "bodies": [dict(TOP, m=1.0, c=0.1)],
-        "grid": {"omega": {"start": SCAN[0], "stop": SCAN[1], "num": 25}, "c_1": {"values": C1}, "m_1": {"values": M1}},
-    })
+    scene = from_dict(top_system({"omega": {"start": SCAN[0], "stop": SCAN[1], "num": 25}, "c_1": {"values": C1}, "m_1": {"values": M1}}))
     return stabmap.critical(scene, "omega", rtol=1e-10)
 
 
@@ -62,13 +48,13 @@ def crit_file(crit, tmp_path_factory):
 
 def _check_interval(c, m, lower, upper, lower_outer, upper_outer, from_start, to_end):
     """One stable interval against the closed form: its ends stable, the outer values unstable, within the tolerance."""
-    assert _stable(lower, c, m) and _stable(upper, c, m)
+    assert maievskii_stable(lower, c, m) and maievskii_stable(upper, c, m)
     assert from_start == (lower == SCAN[0]) and to_end == (upper == SCAN[1])
     for end, outer in ((lower, lower_outer), (upper, upper_outer)):
         if end in SCAN:
             assert np.isnan(outer)
         else:
-            assert not _stable(outer, c, m) and 0 < abs(end - outer) <= 1e-10 * max(abs(end), abs(outer))
+            assert not maievskii_stable(outer, c, m) and 0 < abs(end - outer) <= 1e-10 * max(abs(end), abs(outer))
 
 
 def test_to_dataframe_has_one_row_per_interval_of_the_closed_form(crit):
@@ -97,25 +83,20 @@ def test_summary_of_critical_values_and_of_an_atlas(crit):
     assert s["undecided_gaps"] == 0 and s["intervals_with_gap_inside"] == 0
     # the stable length of each line: 120 (hanging), 2 (60 - w*), or 0, to the tolerance of the located ends
     for (c, m), n in expected.items():
-        length = 120.0 if n == 1 else 2 * (60 - float(_w2(c, m)) ** 0.5) if n == 2 else 0.0
+        length = 120.0 if n == 1 else 2 * (60 - float(maievskii_w2(c, m)) ** 0.5) if n == 2 else 0.0
         assert float(s["per_line"]["stable_length"].sel(c_1=c, m_1=m)) == pytest.approx(length, abs=1e-7)
         assert int(s["per_line"]["n_boundaries"].sel(c_1=c, m_1=m)) == (2 if n == 2 else 0)
     assert s["stable_length"] == pytest.approx(float(s["per_line"]["stable_length"].sum()))
     assert s["smallest_stable"]["value"] == SCAN[0] and s["smallest_stable"]["outer"] is None
     # an atlas of the same scene: its summary counts its grid points, stable by the closed form
-    atlas = stabmap.compute_atlas(from_dict({
-        "support": "fixed", "g": G, "bodies": [dict(TOP, m=1.0, c=0.1)],
-        "grid": {"omega": {"start": -60.0, "stop": 60.0, "num": 13}, "c_1": {"values": C1}},
-    }))
+    atlas = stabmap.compute_atlas(from_dict(top_system({"omega": {"start": -60.0, "stop": 60.0, "num": 13}, "c_1": {"values": C1}})))
     a = atlas.stabmap.summary()
     omegas, cs = atlas["omega"].values, atlas["c_1"].values
-    assert a["points"] == 39 and a["stable"] == sum(_stable(float(w), float(c), 1.0) for w in omegas for c in cs)
+    assert a["points"] == 39 and a["stable"] == sum(maievskii_stable(float(w), float(c), 1.0) for w in omegas for c in cs)
 
 
 def test_misuse_names_the_fix(crit):
-    atlas = stabmap.compute_atlas(from_dict({
-        "support": "fixed", "g": G, "bodies": [dict(TOP, m=1.0, c=0.1)], "grid": {"omega": {"values": [1.0, 50.0]}},
-    }))
+    atlas = stabmap.compute_atlas(from_dict(top_system({"omega": {"values": [1.0, 50.0]}})))
     with pytest.raises(stabmap.StabmapError, match=r"this Dataset is an atlas: ask it with ds.stabmap.boundaries"):
         atlas.stabmap.to_dataframe()
     with pytest.raises(stabmap.StabmapError, match=r"not a stabmap atlas or critical-values file .*stabmap.open_atlas"):
@@ -144,7 +125,7 @@ def _check_csv_rows(rows: list[dict]):
         elif r["row"] == "boundary":
             below, above = int(r["n_complex_pairs_below"]), int(r["n_complex_pairs_above"])
             assert {below, above} == {0, 1}
-            assert _stable(num["lower"], c, m) == (below == 0) and _stable(num["upper"], c, m) == (above == 0)
+            assert maievskii_stable(num["lower"], c, m) == (below == 0) and maievskii_stable(num["upper"], c, m) == (above == 0)
             assert 0 < num["upper"] - num["lower"] <= 1e-10 * max(abs(num["lower"]), abs(num["upper"]))
             assert r["from_scan_start"] == "" and r["omega_lower_outer [rad s-1]"] == ""
         else:
@@ -221,7 +202,7 @@ def test_info_all_and_limit(crit_file, crit, capsys):
             if n:
                 ends = [float(e.split(" (")[0]) for piece in text.split("; ") for e in piece.split(" to ")]
                 # printed to 10 digits: each end is a scan end or +-w* to that precision
-                w = float(_w2(c, m)) ** 0.5 if n == 2 else None
+                w = float(maievskii_w2(c, m)) ** 0.5 if n == 2 else None
                 assert len(ends) == 2 * n and all(e in SCAN or abs(abs(e) - w) <= 1e-9 * w for e in ends)
     assert "6 stable intervals and 4 boundaries on 6 lines" in out
     code, _, err = _run(capsys, "info", crit_file, "--limit", "-1")
@@ -271,13 +252,11 @@ def test_closed_chain_csv_along_the_length_ratio(tmp_path, capsys):
 
 
 def test_query_output_file_for_an_atlas_question(tmp_path, capsys):
-    atlas = stabmap.compute_atlas(from_dict({
-        "support": "fixed", "g": G, "bodies": [dict(TOP, m=1.0, c=0.1)], "grid": {"omega": {"start": 1.0, "stop": 60.0, "num": 12}},
-    }))
+    atlas = stabmap.compute_atlas(from_dict(top_system({"omega": {"start": 1.0, "stop": 60.0, "num": 12}})))
     path = stabmap.write_atlas(atlas, tmp_path / "a.nc")
     code, printed, _ = _run(capsys, "query", path, "--fraction", "--csv")
     target = tmp_path / "f.csv"
     assert code == 0 and _run(capsys, "query", path, "--fraction", "--csv", "-o", target)[:2] == (0, f"wrote {target}\n")
     assert target.read_text() == printed
     row = next(csv.DictReader(io.StringIO(printed)))
-    assert int(row["stable"]) == sum(_stable(float(w), 0.1, 1.0) for w in atlas["omega"].values)
+    assert int(row["stable"]) == sum(maievskii_stable(float(w), 0.1, 1.0) for w in atlas["omega"].values)

@@ -11,6 +11,7 @@ from stabmap.systems.gyroscopes.outputs import BY_EXACT, BY_STURM
 
 import reference as ref
 from systems import engine_enclosure, engine_point, random_system, reference_args
+from scenes import top_system
 
 CASES = [(n, modes, support) for n in (1, 2, 3, 4) for modes in (0, 1, 2) for support in ("fixed", "free")]
 
@@ -37,19 +38,15 @@ def test_most_random_points_are_decided_by_intervals():
     assert by.count(BY_STURM) >= 30
 
 
-def _maievskii(omega: float) -> dict:
-    return {"support": "fixed", "g": 9.81, "omega": omega, "bodies": [{"m": 1.0, "A": 0.02, "C": 0.03, "c": 0.1}]}
-
-
 def test_maievskii_boundary_and_neighbours():
     # C^2 w^2 = 4 (A + m c^2) m c g  at  w* = sqrt(4 * 0.03 * 0.981) / 0.03
     w_star = (4 * (0.02 + 0.01) * 0.1 * 9.81) ** 0.5 / 0.03
     for rel in (-1e-3, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-3):
-        system = _maievskii(w_star * (1 + rel))
+        system = top_system(omega=w_star * (1 + rel))
         expected = ref.count_complex_pairs(ref.char_poly(**reference_args(system)))
         assert engine_point(system)[0] == expected
-    assert engine_point(_maievskii(w_star * 0.99))[0] == 1
-    assert engine_point(_maievskii(w_star * 1.01))[0] == 0
+    assert engine_point(top_system(omega=w_star * 0.99))[0] == 1
+    assert engine_point(top_system(omega=w_star * 1.01))[0] == 0
 
 
 def test_exact_double_root_counts_as_stable():

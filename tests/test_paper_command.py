@@ -37,11 +37,25 @@ def test_gyroscope_cases_quick_with_figures(tmp_path, capsys):
     assert "| 0 |\n" in out and "DISAGREES" not in out
 
 
-@pytest.mark.slow
-def test_every_paper_check_quick(tmp_path):
+def test_with_no_system_named_every_paper_is_checked(tmp_path, monkeypatch):
+    """``stabmap paper`` alone runs all four checks, figures in one folder each, and gathers their disagreements.
+    The checks themselves run elsewhere once each: every gyroscope case quick with its figure in
+    tests/test_paper_cases.py, closed and reactions above, viscous quick in tests/test_viscous.py."""
+    import importlib
+
+    calls = {}
+    for name in papers.SYSTEMS:
+        def run(*args, _name=name, **kwargs):
+            calls[_name] = kwargs
+            return {"problems": [f"{_name} disagrees"] if _name == "reactions" else [], "text": f"the {_name} table"}
+
+        monkeypatch.setattr(importlib.import_module(f"stabmap.paper.{name}"), "run", run)
     done = papers.check(out=tmp_path, quick=True)
-    assert done["problems"] == []
-    assert len(list((tmp_path / "gyroscopes").glob("*.png"))) == len(paper_cases.CASES)
+    assert set(calls) == {"gyroscopes", "closed", "reactions", "viscous"}
+    assert {name: kwargs["out"] for name, kwargs in calls.items()} == {name: tmp_path / name for name in calls}
+    assert calls["gyroscopes"]["quick"] and calls["viscous"]["quick"]
+    assert done["problems"] == ["reactions disagrees"]
+    assert all(f"## {name}\nthe {name} table" in done["text"] for name in calls)
 
 
 def test_a_window_narrower_than_the_scan_step_is_found_by_rescanning_that_step(capsys):

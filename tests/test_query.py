@@ -11,7 +11,6 @@ import csv
 import io
 import json
 import math
-from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -24,16 +23,10 @@ from stabmap.cli import main
 from stabmap.systems.gyroscopes.outputs import BY_INFERRED as INFERRED
 from stabmap.read.report import render
 from stabmap.systems.gyroscopes.scene import from_dict
+from scenes import A, C, G, M, maievskii_stable, top_system
 
-M, A, C, G = 1.0, 0.02, 0.03, 9.81
 OMEGA = np.linspace(-60.0, 60.0, 97)  # step 1.25, holds 0
 C1 = [-0.1, 0.05, 0.1, 0.2, 0.3, 1.0]  # hanging (always stable), four ordinary tops, one too slow for the whole scan
-
-
-def maievskii_stable(omega: float, c: float, m: float = M) -> bool:
-    """Stability of one top at the exact binary values of its parameters."""
-    m, a, cc, g, c, w = (Fraction(float(v)) for v in (m, A, C, G, c, omega))
-    return cc * cc * w * w >= 4 * (a + m * c * c) * m * c * g
 
 
 def omega_crit(c: float, m: float = M) -> float:
@@ -41,7 +34,7 @@ def omega_crit(c: float, m: float = M) -> float:
 
 
 def scene(grid: dict) -> stabmap.Scene:
-    return from_dict({"support": "fixed", "g": G, "bodies": [{"m": M, "A": A, "C": C, "c": 0.1}], "grid": grid})
+    return from_dict(top_system(grid))
 
 
 @pytest.fixture(scope="module")

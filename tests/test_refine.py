@@ -17,6 +17,7 @@ from stabmap import systems
 from stabmap.cli import main
 from stabmap.systems.gyroscopes.outputs import BY_INFERRED
 from stabmap.scene.grid import Axis, resample
+from scenes import top_toml
 
 # Every bundled example of a system that can be refined (reactions, say, cannot: its label is no stability class).
 ALL_EXAMPLES = [n for n in stabmap.example_names() if systems.of(stabmap.example(n)).inferred(np.zeros(0, dtype=np.int16)) is not None]
@@ -158,8 +159,7 @@ def test_bad_arguments(kwargs, message):
 
 def test_refining_a_grid_too_coarse_to_refine_says_so(tmp_path, capsys):
     scene = tmp_path / "small.toml"
-    scene.write_text('support = "fixed"\n[[bodies]]\nm = 1.0\nA = 0.02\nC = 0.03\nc = 0.1\n'
-                     '[grid]\nomega = { start = 1.0, stop = 100.0, num = 40 }\n')
+    scene.write_text(top_toml("omega = { start = 1.0, stop = 100.0, num = 40 }\n"))
     assert main(["atlas", str(scene), "-o", str(tmp_path / "a.nc"), "--refine", "-q"]) == 0
     err = capsys.readouterr().err
     assert "nothing to infer, every point computed" in err and "--coarse-stride" in err and "x fewer" not in err

@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 
 import stabmap
 from stabmap import StabmapError, loads_scene
+from scenes import TOP
 
 GOOD = """
 title = "two tops"
@@ -184,8 +185,6 @@ def test_every_joint_axis_needs_joints():
 
 # --- one place for the checks ------------------------------------------------------------------------------
 
-_TOP = {"m": 1.0, "A": 0.02, "C": 0.03, "c": 0.1}
-
 
 def _python_and_toml(change_python, change_toml):
     """The message of a bad scene built in Python, and of the same scene read from TOML."""
@@ -194,7 +193,7 @@ def _python_and_toml(change_python, change_toml):
     from stabmap.systems.gyroscopes.scene import Body, Scene
     from stabmap.systems.gyroscopes.topology import Topology
 
-    kw = {"bodies": (Body(**_TOP, s=0.25), Body(**_TOP)), "omega": 50.0, "joints": (120.0,), "grid": (Axis("omega", (1.0, 2.0)),)}
+    kw = {"bodies": (Body(**TOP, s=0.25), Body(**TOP)), "omega": 50.0, "joints": (120.0,), "grid": (Axis("omega", (1.0, 2.0)),)}
     with pytest.raises(StabmapError) as python:  # a part (an Axis, a Topology) may refuse itself already
         change_python(kw, Body, Axis, Cavity, Topology)
         Scene(**kw)
@@ -208,19 +207,19 @@ def _python_and_toml(change_python, change_toml):
 
 
 SAME = [
-    (lambda kw, Body, *_: kw.update(bodies=(kw["bodies"][0], Body(**{**_TOP, "m": -1.0}))), [("m = 0.5", "m = -1.0")]),
+    (lambda kw, Body, *_: kw.update(bodies=(kw["bodies"][0], Body(**{**TOP, "m": -1.0}))), [("m = 0.5", "m = -1.0")]),
     (lambda kw, *_: kw.update(support="floating"), [('support = "fixed"', 'support = "floating"')]),
     (lambda kw, *_: kw.update(joints=(1.0, 2.0)), [("joints = [120.0]", "joints = [1.0, 2.0]")]),
     (lambda kw, *_: kw.update(joints=(-3.0,)), [("joints = [120.0]", "joints = [-3.0]")]),
-    (lambda kw, Body, *_: kw.update(bodies=(Body(**_TOP, s=0.25, E=(1e-4,), kappa=(0.0,)), kw["bodies"][1])),
+    (lambda kw, Body, *_: kw.update(bodies=(Body(**TOP, s=0.25, E=(1e-4,), kappa=(0.0,)), kw["bodies"][1])),
      [("kappa = [1.31, 2.7]", "kappa = [0.0, 2.7]")]),
-    (lambda kw, Body, *_: kw.update(bodies=(Body(**_TOP, s=0.25, E=(1e-4, 2e-5), kappa=(1.31,)), kw["bodies"][1])),
+    (lambda kw, Body, *_: kw.update(bodies=(Body(**TOP, s=0.25, E=(1e-4, 2e-5), kappa=(1.31,)), kw["bodies"][1])),
      [("kappa = [1.31, 2.7]", "kappa = [1.31]")]),
     (lambda kw, _, Axis, *__: kw.update(grid=(Axis("m_9", (1.0,)),)), [("m_2 = {", "m_9 = {")]),
     (lambda kw, _, Axis, *__: kw.update(grid=(Axis("K_1", (0.0, 10.0, 5.0)),)), [("K_1 = { values = [0.0, 10.0, 100.0] }", "K_1 = { values = [0.0, 10.0, 5.0] }")]),
     (lambda kw, _, Axis, *__: kw.update(grid=(Axis("K_1", (-1.0, 10.0)),)), [("K_1 = { values = [0.0, 10.0, 100.0] }", "K_1 = { values = [-1.0, 10.0] }")]),
     (lambda kw, *_: kw.update(K_0=1.0, support="free"), [('support = "fixed"', 'support = "free"'), ("g = 9.81", "K_0 = 1.0")]),
-    (lambda kw, Body, Axis, Cavity, _: kw.update(bodies=(Body(**_TOP, s=0.25, cavity=Cavity("cylinder", 0.0, 0.05, 1000.0)), kw["bodies"][1])),
+    (lambda kw, Body, Axis, Cavity, _: kw.update(bodies=(Body(**TOP, s=0.25, cavity=Cavity("cylinder", 0.0, 0.05, 1000.0)), kw["bodies"][1])),
      [("fluid = { E = [1e-4, 2e-5], kappa = [1.31, 2.7] }", 'cavity = { shape = "cylinder", radius = 0.0, half_height = 0.05, density = 1000.0 }')]),
     (lambda kw, Body, Axis, Cavity, Topology: kw.update(topology=Topology((0, 2), (0.0, 0.3))),
      [("[[bodies]]", "[topology]\nparent = [0, 2]\nat = [0.0, 0.3]\n\n[[bodies]]")]),

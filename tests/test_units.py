@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import json
 import math
-from fractions import Fraction
 from importlib import resources
 
 import mpmath as mp
@@ -26,8 +25,8 @@ from stabmap.read.info import describe
 from stabmap.read.plot import fixed_caption
 from stabmap.scene import units
 from stabmap.scene.grid import Axis
+from scenes import maievskii_stable
 
-M, A, C, G = 1.0, 0.02, 0.03, 9.81
 C1 = (0.05, 0.1, 0.2)
 RPM = 2 * math.pi / 60  # only to write the rad/s scene by hand; the conversions are checked in mpmath below
 
@@ -43,12 +42,6 @@ c = 0.1
 omega = {{ start = {start}, stop = {stop}, num = 31 }}
 c_1 = {{ values = [0.05, 0.1, 0.2] }}
 """
-
-
-def maievskii_stable(omega: float, c: float) -> bool:
-    """Stability of one top at the exact binary values of its parameters."""
-    m, a, cc, g, c, w = (Fraction(float(v)) for v in (M, A, C, G, c, omega))
-    return cc * cc * w * w >= 4 * (a + m * c * c) * m * c * g
 
 
 def exact_si(number: str, per_unit) -> float:
