@@ -34,7 +34,7 @@ def test_bad_arguments_from_python_name_the_parameters():
 def test_the_default_axis_is_the_systems():
     # no along: the gyroscopes' default_axis, omega; a scene without it says which default it took and why
     assert critical(_maievskii_scene(num=5), rtol=1e-6).attrs["critical_along"] == "omega"
-    scene = from_dict({"support": "fixed", "omega": 50.0, "bodies": [dict(TOP, c=0.1)], "grid": {"m_1": {"values": [0.5, 1.0]}}})
+    scene = from_dict(top_system({"m_1": {"values": [0.5, 1.0]}}, omega=50.0))
     with pytest.raises(stabmap.StabmapError, match=r"along not given, so the gyroscopes system's default axis 'omega': not a grid "
                                                    r"axis of this scene; its grid axes are: m_1. .*, or give along one of them"):
         critical(scene)

@@ -176,7 +176,7 @@ def test_three_axes_over_one_needs_the_others_fixed():
         scene({"omega": {"start": 0.5, "stop": 60.5, "num": 61}, "c_1": {"values": [0.1, 0.2]}, "m_1": {"values": [1.0, 2.0]}}),
         threads=2, progress=False,
     )
-    with pytest.raises(stabmap.StabmapError, match=r"over 'c_1': fix the other axes as well \(m_1=1"):
+    with pytest.raises(stabmap.StabmapError, match=r"over='c_1': fix the other axes as well \(m_1=1"):
         stabmap.smallest_stable(ds, "omega", over="c_1")
     s = stabmap.smallest_stable(ds, "omega", over="c_1", m_1=2.2)
     assert float(s["m_1"]) == 2.0 and "m_1 = 2.2 -> nearest grid value 2 kg" in s.attrs["selection"]
