@@ -24,7 +24,8 @@ HATCH_DEGENERATE = "xxxx"
 
 def colour(value: int, stable: int | None = 0, absent: int | None = None, undecided: int | None = None) -> str:
     """The colour of the label ``value`` (``absent``: white; ``undecided``: dark grey; other negatives: degenerate;
-    ``stable``: the stable class) in every figure."""
+    ``stable``: the stable class, by default 0 as in a count of unstable modes; None: no class is stable) in every
+    figure. :func:`system_colour` takes them from a system."""
     if absent is not None and value == absent:
         return ABSENT_COLOUR
     if undecided is not None and value == undecided:
