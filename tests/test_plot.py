@@ -7,6 +7,7 @@ between neighbouring points whose N_c differ, on hand-made maps with log and irr
 from __future__ import annotations
 
 import os
+import re
 
 import numpy as np
 import pytest
@@ -18,7 +19,18 @@ from matplotlib.colors import to_rgba
 
 import stabmap
 from stabmap.cli import main
-from stabmap.read.plot import atlas_figure, cell_edge_boundaries, class_label, colour, plan_figure, plot_atlas
+from stabmap.errors import cli_spelling
+from stabmap.read.plot import (
+    atlas_figure,
+    axis_label,
+    cell_edge_boundaries,
+    class_label,
+    colour,
+    fixed_caption,
+    plan_figure,
+    plot_atlas,
+)
+from stabmap.systems.gyroscopes import SYSTEM as GYRO
 from stabmap.systems.gyroscopes.outputs import DECIDED_BY, N_COMPLEX_PAIRS
 
 COORD_ATTRS = {
@@ -143,7 +155,7 @@ def test_legend_has_one_entry_per_class_present_and_fixed_colours():
     ds = hand_atlas({"K_1": ([0.0, 5.0, 10.0], "linear"), "omega": ([1.0, 2.0, 3.0, 4.0], "linear")}, nc, by)
     fig = atlas_figure(ds)
     labels = [t.get_text() for t in legend_of(fig).get_texts()]
-    assert labels == [class_label(-1), class_label(0), class_label(1), class_label(3), "stability boundary", "N$_c$ changes", "inferred from cell\ncorners (not computed)"]
+    assert labels == [class_label(v, GYRO) for v in (-1, 0, 1, 3)] + ["stability boundary", "N$_c$ changes", "inferred from cell\ncorners (not computed)"]
     assert labels[1] == "stable (all roots real)" and labels[2] == "unstable: 1 complex pair" and labels[3] == "unstable: 3 complex pairs"
     ax = fig.axes[0]
     for v in (-1, 0, 1, 3):  # class colours do not depend on which classes are present
@@ -248,7 +260,7 @@ def test_facets_one_panel_per_value_with_titles(atlas3):
     assert "of 5 values drawn" not in panels_of(fig).get_suptitle()
     labels = [t.get_text() for t in legend_of(fig).get_texts()]
     present = sorted(int(v) for v in np.unique(atlas3["n_complex_pairs"]))
-    assert labels[: len(present)] == [class_label(v) for v in present]
+    assert labels[: len(present)] == [class_label(v, GYRO) for v in present]
 
 
 def test_facets_subset_and_choice(atlas3):
@@ -285,6 +297,43 @@ def test_four_axes_rows_and_columns():
     assert plan.fixed == {"C_1": (0, None)} and "C_1 fixed at its first value" in plan.notes[-1]
 
 
+def test_errors_and_notes_name_parameters_as_python_or_the_command_line_spells_them(atlas3):
+    """One message each way: ``x='foo'`` from Python, ``--x foo`` under the CLI's spelling (stabmap.errors)."""
+    cases = [
+        ({"x": "foo"}, "x='foo': not an axis of this atlas; choose from omega, m_2, K_1", "--x foo: not an axis"),
+        ({"max_panels": 0}, "max_panels must be a whole number >= 1, got 0", "--max-panels must be a whole number >= 1"),
+        ({"sel": {"nope": 1.0}}, "sel={'nope': ...}: not an axis of this atlas", "--sel nope=...: not an axis"),
+        ({"x": "K_1", "sel": {"K_1": 10.0}}, "x='K_1': this axis is also fixed by sel={'K_1': ...}",
+         "--x K_1: this axis is also fixed by --sel K_1=...; drop one of the two"),
+    ]
+    for options, python, cli in cases:
+        with pytest.raises(stabmap.StabmapError, match=re.escape(python)):
+            plan_figure(atlas3, **options)
+        with cli_spelling(), pytest.raises(stabmap.StabmapError, match=re.escape(cli)):
+            plan_figure(atlas3, **options)
+    assert plan_figure(atlas3, max_panels=2).notes[0].endswith("(more with max_panels, now 2; one with sel)")
+    with cli_spelling():
+        assert plan_figure(atlas3, max_panels=2).notes[0].endswith("(more with --max-panels, now 2; one with --sel)")
+    five = atlas3[["n_complex_pairs"]].expand_dims(p=[1.0, 2.0], q=[1.0, 2.0])  # p, q, omega, m_2 drawn; K_1 left over
+    assert plan_figure(five).notes[-1] == "K_1 fixed at its first value (choose with sel={'K_1': VALUE})"
+    with cli_spelling():
+        assert plan_figure(five).notes[-1] == "K_1 fixed at its first value (choose with --sel K_1=VALUE)"
+
+
+def test_axis_label_and_caption_as_the_gyroscopes_write_them_in_a_figure():
+    """An inertia axis drops "about its centre of mass" (every body's A says it), and a liquid's E is in kg m² as
+    mathtext, as every other unit of the figure (``System.figure_text``)."""
+    scene = stabmap.loads_scene(
+        "support = \"fixed\"\n[[bodies]]\nm = 1.0\nA = 0.02\nC = 0.03\nc = 0.1\nfluid = { E = [1e-4], kappa = [1.31] }\n"
+        "[grid]\nomega = { values = [10.0, 20.0] }\nA_1 = { values = [0.02, 0.03] }\n"
+    )
+    ds = stabmap.compute_atlas(scene, threads=1, progress=False)
+    assert "about its centre of mass" in ds["A_1"].attrs["long_name"]  # the atlas keeps the whole name
+    assert axis_label(ds, "A_1", width=500) == "equatorial moment of inertia of body 1 $A_{1}$ [kg\u00a0m$^{2}$]"
+    caption = fixed_caption(ds, 500)
+    assert "E\u00a0=\u00a00.0001\u00a0kg\u00a0m$^{2}$," in caption and " m2" not in caption.replace("\u00a0", " ")
+
+
 # -------------------------------------------------------------------------------------------------- files, CLI
 def test_cli_png_and_pdf_are_valid_and_vector(atlas3_file, tmp_path, capsys):
     png, pdf = tmp_path / "map.png", tmp_path / "map.pdf"
@@ -306,8 +355,8 @@ def test_cli_png_and_pdf_are_valid_and_vector(atlas3_file, tmp_path, capsys):
     "args,message",
     [
         (["--facet", "nope"], "--facet nope: not an axis of this atlas; choose from omega, m_2, K_1"),
-        (["--sel", "nope=1"], "--sel nope: not an axis of this atlas"),
-        (["--sel", "g=9"], "--sel g: fixed at 9.81 m s-2 in this atlas, not a grid axis"),
+        (["--sel", "nope=1"], "--sel nope=...: not an axis of this atlas"),
+        (["--sel", "g=9"], "--sel g=...: fixed at 9.81 m s-2 in this atlas, not a grid axis"),
         (["--sel", "K_1"], "--sel 'K_1': write NAME=VALUE"),
         (["--x", "nope"], "--x nope: not an axis of this atlas"),
         (["--x", "omega", "--y", "omega"], "--x and --y both name omega"),

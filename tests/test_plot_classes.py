@@ -101,7 +101,7 @@ def test_xarray_draws_the_label_and_flag_variables_with_named_classes(dry):
         mesh = dry.n_complex_pairs.stabmap.plot(x="omega")
         nc = dry.n_complex_pairs.transpose("c_1", "omega").values.ravel()
         np.testing.assert_allclose(facecolours(mesh), [to_rgba(colour(int(v))) for v in nc], atol=1e-6)
-        assert [t.get_text() for t in mesh.colorbar.ax.get_yticklabels()] == [class_label(0), class_label(1)]
+        assert [t.get_text() for t in mesh.colorbar.ax.get_yticklabels()] == [class_label(0, gyroscopes.SYSTEM), class_label(1, gyroscopes.SYSTEM)]
         style = dry.decided_by.stabmap.style()  # any flag variable: one colour a flag, its meaning on the colour bar
         assert style["cmap"].N == len(dry.decided_by.attrs["flag_values"])
         assert style["cbar_kwargs"]["format"](6.0) == "box proof"

@@ -338,3 +338,13 @@ class System(ABC):
         """Legend text of one label value."""
         var = self.variable(self.label)
         return var.meaning(value).replace("_", " ") if var.flags else f"{self.label} = {value}"
+
+    # figures
+    def figure_text(self, text: str, units) -> str:
+        """``text`` of this system (a coordinate's ``long_name``, a note of its scene) as a figure writes it.
+
+        A figure has less room than ``stabmap info``: a system may shorten a phrase its names all repeat, and write
+        the units in its notes with ``units`` (a function that turns a CF unit string such as ``"kg m2"`` into the
+        figure's text of it).  The default writes ``text`` as it is.
+        """
+        return text

@@ -175,6 +175,14 @@ class Gyroscopes(System):
         return {"stability": stability_from_pairs(label), "decided_by": np.full(np.shape(label), BY_INFERRED, dtype=np.int8),
                 **not_computed(label, proved=False)}
 
+    # figures
+    def figure_text(self, text: str, units) -> str:
+        # Each body's A is "about its centre of mass" (parameters.py); an axis label has no room to say it again.
+        text = text.replace(" about its centre of mass", "")
+        for unit in ("kg m2", "m7"):  # what notes() writes after numbers: a liquid's E, a viscous liquid's tensor
+            text = text.replace(f" {unit}", f" {units(unit)}")
+        return text
+
 
 SYSTEM = Gyroscopes()
 

@@ -1,0 +1,216 @@
+"""The atlas figure: plan (which axis goes where) -> reduce (each panel to blocks no smaller than a pixel) ->
+draw (classes, hatches, boundaries on cell edges, panel titles, axes) -> legend and title, one function a step.
+
+``atlas_figure`` draws an atlas Dataset into a new matplotlib Figure and computes nothing: it reads the system's
+label, its provenance flags and ``cell``, and their coordinates, chunk by chunk when the atlas is lazy.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ... import systems
+from ..areas import AreaShares
+from .captions import atlas_title, captioned_figure
+from .geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, cell_edges, touches_stability
+from .labels import axis_label, display_ticks, log_axis, log_ticks, value_text
+from .layout import LEGEND_WIDTH, MAX_PANELS, FigurePlan, figure_size, panel_grid, panel_points, plan_figure
+from .paint import fill_classes, hatch_cells, paint_cells
+from .palette import BOUNDARY, CLASS_EDGE, class_colours, legend_handles
+from .reduce import FLAG_CHANGE, FLAG_INFERRED, FLAG_NODE_ONLY, Reduced, reduce_panels
+
+
+def atlas_figure(
+    ds: xr.Dataset,
+    *,
+    x: str | None = None,
+    y: str | None = None,
+    sel: dict[str, float] | None = None,
+    facet: str | None = None,
+    max_panels: int = MAX_PANELS,
+):
+    """Draw an atlas into a new matplotlib Figure (nothing is saved, nothing computed).
+
+    The atlas may be lazy (``open_atlas(path, lazy=True)``): each panel is read chunk by chunk, and a panel with
+    more grid points than pixels is drawn in blocks (:mod:`stabmap.read.plot`), so memory stays bounded at any size.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        An atlas (``stabmap.compute_atlas``, ``stabmap.open_atlas``).
+    x, y : str, optional
+        Axes of the map (default: the first two axes of the atlas that are not fixed or faceted, in order).
+    sel : dict, optional
+        Axes to fix, ``{name: value}``; the nearest grid value is used and shown.
+    facet : str, optional
+        The axis whose values become panels (default: the third remaining axis). A fourth remaining axis gives
+        the rows; further axes are fixed at their first value, and the figure says so.
+    max_panels : int
+        At most this many panels; evenly spaced values are drawn from longer axes (default 12).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Not registered with pyplot: save it with ``fig.savefig``. ``fig.axes[0]`` is the first map (for a 2-D
+        atlas the only one) in data coordinates, x and y being the grid values, so curves can be overlaid with
+        ``fig.axes[0].plot(x, y)``; its limits are fixed to the grid. The legend is ``fig.legends[0]``.
+
+    Raises
+    ------
+    StabmapError
+        For an option that does not fit the atlas (unknown axis, an axis given two roles, ...), naming the
+        parameter as the caller spelled it (``x='foo'`` in Python, ``--x foo`` from the command line).
+    """
+    plan = plan_figure(ds, x=x, y=y, sel=sel, facet=facet, max_panels=max_panels)
+    system = systems.of_atlas(ds.attrs)
+    nrows, ncols, width = panel_grid(plan)
+    reduced = reduce_panels(ds, plan, system, width, nrows, ncols)
+    xe, ye = map_edges(ds, plan, reduced.factors)
+    title = figure_title(ds, plan, system, reduced, width)
+    size = figure_size(plan, width, nrows, title.count("\n") + 1, len(reduced.present))
+    fig = captioned_figure(ds, size)
+    if plan.facet is None:
+        maps = side = fig
+    else:  # panels with their titles on the left, the legend on the right: the two never overlap
+        maps, side = fig.subfigures(1, 2, width_ratios=[size[0] - LEGEND_WIDTH, LEGEND_WIDTH])
+    grid = maps.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False)
+    axes = [grid[n // ncols, n % ncols] for n in range(len(reduced.panels))]
+    for ax in grid.ravel()[len(reduced.panels) :]:
+        ax.remove()
+
+    cmap, norm = class_colours(reduced.present, system)
+    span = panel_points(width, nrows, ncols, facets=plan.facet is not None, strip=plan.y is None)
+    log = (log_axis(ds, plan.x), bool(plan.y) and log_axis(ds, plan.y))
+    drawn = {"stability": False, "classes": False, "inferred": False, "light": False, "node-only": False,
+             "node-only-light": False, "change": False}
+    for n, (ax, blocks, (r, c)) in enumerate(zip(axes, reduced.blocks, reduced.panels)):
+        for key, value in draw_panel(ax, blocks, xe, ye, system, cmap, norm, span, log).items():
+            drawn[key] |= value
+        if plan.facet is not None:
+            ax.set_title(panel_title(ds, plan, system, blocks, r, c, None if reduced.shares is None else reduced.shares[n]), fontsize=9)
+
+    shown = set_map_axes(axes[0], ds, plan, xe, ye)
+    if plan.facet is None:
+        axes[0].set_xlabel(axis_label(ds, plan.x, shown=shown[plan.x]))
+        if plan.y:
+            axes[0].set_ylabel(axis_label(ds, plan.y, width=45, shown=shown[plan.y]))
+    else:
+        for n, ax in enumerate(axes):  # tick labels only where no panel is below / to the left
+            ax.tick_params(labelbottom=n + ncols >= len(reduced.panels), labelleft=n % ncols == 0)
+        maps.supxlabel(axis_label(ds, plan.x, width=int(12 * (size[0] - LEGEND_WIDTH)), shown=shown[plan.x]), fontsize=10)
+        maps.supylabel(axis_label(ds, plan.y, width=int(10 * size[1]), shown=shown.get(plan.y, "")), fontsize=10)
+
+    add_legend(fig if plan.facet is None else side, plan, system, reduced.present, drawn)
+    if plan.facet is None:
+        axes[0].set_title(title, fontsize=10)
+    else:
+        maps.suptitle(title, fontsize=10)
+    return fig
+
+
+def map_edges(ds: xr.Dataset, plan: FigurePlan, factors: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """The edges of the drawn cells along x and y: grid cells (geometric on a log axis), merged into blocks of
+    ``factors`` (y, x); a strip's y runs from 0 to 1."""
+    xe = cell_edges(np.asarray(ds[plan.x], dtype=float), "log" if log_axis(ds, plan.x) else None)
+    ye = cell_edges(np.asarray(ds[plan.y], dtype=float), "log" if log_axis(ds, plan.y) else None) if plan.y else np.array([0.0, 1.0])
+    return block_edges(xe, factors[1]), block_edges(ye, factors[0]) if plan.y else ye
+
+
+def figure_title(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, width: float) -> str:
+    """The title over the map or the panels (:func:`stabmap.read.plot.captions.atlas_title`), in lines as wide as
+    the maps."""
+    stable = system.stable_label
+    n_stable = None if stable is None else reduced.totals.get(stable, 0)
+    return atlas_title(ds, plan, n_stable, reduced.points, 70 if plan.facet is None else int(12 * (width - LEGEND_WIDTH)),
+                       reduced.factors, reduced.shape, shares=None if reduced.shares is None else AreaShares.mean(reduced.shares))
+
+
+def draw_panel(ax, blocks, xe: np.ndarray, ye: np.ndarray, system, cmap, norm, span: tuple[float, float],
+               log: tuple[bool, bool]) -> dict[str, bool]:
+    """Draw one panel's blocks into ``ax``: the classes, the hatches (inferred, node only, degenerate), blocks of
+    mixed labels and cells holding a change, then the boundaries on cell edges, as wide as the bands allow.
+    Returns which of these it drew, for the legend."""
+    from matplotlib.collections import LineCollection
+
+    stable, absent = system.stable_label, system.absent_label
+    drawn: dict[str, bool] = {}
+    values, mixed = blocks.low, blocks.mixed
+    fill_classes(ax, values, xe, ye, system, cmap, norm)
+    bits = np.zeros(values.shape, dtype=np.int32) if blocks.any_flag is None else blocks.any_flag
+    inferred = (bits & FLAG_INFERRED) > 0
+    node_only = ((bits & FLAG_NODE_ONLY) > 0) & ~inferred
+    for mask, gid in ((inferred, "inferred-cells"), (node_only, "node-only-cells"),
+                      ((values < 0) & (values != absent) & ~mixed, "degenerate-cells")):
+        if mask.any():
+            light = hatch_cells(ax, mask, xe, ye, gid)
+            if gid == "inferred-cells":
+                drawn["inferred"], drawn["light"] = True, light
+            elif gid == "node-only-cells":
+                drawn["node-only"], drawn["node-only-light"] = True, light
+    codes, state = block_classes(blocks, stable)
+    change = (bits & FLAG_CHANGE) > 0
+    near_stable = touches_stability(blocks, stable) if stable is not None else np.zeros(values.shape, dtype=bool)
+    drawn["change"] = bool(change.any())
+    for mask, col, gid in ((mixed & ~blocks.mixed_stability, CLASS_EDGE, "mixed-class-blocks"), (blocks.mixed_stability, BOUNDARY, "mixed-stability-blocks"),
+                           (change & ~near_stable, CLASS_EDGE, "change-cells"), (change & near_stable, BOUNDARY, "stability-change-cells")):
+        if mask.any():
+            paint_cells(ax, mask, xe, ye, col, gid, vector=gid.endswith("-cells") and tuple(blocks.factors) == (1, 1))
+    stab, other = cell_edge_boundaries(codes, xe, ye, stable, state=state)
+    for segs, widest, col, gid in ((other, 0.6, CLASS_EDGE, "class-boundary"), (stab, 1.5, BOUNDARY, "stability-boundary")):
+        widths = boundary_widths(segs, xe, ye, span, widest, log=log, codes=codes)
+        lines = LineCollection(segs, colors=col, linewidths=widths, capstyle="projecting", joinstyle="miter", zorder=3 + (gid == "stability-boundary"))
+        lines.set_gid(gid)
+        ax.add_collection(lines, autolim=False)
+    drawn["stability"], drawn["classes"] = len(stab) > 0, len(other) > 0
+    return drawn
+
+
+def panel_title(ds: xr.Dataset, plan: FigurePlan, system, blocks, r: int | None, c: int, share: AreaShares | None) -> str:
+    """A small multiple's title: its facet (and row) value, and its share proved stable (of its area with
+    ``share``, else of its grid points)."""
+    parts = [value_text(ds, plan.facet, float(ds[plan.facet][c]))]
+    if plan.row is not None:
+        parts.append(value_text(ds, plan.row, float(ds[plan.row][r])))
+    if system.stable_label is None:  # a system without stability: the panel's coordinates only
+        return "\n".join(parts)
+    parts.append(f"{100 * share.stable:.0f} % of its area proved stable" if share is not None  # as the title
+                 else f"{100 * blocks.counts.get(system.stable_label, 0) / sum(blocks.counts.values()):.0f} % {system.stable_word}")
+    two_lines = plan.row is not None or share is not None  # the longer text of areas needs its own line
+    return "\n".join([", ".join(parts[:-1]), parts[-1]]) if two_lines else f"{parts[0]}  ({parts[1]})"
+
+
+def set_map_axes(first, ds: xr.Dataset, plan: FigurePlan, xe: np.ndarray, ye: np.ndarray) -> dict[str, str]:
+    """Scales, limits and ticks of the maps (shared, so set on the ``first``): log axes labelled between decades,
+    ticks at a few listed values, spin rates in their display units. Returns the unit each axis is shown in."""
+    if log_axis(ds, plan.x):
+        first.set_xscale("log")
+    first.set_xlim(min(xe[0], xe[-1]), max(xe[0], xe[-1]))
+    if plan.y:
+        if log_axis(ds, plan.y):
+            first.set_yscale("log")
+        first.set_ylim(min(ye[0], ye[-1]), max(ye[0], ye[-1]))
+    else:
+        first.set_ylim(0, 1)
+        first.set_yticks([])
+    for dim, axis in ((plan.x, first.xaxis), (plan.y, first.yaxis)):
+        if dim and axis.get_scale() == "log":
+            log_ticks(axis, *sorted(np.asarray(ds[dim], dtype=float)[[0, -1]]))
+    for dim, setter, log in ((plan.x, first.set_xticks, first.get_xscale() == "log"), (plan.y, first.set_yticks, first.get_yscale() == "log")):
+        if dim and ds[dim].attrs.get("scale") == "values" and 1 < ds.sizes[dim] <= 8:  # ticks at listed values ...
+            v = np.sort(np.asarray(ds[dim], dtype=float))
+            v_ = np.log(v) if log else v
+            if np.min(np.diff(v_)) >= (v_[-1] - v_[0]) / 12:  # ... unless their labels would collide
+                setter(v)
+    return {dim: display_ticks(ds, dim, axis) for dim, axis in ((plan.x, first.xaxis), (plan.y, first.yaxis)) if dim}
+
+
+def add_legend(where, plan: FigurePlan, system, present: list[int], drawn: dict[str, bool]) -> None:
+    """The legend of the classes ``present`` and the marks ``drawn``: beside a single map, or at the top of the
+    right-hand subfigure of small multiples (``where``)."""
+    legend = {"frameon": False, "title": system.label_title, "fontsize": 9, "title_fontsize": 9}
+    handles = legend_handles(system, present, drawn)
+    if plan.facet is None:
+        where.legend(handles=handles, loc="outside right upper", alignment="left", **legend)
+    else:
+        where.legend(handles=handles, loc="upper left", bbox_to_anchor=(0.0, 0.97), alignment="left", **legend)

@@ -1,0 +1,146 @@
+"""The figure of a critical-values file (``stabmap critical``): the scanned parameter along x, as on the atlas
+maps, each stretch between located changes in its class's colour, against the one other axis left free."""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ... import systems
+from ...errors import StabmapError, given
+from .captions import captioned_figure, fill_title
+from .geometry import cell_edges
+from .layout import VALUE
+from .labels import axis_label, log_ticks, mathtext, symbol, value_text
+from .palette import HATCH_DEGENERATE, class_patch, system_colour
+
+
+def scanned_attrs(ds: xr.Dataset, system, along: str, lower: xr.DataArray) -> dict:
+    """long_name and units of the scanned parameter, as an atlas's axis has them (from the stored scene)."""
+    try:
+        info = system.parameter(systems.loads_scene(str(ds.attrs["scene"]), "the file's scene"), along)
+        return {"long_name": info.long_name, "units": info.units}
+    except (KeyError, StabmapError):  # no scene, or one this version does not read: the symbol and units only
+        return {"units": lower.attrs.get("units", "")}
+
+
+def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
+    """Draw a critical-values Dataset into a new Figure: the scanned parameter along x (as on the atlas maps),
+    each stretch between located boundaries in the colour of its class (as on the maps), the boundaries as dots,
+    against the one other axis (y) left free by ``sel``.
+
+    A file without ``<label>_at_scan_start`` (written before it existed) shows its stable intervals only.
+    """
+    system = systems.of_atlas(ds.attrs)
+    along = ds.attrs["critical_along"]
+    free, chosen = free_axes(ds, along, sel)
+    rows, start = critical_rows(ds, system, along, free, chosen)
+    scan = [float(v) for v in ds.attrs["critical_scan_range"]]
+    stretches = critical_stretches(rows, system, along, start, scan)
+
+    fig = captioned_figure(ds, (7.5, 5.5 if free else 2.4))
+    ax = fig.subplots()
+    if free:
+        y = np.asarray(ds[free[0]])
+        edges = cell_edges(y, ds[free[0]].attrs.get("scale"))
+    else:
+        edges = np.array([0.0, 1.0])
+    present = draw_stretches(ax, stretches, edges, system)
+    b_lo, b_hi = np.asarray(rows["boundary_lower"]), np.asarray(rows["boundary_upper"])
+    ends = np.concatenate([b_lo.ravel(), b_hi.ravel()])
+    ys = np.broadcast_to(((edges[:-1] + edges[1:]) / 2 if free else np.array([0.5]))[:, None], b_lo.shape).ravel()
+    ax.plot(ends, np.concatenate([ys, ys]), "k.", ms=2.5 if free else 6)
+    ax.set_xlim(scan[0], scan[1])
+    ax.set_ylim(edges[0], edges[-1])
+    if free:
+        ax.set_ylabel(axis_label(ds, free[0], width=45))
+        if ds[free[0]].attrs.get("scale") == "log":
+            ax.set_yscale("log")
+            log_ticks(ax.yaxis, float(np.min(y)), float(np.max(y)))
+    else:
+        ax.set_yticks([])
+    lower = ds[f"{along}_stable_lower"]
+    ax.set_xlabel(axis_label(xr.Dataset(coords={along: ((), 0.0, scanned_attrs(ds, system, along, lower))}, attrs=ds.attrs), along, width=60))
+    critical_legend(fig, system, present)
+    ax.set_title(critical_title(ds, along, start is None, chosen), fontsize=10)
+    return fig
+
+
+def free_axes(ds: xr.Dataset, along: str, sel: dict[str, float] | None) -> tuple[list[str], dict[str, float]]:
+    """The axes of the file other than ``along`` left free by ``sel`` (at most one), and ``sel`` checked."""
+    dims = [d for d in ds[f"{along}_stable_lower"].dims if d != "interval"]
+    for k in sel or {}:
+        if k not in dims:
+            raise StabmapError(f"{given('sel', ..., k)}: not an axis of this file; its axes are: {', '.join(dims) or '(none)'}")
+    chosen = dict(sel or {})
+    free = [d for d in dims if d not in chosen]
+    if len(free) > 1:
+        raise StabmapError(f"this file has {len(free)} other axes ({', '.join(free)}); fix all but one with {given('sel', VALUE, 'NAME')}")
+    return free, chosen
+
+
+def critical_rows(ds: xr.Dataset, system, along: str, free: list[str], chosen: dict[str, float]) -> tuple[xr.Dataset, str | None]:
+    """The file's boundaries, classes and stable intervals at ``chosen``, one row per value of the free axis (one
+    row named ``row`` without one), and the name of the label at the scan's start (None in an older file)."""
+    lab = system.label
+    names = ["boundary_lower", "boundary_upper", f"{lab}_below", f"{lab}_above", f"{along}_stable_lower", f"{along}_stable_upper"]
+    start = f"{lab}_at_scan_start" if f"{lab}_at_scan_start" in ds else None
+    picked = ds[names + ([start] if start else [])]
+    if chosen:
+        picked = picked.sel(chosen, method="nearest")
+    return (picked.transpose(*free, ...) if free else picked.expand_dims(row=[0])), start
+
+
+def critical_stretches(rows: xr.Dataset, system, along: str, start: str | None, scan: list[float]) -> list[tuple]:
+    """(row, x0, x1, class) of every stretch the file proves; the few-ulp brackets between them are left out. An
+    older file (no ``start``) gives its stable intervals only."""
+    b_lo, b_hi = np.asarray(rows["boundary_lower"]), np.asarray(rows["boundary_upper"])
+    above = np.asarray(rows[f"{system.label}_above"])
+    s_lo, s_hi = np.asarray(rows[f"{along}_stable_lower"]), np.asarray(rows[f"{along}_stable_upper"])
+    stretches = []
+    for r in range(b_lo.shape[0]):
+        if start is None:
+            stretches += [(r, lo, hi, system.stable_label) for lo, hi in zip(s_lo[r], s_hi[r]) if np.isfinite(lo)]
+            continue
+        ok = np.isfinite(b_lo[r])
+        cuts = [scan[0], *[v for pair in zip(b_lo[r][ok], b_hi[r][ok]) for v in pair], scan[1]]
+        classes = [int(np.asarray(rows[start])[r]), *above[r][ok].astype(int)]
+        stretches += [(r, cuts[2 * i], cuts[2 * i + 1], c) for i, c in enumerate(classes)]
+    return stretches
+
+
+def draw_stretches(ax, stretches: list[tuple], edges: np.ndarray, system) -> list[int]:
+    """Fill each stretch as a box between its row's cell ``edges``, in its class's colour; returns the classes drawn.
+
+    One box per point and stretch: joining neighbouring points would draw boundaries (and shade regions) that
+    were never computed wherever the classes change between points.
+    """
+    from matplotlib.collections import PolyCollection
+
+    present = sorted({c for *_, c in stretches})
+    for c in present:
+        boxes = [[(x0, edges[r]), (x0, edges[r + 1]), (x1, edges[r + 1]), (x1, edges[r])] for r, x0, x1, cc in stretches if cc == c]
+        hatch = HATCH_DEGENERATE if c < 0 and c != system.absent_label else None
+        ax.add_collection(PolyCollection(boxes, facecolors=system_colour(c, system), edgecolors="none", hatch=hatch))
+    return present
+
+
+def critical_legend(fig, system, present: list[int]) -> None:
+    """The classes drawn and the located changes (dots), beside the plot."""
+    from matplotlib.lines import Line2D
+
+    handles = [class_patch(c, system) for c in present]
+    handles.append(Line2D([], [], color="k", marker=".", ls="none", label=f"a change of {mathtext(system.label_symbol)},\nlocated"))
+    fig.legend(handles=handles, loc="outside right upper", alignment="left", frameon=False, title=system.label_title,
+               fontsize=9, title_fontsize=9)
+
+
+def critical_title(ds: xr.Dataset, along: str, old: bool, chosen: dict[str, float]) -> str:
+    """The file's title, what was scanned and how closely each change is located, and the values ``chosen``."""
+    title = fill_title(ds.attrs.get("title", "stabmap critical values"), 70)
+    title += f"\n{symbol(ds, along)} scanned, every change located to rtol {ds.attrs['critical_rtol']:g}"
+    if old:
+        title += " (stable intervals only: an older file)"
+    if chosen:
+        title += "; " + ", ".join(value_text(ds, k, float(ds[k].sel({k: v}, method="nearest"))) if k in ds.coords else f"{k} = {v:.4g}" for k, v in chosen.items())
+    return title
