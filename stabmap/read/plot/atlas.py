@@ -81,10 +81,10 @@ def atlas_figure(
 
     cmap, norm = class_colours(reduced.present, system)
     span = panel_points(width, nrows, ncols, facets=plan.facet is not None, strip=plan.y is None)
-    log = (log_axis(ds, plan.x), bool(plan.y) and log_axis(ds, plan.y))
+    log = (log_axis(ds, plan.x), plan.y is not None and log_axis(ds, plan.y))
     drawn = {"stability": False, "classes": False, "inferred": False, "light": False, "node-only": False,
              "node-only-light": False, "change": False}
-    for n, (ax, blocks, (r, c)) in enumerate(zip(axes, reduced.blocks, reduced.panels)):
+    for n, (ax, blocks, (r, c)) in enumerate(zip(axes, reduced.blocks, reduced.panels, strict=True)):
         for key, value in draw_panel(ax, blocks, xe, ye, system, cmap, norm, span, log).items():
             drawn[key] |= value
         if plan.facet is not None:
@@ -96,6 +96,7 @@ def atlas_figure(
         if plan.y:
             axes[0].set_ylabel(axis_label(ds, plan.y, width=45, shown=shown[plan.y]))
     else:
+        assert plan.y is not None  # plan_figure gives facets only to a map of two axes
         for n, ax in enumerate(axes):  # tick labels only where no panel is below / to the left
             ax.tick_params(labelbottom=n + ncols >= len(reduced.panels), labelleft=n % ncols == 0)
         maps.supxlabel(axis_label(ds, plan.x, width=int(12 * (size[0] - LEGEND_WIDTH)), shown=shown[plan.x]), fontsize=10)
@@ -152,14 +153,16 @@ def draw_panel(ax, blocks, xe: np.ndarray, ye: np.ndarray, system, cmap, norm, s
     change = (bits & FLAG_CHANGE) > 0
     near_stable = touches_stability(blocks, stable) if stable is not None else np.zeros(values.shape, dtype=bool)
     drawn["change"] = bool(change.any())
-    for mask, col, gid in ((mixed & ~blocks.mixed_stability, CLASS_EDGE, "mixed-class-blocks"), (blocks.mixed_stability, BOUNDARY, "mixed-stability-blocks"),
+    for mask, col, gid in ((mixed & ~blocks.mixed_stability, CLASS_EDGE, "mixed-class-blocks"),
+                           (blocks.mixed_stability, BOUNDARY, "mixed-stability-blocks"),
                            (change & ~near_stable, CLASS_EDGE, "change-cells"), (change & near_stable, BOUNDARY, "stability-change-cells")):
         if mask.any():
             paint_cells(ax, mask, xe, ye, col, gid, vector=gid.endswith("-cells") and tuple(blocks.factors) == (1, 1))
     stab, other = cell_edge_boundaries(codes, xe, ye, stable, state=state)
     for segs, widest, col, gid in ((other, 0.6, CLASS_EDGE, "class-boundary"), (stab, 1.5, BOUNDARY, "stability-boundary")):
         widths = boundary_widths(segs, xe, ye, span, widest, log=log, codes=codes)
-        lines = LineCollection(segs, colors=col, linewidths=widths, capstyle="projecting", joinstyle="miter", zorder=3 + (gid == "stability-boundary"))
+        lines = LineCollection(segs, colors=col, linewidths=widths, capstyle="projecting", joinstyle="miter",
+                               zorder=3 + (gid == "stability-boundary"))
         lines.set_gid(gid)
         ax.add_collection(lines, autolim=False)
     drawn["stability"], drawn["classes"] = len(stab) > 0, len(other) > 0
@@ -169,6 +172,7 @@ def draw_panel(ax, blocks, xe: np.ndarray, ye: np.ndarray, system, cmap, norm, s
 def panel_title(ds: xr.Dataset, plan: FigurePlan, system, blocks, r: int | None, c: int, share: AreaShares | None) -> str:
     """A small multiple's title: its facet (and row) value, and its share proved stable (of its area with
     ``share``, else of its grid points)."""
+    assert plan.facet is not None  # only small multiples have panel titles
     parts = [value_text(ds, plan.facet, float(ds[plan.facet][c]))]
     if plan.row is not None:
         parts.append(value_text(ds, plan.row, float(ds[plan.row][r])))

@@ -120,7 +120,9 @@ def fill_mathtext(text: str, chars: int) -> str:
     def shown(word: str) -> int:  # '$\\kappa_{2}$' shows as two characters
         return len(re.sub(r"[${}^_]", "", re.sub(r"\\[A-Za-z]+", "x", word)))
 
-    lines, line, width = [], [], 0
+    lines: list[str] = []
+    line: list[str] = []
+    width = 0
     for word in re.split(r"(?<=[,;:]) (?![\d-])", text):  # a list of values (E = 1e-4, 2e-5) stays on one line
         word = word.replace(" ", "\u00a0")
         w = shown(word)

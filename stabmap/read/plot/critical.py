@@ -10,8 +10,8 @@ from ... import systems
 from ...errors import StabmapError, given
 from .captions import captioned_figure, fill_title
 from .geometry import cell_edges
-from .layout import VALUE
 from .labels import axis_label, log_ticks, mathtext, symbol, value_text
+from .layout import VALUE
 from .palette import HATCH_DEGENERATE, class_patch, system_colour
 
 
@@ -100,10 +100,10 @@ def critical_stretches(rows: xr.Dataset, system, along: str, start: str | None, 
     stretches = []
     for r in range(b_lo.shape[0]):
         if start is None:
-            stretches += [(r, lo, hi, system.stable_label) for lo, hi in zip(s_lo[r], s_hi[r]) if np.isfinite(lo)]
+            stretches += [(r, lo, hi, system.stable_label) for lo, hi in zip(s_lo[r], s_hi[r], strict=True) if np.isfinite(lo)]
             continue
         ok = np.isfinite(b_lo[r])
-        cuts = [scan[0], *[v for pair in zip(b_lo[r][ok], b_hi[r][ok]) for v in pair], scan[1]]
+        cuts = [scan[0], *[v for pair in zip(b_lo[r][ok], b_hi[r][ok], strict=True) for v in pair], scan[1]]
         classes = [int(np.asarray(rows[start])[r]), *above[r][ok].astype(int)]
         stretches += [(r, cuts[2 * i], cuts[2 * i + 1], c) for i, c in enumerate(classes)]
     return stretches
@@ -142,5 +142,6 @@ def critical_title(ds: xr.Dataset, along: str, old: bool, chosen: dict[str, floa
     if old:
         title += " (stable intervals only: an older file)"
     if chosen:
-        title += "; " + ", ".join(value_text(ds, k, float(ds[k].sel({k: v}, method="nearest"))) if k in ds.coords else f"{k} = {v:.4g}" for k, v in chosen.items())
+        title += "; " + ", ".join(value_text(ds, k, float(ds[k].sel({k: v}, method="nearest"))) if k in ds.coords else f"{k} = {v:.4g}"
+                                  for k, v in chosen.items())
     return title

@@ -74,18 +74,19 @@ def cell_edge_boundaries(
     """
     v = np.asarray(values)
     xe, ye = np.asarray(xedges, dtype=float), np.asarray(yedges, dtype=float)
-    stable = v == stable if state is None else np.asarray(state)
+    is_stable = v == stable if state is None else np.asarray(state)
     dv, dh = v[:, 1:] != v[:, :-1], v[1:, :] != v[:-1, :]
-    sv, sh = stable[:, 1:] != stable[:, :-1], stable[1:, :] != stable[:-1, :]
+    sv, sh = is_stable[:, 1:] != is_stable[:, :-1], is_stable[1:, :] != is_stable[:-1, :]
     return segments(sv, sh, xe, ye), segments(dv & ~sv, dh & ~sh, xe, ye)
 
 
 def rectangles(mask: np.ndarray, xe: np.ndarray, ye: np.ndarray) -> list[np.ndarray]:
     """The marked cells as few rectangles: runs along x, merged with identical runs in the rows above."""
     line, start, stop = runs(mask)
-    open_, done = {}, []
+    open_: dict[tuple[int, int], tuple[int, int]] = {}  # a run (start, stop) along x -> its rows [j0, j1)
+    done: list[tuple[int, int, int, int]] = []
     previous = -1
-    for j, a, b in zip(line, start, stop):
+    for j, a, b in zip(line, start, stop, strict=True):
         if j != previous:  # close runs that did not continue into this row
             for key, (j0, j1) in list(open_.items()):
                 if j1 < j:

@@ -139,7 +139,8 @@ def plan_figure(
         facet = facet or rest.pop(0)
     row = rest.pop(0) if len(free) >= 4 else None
 
-    fixed, notes = {}, []
+    fixed: dict[str, tuple[int, float | None]] = {}
+    notes = []
     for k, v in sel.items():
         values = np.asarray(ds[k], dtype=float)
         fixed[k] = (int(np.argmin(np.abs(values - v))), float(v))
@@ -150,7 +151,8 @@ def plan_figure(
         fixed[d] = (0, None)
         notes.append(f"{d} fixed at its first value (choose with {given('sel', VALUE, d)})")
 
-    facet_index = row_index = ()
+    facet_index: tuple[int, ...] = ()
+    row_index: tuple[int, ...] = ()
     panel_notes = []
     if facet is not None:
         n_f = ds.sizes[facet]
@@ -200,7 +202,7 @@ def panel_pixels(width: float, nrows: int, ncols: int, *, facets: bool, strip: b
         maps = (1 if strip else _SINGLE_HEIGHT, width - _SINGLE_MARGIN)
     else:
         maps = ((_PANEL_HEIGHT - _PANEL_TITLE) * 1.0, (width - LEGEND_WIDTH - _FACET_MARGIN) / ncols - _PANEL_GAP)
-    return tuple(max(1, int(dpi * v)) for v in maps)
+    return max(1, int(dpi * maps[0])), max(1, int(dpi * maps[1]))
 
 
 def panel_points(width: float, nrows: int, ncols: int, *, facets: bool, strip: bool) -> tuple[float, float]:

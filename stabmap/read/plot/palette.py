@@ -81,11 +81,13 @@ def legend_handles(system, present: list[int], drawn: dict[str, bool]) -> list:
     if drawn["classes"]:
         handles.append(Line2D([], [], color=CLASS_EDGE, lw=0.6, label=f"{mathtext(system.label_symbol)} changes"))
     if drawn["inferred"] and not drawn["light"]:
-        handles.append(Patch(facecolor="white", edgecolor="#00000066", lw=0, hatch=HATCH_INFERRED, label="inferred from cell\ncorners (not computed)"))
+        handles.append(Patch(facecolor="white", edgecolor="#00000066", lw=0, hatch=HATCH_INFERRED,
+                             label="inferred from cell\ncorners (not computed)"))
     elif drawn["inferred"]:
         handles.append(Patch(facecolor="#DDDDDD", edgecolor="none", label="lighter: inferred from cell\ncorners (not computed)"))
     if drawn["node-only"] and not drawn["node-only-light"]:
-        handles.append(Patch(facecolor="white", edgecolor="#00000066", lw=0, hatch=HATCH_NODE_ONLY, label="proved at the grid node,\nnot over its cell"))
+        handles.append(Patch(facecolor="white", edgecolor="#00000066", lw=0, hatch=HATCH_NODE_ONLY,
+                             label="proved at the grid node,\nnot over its cell"))
     elif drawn["node-only"]:
         handles.append(Patch(facecolor="#DDDDDD", edgecolor="none", label="lighter: proved at the grid\nnode, not over its cell"))
     if drawn["change"]:
