@@ -5,6 +5,10 @@ Nothing here imports stabmap, xarray, dask or matplotlib; the labelled layer
 of lambda everywhere (as ``numpy.polynomial``).  This folder is installed as
 ``stabmap.kernels`` (PyPI has an unrelated top-level ``kernels`` package); its
 modules import each other relatively, so they work under either name.
+
+``layout`` names the columns of the parameter arrays (``body[k, layout.OMEGA]``), the slots of the state arrays
+and the fields of the block workspaces (namedtuples: ``ws.state``, ``ws.pws.beta``); the labelled layer fills the
+arrays by the same names (docs/speed.md, "Named layouts, at no cost").
 """
 
 from .block import allatonce_block, box_block, charpoly_block, count_block, decide_block, linearise_block, nodes_box_block

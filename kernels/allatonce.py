@@ -30,7 +30,7 @@ import numpy as np
 from numba import types
 from numba.np.linalg import _LAPACK
 
-from . import ball, pencil
+from . import ball, layout, pencil
 from .inclusion import find_root, group_disks
 from .options import kernel
 
@@ -83,30 +83,27 @@ def allocate(n, nmodes):
     disc = np.empty(D, np.complex128)
     rad = np.empty(D)
     group = np.empty(D, np.int64)
-    # [0] X, Y hold a decomposition to refine; [1] cold starts; [2] points decided warm; [3] points left to skip
-    # (``certify.certify_point``); [4] the X, Y one point back continue this one (extrapolate from both);
-    # [5] the blocks changed at this point (a pair split or joined: columns moved, so no extrapolation next)
-    state = np.zeros(6, np.int64)
-    return mats, An, Mp, yk, yb, lam, size, vec, disc, rad, group, state
+    state = np.zeros(layout.ALLATONCE_STATE, np.int64)  # slots named in layout (AAO_HELD, ...)
+    return layout.AllatonceWork(mats, An, Mp, yk, yb, lam, size, vec, disc, rad, group, state)
 
 
 @kernel
 def pencil_balls(body, E, nmodes, pws, aw):
     """The balls of A (rows n..2n-1) and M', and the liquid rows' beta, from the pencil workspace ``pws``."""
-    mats, An, Mp, yk, yb, lam, size, vec, disc, rad, group, state = aw
-    mat, v, beta = pws[3], pws[4], pws[5]
+    An, Mp, yk, yb = aw.An, aw.Mp, aw.yk, aw.yb
+    mat, v, beta = pws.mat, pws.vec, pws.beta
     n = body.shape[0]
     An[:] = 0.0
     for k in range(n):
         for j in range(n):
-            An[0, k, j], An[1, k, j] = mat[8, k, j], mat[9, k, j]
-            Mp[0, k, j], Mp[1, k, j] = mat[6, k, j], mat[7, k, j]
-        Mp[0, k, k], Mp[1, k, k] = ball.radd(Mp[0, k, k], Mp[1, k, k], -v[2, k], v[3, k])
-        An[0, k, n + k], An[1, k, n + k] = -v[0, k], v[1, k]
+            An[0, k, j], An[1, k, j] = mat[layout.K_MID, k, j], mat[layout.K_RAD, k, j]
+            Mp[0, k, j], Mp[1, k, j] = mat[layout.M_MID, k, j], mat[layout.M_RAD, k, j]
+        Mp[0, k, k], Mp[1, k, k] = ball.radd(Mp[0, k, k], Mp[1, k, k], -v[layout.ESUM_MID, k], v[layout.ESUM_RAD, k])
+        An[0, k, n + k], An[1, k, n + k] = -v[layout.G_MID, k], v[layout.G_RAD, k]
     r = 0
     for j in range(n):
         for l in range(nmodes[j]):
-            gm, gr = ball.radd(body[j, 5], 0.0, -beta[0, j, l], beta[1, j, l])
+            gm, gr = ball.radd(body[j, layout.OMEGA], 0.0, -beta[0, j, l], beta[1, j, l])
             An[0, j, 2 * n + r], An[1, j, 2 * n + r] = ball.rmul(E[j, l], 0.0, gm, gr)
             yk[r], yb[0, r], yb[1, r] = j, beta[0, j, l], beta[1, j, l]
             r += 1
@@ -202,7 +199,8 @@ def verify(m, aw):
     Needs ``pencil_balls`` of this point.  Every bound is rigorous for every pencil in the balls; X, Y
     and L are any floats (a poor choice only makes the discs too large to decide).
     """
-    mats, An, Mp, yk, yb, lam, size, vec, disc, rad, group, state = aw
+    mats, An, Mp, yk, yb, lam = aw.mats, aw.An, aw.Mp, aw.yk, aw.yb, aw.lam
+    size, vec, disc, rad, group = aw.size, aw.vec, aw.disc, aw.rad, aw.group
     X, Y, Z, AX, R, G, F = mats[0], mats[1], mats[2], mats[3], mats[4], mats[5], mats[6]
     n, D = An.shape[1], X.shape[0]
     w, lw, xq, ra, rz, rr, one, rho = vec[0], vec[1], vec[2], vec[3], vec[4], vec[5], vec[6], vec[7]
@@ -343,7 +341,7 @@ def decompose(C, aw):
 
     Needs ``pencil_balls``.  False on failure (no convergence, a singular B X); C is overwritten.
     """
-    mats, An, Mp, yk, yb, lam, size, vec, disc, rad, group, state = aw
+    mats, An, Mp, yk, yb, lam, size, vec, rad = aw.mats, aw.An, aw.Mp, aw.yk, aw.yb, aw.lam, aw.size, aw.vec, aw.rad
     X, Y, Z, V, F = mats[0], mats[1], mats[2], mats[8], mats[6]
     n, D = An.shape[1], X.shape[0]
     # LAPACK reads Fortran order: hand it C transposed in memory
@@ -527,7 +525,7 @@ def refine(aw):
     small one leaves the decomposition accurate to about its square.  -1 if the stored decomposition is too far
     from this pencil (a pair turned real, or Y is no longer a near inverse).
     """
-    mats, An, Mp, yk, yb, lam, size, vec, disc, rad, group, state = aw
+    mats, An, Mp, yk, yb, lam, size, group, state = aw.mats, aw.An, aw.Mp, aw.yk, aw.yb, aw.lam, aw.size, aw.group, aw.state
     X, Y, Z, AX, H, T, P = mats[0], mats[1], mats[2], mats[3], mats[4], mats[5], mats[7]
     n, D = An.shape[1], X.shape[0]
     _products(X, AX, Z, An, Mp, yk, yb, n, D)
@@ -559,7 +557,7 @@ def refine(aw):
     # where two real eigenvalues met and left the axis, or a pair met it, the blocks change with them
     regrouped = _regroup(X, Y, H, size, mats[8], D)
     if regrouped:
-        state[5] = 1
+        state[layout.AAO_MOVED] = 1
     # the 2 x 2 diagonal blocks back to normal form [[a, b], [-b, a]] (S: H_bb S = S N), 1 x 1 ones read off
     j = 0
     while j < D:
@@ -603,7 +601,7 @@ def refine(aw):
             if not _transform(X, Y, H, j, s11, s12, s21, s22, D):
                 return -1.0
             size[j], size[j + 1] = 1, 1
-            state[5] = 1
+            state[layout.AAO_MOVED] = 1
             lam[j, 0], lam[j, 1], lam[j + 1, 0], lam[j + 1, 1] = H[j, j], 0.0, H[j + 1, j + 1], 0.0
             j += 2
             continue
@@ -652,16 +650,16 @@ def refine(aw):
 def extrapolate(aw):
     """X, Y linearly extrapolated from the last two points where they continue each other (else the last
     point's kept); the last point's saved for the next."""
-    mats, An, Mp, yk, yb, lam, size, vec, disc, rad, group, state = aw
+    mats, state = aw.mats, aw.state
     X, Y, Xp, Yp = mats[0], mats[1], mats[9], mats[10]
     D = X.shape[0]
     for i in range(D):
         for j in range(D):
             x, y = X[i, j], Y[i, j]
-            if state[4] == 1:
+            if state[layout.AAO_CONTINUES] == 1:
                 X[i, j], Y[i, j] = 2.0 * x - Xp[i, j], 2.0 * y - Yp[i, j]
             Xp[i, j], Yp[i, j] = x, y
-    state[5] = 0
+    state[layout.AAO_MOVED] = 0
 
 
 @kernel
@@ -692,9 +690,9 @@ def certify(body, E, nmodes, parent, m, pws, C, Mo, aw, warm):
     ``warm``: first refine the decomposition left by the previous point; cold (the eigenvectors of
     the float linearisation, into C with scratch Mo) if that fails or there is none.
     """
-    mats, An, Mp, yk, yb, lam, size, vec, disc, rad, group, state = aw
+    size, state = aw.size, aw.state
     pencil_balls(body, E, nmodes, pws, aw)
-    if warm and state[0] == 1:
+    if warm and state[layout.AAO_HELD] == 1:
         extrapolate(aw)
         moved = refine(aw)
         last = np.inf
@@ -705,21 +703,21 @@ def certify(body, E, nmodes, parent, m, pws, C, Mo, aw, warm):
                 tried = moved
                 nonreal = verify(m, aw)
                 if nonreal >= 0:
-                    state[2] += 1
-                    state[4] = 1 - state[5]
+                    state[layout.AAO_WARM] += 1
+                    state[layout.AAO_CONTINUES] = 1 - state[layout.AAO_MOVED]
                     return nonreal // 2, True
             if stop:
                 break
             last = moved
             moved = refine(aw)
-    state[0] = 0
-    state[4] = 0
+    state[layout.AAO_HELD] = 0
+    state[layout.AAO_CONTINUES] = 0
     if not pencil.linearisation(body, E, nmodes, parent, pws, C, Mo):
         return -1, False
-    state[1] += 1
+    state[layout.AAO_COLD] += 1
     if not decompose(C, aw):
         return -1, False
-    state[0] = 1
+    state[layout.AAO_HELD] = 1
     nonreal = verify(m, aw)
     if nonreal < 0:
         return -1, False

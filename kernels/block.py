@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import certify, dd, pencil
+from . import certify, dd, layout, pencil
 from .boxcount import middle
 from .charpoly import allocate, block_det, charpoly_point, diagonal_blocks, matrix_box, matrix_point, same_structure
 from .count import allocate_count, count_box, count_nodes, count_point, fails_at_nodes
@@ -85,11 +85,11 @@ def _count_coefficients(body, joint, at, g, E, kappa, nmodes, parent, rowdeg, fr
 
 @kernel
 def _count_matrix(ws, rowdeg, c, cs, starts, inclusion, box):
-    """(N_c, status) from the interval matrix P in ws[5], factor by factor: the same N_c for every P it holds.
+    """(N_c, status) from the interval matrix P in ws.P, factor by factor: the same N_c for every P it holds.
 
     ``box``: P encloses a box of parameter points, and each factor is counted by ``count_box``.
     """
-    nblocks = diagonal_blocks(ws[5], starts)
+    nblocks = diagonal_blocks(ws.P, starts)
     total, status = 0, DECIDED_FLOAT
     for b in range(nblocks):
         d = block_det(ws, rowdeg, starts[b], starts[b + 1], c)
@@ -167,7 +167,7 @@ def allatonce_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, 
     for p in range(npts):
         reuse = same_structure(body, joint, at, g, p)
         out_nc[p], out_status[p] = certify.allatonce_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, cws, reuse)
-    return cws[-1][-1][1]
+    return cws.aw.state[layout.AAO_COLD]
 
 
 @kernel
@@ -222,7 +222,7 @@ def box_block(body, rbody, joint, rjoint, g, rg, E, kappa, nmodes, free, parent,
 def _box_ok(body, rb):
     """False for a box the enclosures cannot take: a radius not finite and >= 0, or a magnitude beyond dd.LARGE."""
     for k in range(body.shape[0]):
-        for col in range(6):
+        for col in range(layout.NBODY):
             r = rb[k, col]
             if not (r >= 0.0 and r < dd.LARGE and abs(body[k, col]) < dd.LARGE):
                 return False

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import allatonce, approximations, ball, disks, elimination, pencil
+from . import allatonce, approximations, ball, disks, elimination, layout, pencil
 from .approximations import RIDE
 from .options import kernel
 from .status import DECIDED_ALLATONCE, DECIDED_DISKS, DECIDED_INERTIA, UNDECIDED
@@ -80,13 +80,10 @@ def allocate(n, nmodes, parent):
     feat = np.empty(nfeat)
     R = np.empty(degree)
     group = np.empty(degree, np.int64)
-    # state: [0] the previous point was decided, [1] its degree d, [2] points left to do cold,
-    # [3] zold holds the roots of the point before the previous one,
-    # [4] the workspace holds the structure (M T, K T) of the last point given,
-    # [5] the all-at-once certificate's cold starts in a row, [6] its last pause (points)
-    state = np.zeros(7, np.int64)
-    # running means: cost of a warm start (n x n solves), its hit rate (hoped 1 until tried), cost of a cold start
-    costs = np.array([0.0, 1.0, 0.0])
+    state = np.zeros(layout.CERTIFY_STATE, np.int64)  # slots named in layout (PREV_DECIDED, ...)
+    # running means (layout.WARM_COST, WARM_HITS, COLD_COST): the hit rate is hoped 1 until tried
+    costs = np.zeros(layout.CERTIFY_COSTS)
+    costs[layout.WARM_HITS] = 1.0
     zold = np.empty(degree, np.complex128)
     bold = np.zeros((n, lmax))  # beta of the previous point
     dm = np.empty((n, n), np.complex128)
@@ -94,7 +91,8 @@ def allocate(n, nmodes, parent):
     centre = np.empty(degree, np.complex128)
     done = np.empty(degree, np.bool_)
     aw = allatonce.allocate(n, nmodes)  # the all-at-once certificate's scratch and its decomposition
-    return pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw
+    return layout.CertifyWork(pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold,
+                              costs, aw)
 
 
 @kernel
@@ -120,7 +118,7 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
     suspects, and the caller counts again with ``with_poles`` True.
     """
     n = body.shape[0]
-    beta = pws[5]
+    beta = pws.beta
     nr = 0
     for i in range(d):
         # only approximations that may be real need separating: the others' disks prove them
@@ -266,7 +264,8 @@ def _attempt(z, d, m, degree, body, E, nmodes, parent, ws, sweeps):
     approximations of non-real roots by at most as many Aberth sweeps (a
     neighbour's roots are good enough for separators, not for disks).
     """
-    pws, C, Mo, wr, wi, vdummy, _z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
+    pws, F, dF, Sm, Sr, R, group, done = ws.pws, ws.F, ws.dF, ws.Sm, ws.Sr, ws.R, ws.group, ws.done
+    feat, dm, dr, centre = ws.feat, ws.dm, ws.dr, ws.centre
     # approximations from the eigenvalue problem (no sweeps) are accurate: separators between them alone
     # usually prove every real root; a neighbour's, extrapolated, often leave suspects, so those count at once
     # with the poles fenced
@@ -331,37 +330,38 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     The previous point given to the same workspace is taken as a grid
     neighbour: its roots are tried first.
     """
-    pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
+    pws, z, F, dF, Sm, Sr, R, group, done = ws.pws, ws.z, ws.F, ws.dF, ws.Sm, ws.Sr, ws.R, ws.group, ws.done
+    state, costs, zold, bold, aw = ws.state, ws.costs, ws.zold, ws.bold, ws.aw
     n = body.shape[0]
-    degree = C.shape[0]
+    degree = ws.C.shape[0]
     # M T and K T in the workspace are the previous point's only if it got as far as prepare
-    reuse = reuse and state[4] == 1
-    state[4] = 0
+    reuse = reuse and state[layout.KEPT] == 1
+    state[layout.KEPT] = 0
     if not moderate(body, joint, at, g, E, kappa, nmodes):
-        state[0] = 0
+        state[layout.PREV_DECIDED] = 0
         return -1, UNDECIDED
     m = pencil.prepare(body, joint, at, g, E, kappa, nmodes, parent, free, pws, reuse)
-    state[4] = 1
+    state[layout.KEPT] = 1
     d = degree - m
     ok, lead_m, lead_e = disks.lead_bound(pws, n, Sm, Sr)
     if not ok:  # deg p unproved: nothing below counts
-        state[0] = 0
+        state[layout.PREV_DECIDED] = 0
         return -1, UNDECIDED
     first = _allatonce_first(n, degree, m)
     skipped = False
     if first > 0:
         nc, skipped = _allatonce(body, E, nmodes, parent, m, ws, first == FEW)
         if nc >= 0:
-            state[0] = 0  # the roots in z are not this point's
+            state[layout.PREV_DECIDED] = 0  # the roots in z are not this point's
             return nc, DECIDED_ALLATONCE
     nc, status = -1, UNDECIDED
     # 1. a grid neighbour's roots, extrapolated, usually separate this point's: no eigenvalue problem
-    neighbour = state[0] == 1 and state[1] == d
+    neighbour = state[layout.PREV_DECIDED] == 1 and state[layout.PREV_DEGREE] == d
     if neighbour:
-        approximations.predict(z, zold, d, state[3] == 1, nmodes, pws[5], bold)
-    state[3] = 1 if neighbour else 0
-    bold[:] = pws[5][0]
-    if neighbour and state[2] <= 0:
+        approximations.predict(z, zold, d, state[layout.HISTORY] == 1, nmodes, pws.beta, bold)
+    state[layout.HISTORY] = 1 if neighbour else 0
+    bold[:] = pws.beta[layout.MID]
+    if neighbour and state[layout.COLD_LEFT] <= 0:
         real, nc, status, warm = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, WARM_STEPS)
         suspects = done[:d].sum()
         if status == UNDECIDED and 0 < suspects <= d // 4:
@@ -381,16 +381,17 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
             warm += more
         # try warm starts while they pay: their mean cost below the cold start's times their hit rate
         # (scattered points, or grid neighbours too far apart, make them fail or cost too much)
-        costs[0] = (1 - SMOOTH) * costs[0] + SMOOTH * warm if costs[0] > 0 else warm
-        costs[1] = (1 - SMOOTH) * costs[1] + SMOOTH * (status != UNDECIDED)
-        if costs[2] > 0 and costs[0] > costs[1] * costs[2]:
-            state[2] = PAUSE
-    elif state[2] > 0:
-        state[2] -= 1
+        costs[layout.WARM_COST] = (1 - SMOOTH) * costs[layout.WARM_COST] + SMOOTH * warm if costs[layout.WARM_COST] > 0 else warm
+        costs[layout.WARM_HITS] = (1 - SMOOTH) * costs[layout.WARM_HITS] + SMOOTH * (status != UNDECIDED)
+        if costs[layout.COLD_COST] > 0 and costs[layout.WARM_COST] > costs[layout.WARM_HITS] * costs[layout.COLD_COST]:
+            state[layout.COLD_LEFT] = PAUSE
+    elif state[layout.COLD_LEFT] > 0:
+        state[layout.COLD_LEFT] -= 1
     # 2. approximations from the linearisation, 3. polished by Aberth sweeps, 4. every disk
     if status == UNDECIDED:
-        state[3] = 0  # the eigenvalues come in their own order: no history to extrapolate from
-        if pencil.linearisation(body, E, nmodes, parent, pws, C, Mo) and approximations.eigenvalues(C, wr, wi, vdummy, z, degree, m):
+        state[layout.HISTORY] = 0  # the eigenvalues come in their own order: no history to extrapolate from
+        C = ws.C
+        if pencil.linearisation(body, E, nmodes, parent, pws, C, ws.Mo) and approximations.eigenvalues(C, ws.wr, ws.wi, ws.vdummy, z, degree, m):
             cold = _eigenvalue_price(n, degree)
             real, nc, status, more = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, 0)
             cold += more
@@ -399,7 +400,7 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
                 cold += approximations.aberth(z, d, m, COLD_SWEEPS, body, E, nmodes, pws, F, dF, done, approximations.STEP_TOL)
                 real, nc, status, more = _attempt(z, d, m, degree, body, E, nmodes, parent, ws, 0)
                 cold += more
-            costs[2] = (1 - SMOOTH) * costs[2] + SMOOTH * cold if costs[2] > 0 else cold
+            costs[layout.COLD_COST] = (1 - SMOOTH) * costs[layout.COLD_COST] + SMOOTH * cold if costs[layout.COLD_COST] > 0 else cold
             if status == UNDECIDED:
                 nonreal = disks.nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e)
                 if real + nonreal == degree and nonreal % 2 == 0:
@@ -407,12 +408,12 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     if status == UNDECIDED and skipped:
         # the disks did not decide a point the all-at-once certificate skipped in a pause: it tries, cold, before
         # the point goes to exact arithmetic (ill-conditioned identical chains, say, which only it decides)
-        nc, _ = allatonce.certify(body, E, nmodes, parent, m, pws, C, Mo, aw, False)
+        nc, _ = allatonce.certify(body, E, nmodes, parent, m, pws, ws.C, ws.Mo, aw, False)
         if nc >= 0:
-            state[0] = 0
+            state[layout.PREV_DECIDED] = 0
             return nc, DECIDED_ALLATONCE
-    state[0] = 1 if status != UNDECIDED else 0
-    state[1] = d
+    state[layout.PREV_DECIDED] = 1 if status != UNDECIDED else 0
+    state[layout.PREV_DEGREE] = d
     return nc, status
 
 
@@ -437,21 +438,21 @@ def _allatonce(body, E, nmodes, parent, m, ws, few):
     pauses after COLD_RUN cold starts in a row too (scattered points).  PAUSE points first, twice as many after
     each pause that did not end the run, up to PAUSE_MAX; a point decided warm ends it.
     """
-    pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
-    flags = aw[-1]
-    if flags[3] > 0:
-        flags[3] -= 1
-        flags[0] = 0  # the decomposition kept is too old to refine
+    pws, C, Mo, state, aw = ws.pws, ws.C, ws.Mo, ws.state, ws.aw
+    flags = aw.state  # the all-at-once certificate's own slots
+    if flags[layout.AAO_SKIP] > 0:
+        flags[layout.AAO_SKIP] -= 1
+        flags[layout.AAO_HELD] = 0  # the decomposition kept is too old to refine
         return -1, True
     nc, warm = allatonce.certify(body, E, nmodes, parent, m, pws, C, Mo, aw, True)
     if warm:
-        state[5], state[6] = 0, 0
+        state[layout.AAO_COLD_RUN], state[layout.AAO_PAUSE] = 0, 0
     else:
-        state[5] += 1
-        if nc < 0 or (few and state[5] >= COLD_RUN):
-            state[6] = min(2 * state[6], PAUSE_MAX) if state[6] > 0 else PAUSE
-            flags[3] = state[6]
-            state[5] = 0
+        state[layout.AAO_COLD_RUN] += 1
+        if nc < 0 or (few and state[layout.AAO_COLD_RUN] >= COLD_RUN):
+            state[layout.AAO_PAUSE] = min(2 * state[layout.AAO_PAUSE], PAUSE_MAX) if state[layout.AAO_PAUSE] > 0 else PAUSE
+            flags[layout.AAO_SKIP] = state[layout.AAO_PAUSE]
+            state[layout.AAO_COLD_RUN] = 0
     return nc, False
 
 
@@ -460,12 +461,12 @@ def allatonce_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reus
     """(N_c, status) of one point by the all-at-once certificate alone (section 4b): DECIDED_ALLATONCE or
     UNDECIDED, never another proof (for tests and benchmarks).  The previous point's decomposition is refined
     first; ``reuse`` as for ``certify_point``."""
-    pws, C, Mo, wr, wi, vdummy, z, F, dF, Sm, Sr, feat, R, group, state, dm, dr, centre, done, zold, bold, costs, aw = ws
-    reuse = reuse and state[4] == 1
-    state[4] = 0
+    pws, C, Mo, state, aw = ws.pws, ws.C, ws.Mo, ws.state, ws.aw
+    reuse = reuse and state[layout.KEPT] == 1
+    state[layout.KEPT] = 0
     if not moderate(body, joint, at, g, E, kappa, nmodes):
         return -1, UNDECIDED
     m = pencil.prepare(body, joint, at, g, E, kappa, nmodes, parent, free, pws, reuse)
-    state[4] = 1
+    state[layout.KEPT] = 1
     nc, warm = allatonce.certify(body, E, nmodes, parent, m, pws, C, Mo, aw, True)
     return (nc, DECIDED_ALLATONCE) if nc >= 0 else (-1, UNDECIDED)

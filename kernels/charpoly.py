@@ -18,7 +18,8 @@ of being smeared into tiny nonzero coefficients.
 
 Every number is an interval (hi, lo, rad) of ``dd.py`` stored along a last axis
 of length 3.  Per-point parameter layout (all float64):
-  body[k]   = (m, A, C, c, s, omega) of body k (0-based); s is not read here
+  body[k]   = (m, A, C, c, s, omega) of body k (0-based), columns named in ``layout``
+              (M, A, C, CM, S, OMEGA); s is not read here
   joint[k]  = stiffness of the joint of body k with its parent (joint[0]: the
               base joint, fixed support only; in a chain joint[k] = K_k)
   at[k]     = position of that joint on the parent's axis, measured from the
@@ -34,7 +35,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import dd
+from . import dd, layout
 from .options import kernel
 
 
@@ -74,7 +75,7 @@ def _lever_arms(body, rb, at, ra, parent, free, J):
     n = body.shape[0]
     J[:] = 0.0
     for k in range(n):
-        J[k, k, 0], J[k, k, 2] = body[k, 3], rb[k, 3]
+        J[k, k, 0], J[k, k, 2] = body[k, layout.CM], rb[k, layout.CM]
         child = k
         i = parent[k]
         while i >= 0:
@@ -85,14 +86,14 @@ def _lever_arms(body, rb, at, ra, parent, free, J):
         return
     mt = (0.0, 0.0, 0.0)
     for k in range(n):
-        mt = dd.add(*mt, body[k, 0], 0.0, rb[k, 0])
+        mt = dd.add(*mt, body[k, layout.M], 0.0, rb[k, layout.M])
     if not dd.certain_nonzero(*mt):  # a box whose total mass may be 0: no enclosure, so nothing is proved
         J[:] = np.nan
         return
     for i in range(n):
         s = (0.0, 0.0, 0.0)
         for j in range(n):
-            s = dd.fma(*s, body[j, 0], 0.0, rb[j, 0], J[j, i, 0], J[j, i, 1], J[j, i, 2])
+            s = dd.fma(*s, body[j, layout.M], 0.0, rb[j, layout.M], J[j, i, 0], J[j, i, 1], J[j, i, 2])
         mh, ml, mr = dd.div(*s, *mt)
         for k in range(n):
             J[k, i, 0], J[k, i, 1], J[k, i, 2] = dd.add(J[k, i, 0], J[k, i, 1], J[k, i, 2], -mh, -ml, mr)
@@ -137,7 +138,7 @@ def _stiffness_T(body, rb, joint, rj, at, ra, parent, g, rg, free, sub, K, u):
     for k in range(n - 1, -1, -1):
         outboard = (0.0, 0.0, 0.0)  # mass of the bodies beyond body k
         leaf = True
-        a = dd.mul(body[k, 0], 0.0, rb[k, 0], body[k, 3], 0.0, rb[k, 3])
+        a = dd.mul(body[k, layout.M], 0.0, rb[k, layout.M], body[k, layout.CM], 0.0, rb[k, layout.CM])
         for j in range(k + 1, n):
             if parent[j] != k:
                 continue
@@ -152,7 +153,7 @@ def _stiffness_T(body, rb, joint, rj, at, ra, parent, g, rg, free, sub, K, u):
         while j >= 0:  # row k of -g diag(a) T: the bodies on the path to k
             K[k, j, 0], K[k, j, 1], K[k, j, 2] = dd.add(K[k, j, 0], K[k, j, 1], K[k, j, 2], *dd.neg(*ga))
             j = parent[j]
-        _set(sub, k, dd.add(*outboard, body[k, 0], 0.0, rb[k, 0]))
+        _set(sub, k, dd.add(*outboard, body[k, layout.M], 0.0, rb[k, layout.M]))
 
 
 @kernel
@@ -161,9 +162,9 @@ def _inertia_T(body, rb, parent, J, M):
     n = body.shape[0]
     for i in range(n):
         for j in range(n):
-            acc = (body[i, 1], 0.0, rb[i, 1]) if i == j else (0.0, 0.0, 0.0)
+            acc = (body[i, layout.A], 0.0, rb[i, layout.A]) if i == j else (0.0, 0.0, 0.0)
             for k in range(n):
-                t = dd.mul(body[k, 0], 0.0, rb[k, 0], J[k, i, 0], J[k, i, 1], J[k, i, 2])
+                t = dd.mul(body[k, layout.M], 0.0, rb[k, layout.M], J[k, i, 0], J[k, i, 1], J[k, i, 2])
                 acc = dd.fma(*acc, *t, J[k, j, 0], J[k, j, 1], J[k, j, 2])
             _set(M[i], j, acc)
     # Column j of M T collects the columns of M of the subtree of j: add each column into its
@@ -226,9 +227,9 @@ def _matrix(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, 
     P[:] = 0.0
     for k in range(n):
         L = nmodes[k]
-        omega, romega = body[k, 5], rb[k, 5]
+        omega, romega = body[k, layout.OMEGA], rb[k, layout.OMEGA]
         _liquid_polys(omega, romega, E[k], kappa[k], L, q, w)
-        G = dd.mul(body[k, 2], 0.0, rb[k, 2], omega, 0.0, romega)  # C_k omega_k
+        G = dd.mul(body[k, layout.C], 0.0, rb[k, layout.C], omega, 0.0, romega)  # C_k omega_k
         for j in range(n):
             e = P[k, j]
             # P_kj = Q (lambda^2 MT_kj + lambda GT_kj - KT_kj) - T_kj lambda^2 (lambda + omega) R
@@ -361,7 +362,7 @@ def allocate(n, lmax, degree, parent):
     path_matrix(parent, T)
     sub = np.empty((n, 3))
     zero, zero1 = np.zeros((n, 6)), np.zeros(n)  # the parameters' radii at a single point
-    return J, M, K, q, w, P, D, T, sub, zero, zero1
+    return layout.CharpolyWork(J, M, K, q, w, P, D, T, sub, zero, zero1)
 
 
 @kernel
@@ -372,7 +373,7 @@ def same_structure(body, joint, at, g, p):
     for k in range(body.shape[1]):
         if joint[p, k] != joint[p - 1, k] or at[p, k] != at[p - 1, k]:
             return False
-        for col in range(5):  # m, A, C, c, s; column 5 is omega
+        for col in layout.STRUCTURE:  # omega may differ
             if body[p, k, col] != body[p - 1, k, col]:
                 return False
     return True
@@ -380,27 +381,27 @@ def same_structure(body, joint, at, g, p):
 
 @kernel
 def matrix_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
-    """Build P = diag(Q) Phi T of one point into ws[5]; ws from ``allocate`` (with this parent)."""
-    J, M, K, q, w, P, D, T, sub, zero, zero1 = ws
+    """Build P = diag(Q) Phi T of one point into ws.P; ws from ``allocate`` (with this parent)."""
+    J, M, K, q, w, P, T, sub, zero, zero1 = ws.J, ws.M, ws.K, ws.q, ws.w, ws.P, ws.T, ws.sub, ws.zero, ws.zero1
     _matrix(body, zero, joint, zero1, at, zero1, g, 0.0, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, reuse)
 
 
 @kernel
 def matrix_box(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, ws, u=1.0):
-    """Build P of a box of parameters into ws[5]: every parameter x within its radius r (x +- r) of the
+    """Build P of a box of parameters into ws.P: every parameter x within its radius r (x +- r) of the
     midpoint given (rb, rj, ra, rg: radii shaped as body, joint, at and g).  The intervals of P then hold
     P at every point of the box.  E and kappa are points (they are never scanned).
 
     u (a float > 0): the joints and g are taken times u, the product exact in double-double.  The spin-scaled
     model's node u_i (docs/certification.md, section 6): formed here, its inputs need no rounding radius."""
-    J, M, K, q, w, P, D, T, sub, zero, zero1 = ws
+    J, M, K, q, w, P, T, sub = ws.J, ws.M, ws.K, ws.q, ws.w, ws.P, ws.T, ws.sub
     _matrix(body, rb, joint, rj, at, ra, g, rg, E, kappa, nmodes, parent, free, T, sub, J, M, K, q, w, P, False, u)
 
 
 @kernel
 def block_det(ws, rowdeg, i0, i1, out):
     """Enclosure of det P[i0:i1, i0:i1] (after ``matrix_point``) into out; returns its degree bound."""
-    P, D = ws[5], ws[6]
+    P, D = ws.P, ws.D
     _laplace_det(P[i0:i1, i0:i1], rowdeg[i0:i1], D, out)
     return int(rowdeg[i0:i1].sum())
 

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from . import dd
+from . import dd, layout
 from .boxcount import count_complex_pairs_box, middle, over_grid, separators_spread
 from .inclusion import count_complex_pairs_inclusion
 from .options import kernel
@@ -28,7 +28,7 @@ def allocate_count(degree):
     R = np.empty(degree)
     group = np.empty(2 * degree, np.int64)
     flags = np.empty(degree, np.bool_)
-    return W, X, a, z, R, group, flags
+    return layout.CountWork(W, X, a, z, R, group, flags)
 
 
 @kernel
@@ -39,7 +39,7 @@ def count_point(c, ws, inclusion=True):
     root inclusion (unless ``inclusion`` is False) needs no remainder chain and
     decides well-separated roots at any degree.  Whatever neither proves is UNDECIDED.
     """
-    W, X, a, z, R, group, flags = ws
+    W, X, a, z, R, group, flags = ws.W, ws.X, ws.a, ws.z, ws.R, ws.group, ws.flags
     nc, status = count_complex_pairs(c, W)
     if status != UNDECIDED or not inclusion:
         return nc, status
@@ -74,7 +74,7 @@ def count_box(c, ws):
     The Sturm sequence proves small boxes cheaply; wider ones need the sign changes and Newton disks of
     ``boxcount``, which chain no remainders.  UNDECIDED: the box must be split (or its points decided one by one).
     """
-    W, X, a, z, R, group, flags = ws
+    W, X, a, z, R, group, flags = ws.W, ws.X, ws.a, ws.z, ws.R, ws.group, ws.flags
     nc, status = count_complex_pairs(c, W)
     if status != UNDECIDED:
         return nc, status
@@ -98,7 +98,7 @@ def count_nodes(C, grid, ws, Xn, F, G, low0=-1, top0=-1):
     degree are the box's.  (low0, top0): the span ``fails_at_nodes`` left root approximations for; reused if it is
     the box's.
     """
-    W, X, a, z, R, group, flags = ws
+    a, z, R, group, flags = ws.a, ws.z, ws.R, ws.group, ws.flags
     N = grid[0] * grid[4]
     low, top = C.shape[1], -1
     for k in range(N):
@@ -140,7 +140,7 @@ def fails_at_nodes(C, probe, grid, ws, Xn):
     none; split where it answers True: 1 if the probed values moved mostly along t1 (SPLIT times more than along
     t2), 2 if mostly along t2, else 0: the box is best cut across that axis alone.
     """
-    W, X, a, z, R, group, flags = ws
+    a, z, R, flags = ws.a, ws.z, ws.R, ws.flags
     mid = middle(grid)
     low, top = nonzero_span(C[mid])
     if top < 0:

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from . import ball, elimination, pencil
+from . import ball, elimination, layout, pencil
 from .approximations import UPPER
 from .inclusion import find_root, group_disks
 from .options import kernel
@@ -26,7 +26,7 @@ SHIFTS = (2.0**-30, 2.0**-20, 2.0**-12)  # a Newton disk is centred this far (re
 def nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e):
     """Roots of p~ proved non-real by the disks of Braess & Hadeler around z (module docstring)."""
     n = body.shape[0]
-    cm, cr = pws[6], pws[7]
+    cm, cr = pws.cm, pws.cr
     for i in range(d):
         zi = z[i]
         ok, qm, qr = pencil.complex_matrix(zi, 0.0, body, E, nmodes, pws)
@@ -73,11 +73,11 @@ def nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e):
 @kernel
 def lead_bound(pws, n, Sm, Sr):
     """Lower bound of |det (M - diag(sum E))| (the leading coefficient of p) as (ok, mantissa, exponent)."""
-    mat, vec = pws[3], pws[4]
+    mat, vec = pws.mat, pws.vec
     for i in range(n):
         for j in range(i + 1):
-            Sm[i, j], Sr[i, j] = mat[6, i, j], mat[7, i, j]
-        Sm[i, i], Sr[i, i] = ball.radd(Sm[i, i], Sr[i, i], -vec[2, i], vec[3, i])
+            Sm[i, j], Sr[i, j] = mat[layout.M_MID, i, j], mat[layout.M_RAD, i, j]
+        Sm[i, i], Sr[i, i] = ball.radd(Sm[i, i], Sr[i, i], -vec[layout.ESUM_MID, i], vec[layout.ESUM_RAD, i])
     neg, mant, expo = elimination.ldl(Sm, Sr, n)
     return neg >= 0, mant, expo
 
@@ -98,9 +98,9 @@ def newton_disk(zc, d, m, body, E, nmodes, pws, dm, dr):
     if not math.isfinite(lr) or not ball.excludes_zero(zc, 0.0):
         return np.inf
     if n <= SMALL:
-        ok, tm, tr = elimination.trace_bound(pws[6], pws[7], dm, dr, n)
+        ok, tm, tr = elimination.trace_bound(pws.cm, pws.cr, dm, dr, n)
     else:
-        ok, tm, tr = elimination.trace_preconditioned(pws[6], pws[7], dm, dr, n)
+        ok, tm, tr = elimination.trace_preconditioned(pws.cm, pws.cr, dm, dr, n)
     if not ok:
         return np.inf
     sm, sr = ball.cadd(tm, tr, lm, lr)

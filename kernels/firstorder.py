@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import layout
 from .ball import ETA, INFL, U, excludes_zero, radd, rdiv, rmul
 from .charpoly import allocate, charpoly_point
 from .options import kernel
@@ -84,8 +85,8 @@ def first_order_block(body, joint, g, E, kappa, nmodes, free, parent, at, liquid
             k = liquid[j]
             bk[:, :] = body[p]
             # doubling A_k is exact in binary floating point (h = A_k); a massless shell takes h = 1
-            h = bk[k, 1] if bk[k, 1] != 0.0 else 1.0
-            bk[k, 1] = bk[k, 1] + h
+            h = bk[k, layout.A] if bk[k, layout.A] != 0.0 else 1.0
+            bk[k, layout.A] = bk[k, layout.A] + h
             charpoly_point(bk, joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, False)
             _balls(c, am, ar)
             for i in range(D + 1):
@@ -103,7 +104,7 @@ def first_order_block(body, joint, g, E, kappa, nmodes, free, parent, at, liquid
             qm, qr = 0.0, 0.0
             for j in range(nl):
                 vm, vr = _horner(dm[j], dr[j], xm, xr)
-                wm, wr = radd(xm, xr, body[p, liquid[j], 5], 0.0)
+                wm, wr = radd(xm, xr, body[p, liquid[j], layout.OMEGA], 0.0)
                 vm, vr = rmul(vm, vr, wm, wr)
                 vm, vr = rmul(vm, vr, eps[p, j], eps_r[p, j])
                 qm, qr = radd(qm, qr, vm, vr)

@@ -23,6 +23,7 @@ problem at this degree (BENCHMARKS.md, "Degree 2").
 
 from __future__ import annotations
 
+from . import layout
 from .certify import moderate
 from .options import kernel
 from .status import DECIDED_FLOAT, UNDECIDED
@@ -35,7 +36,7 @@ def one_top(body, joint, at, g, E, kappa, nmodes, free):
     """(N_c, status) of a one-body point without modes; UNDECIDED where the float filter cannot tell."""
     if not moderate(body, joint, at, g, E, kappa, nmodes):
         return -1, UNDECIDED
-    m, A, C, c, omega = body[0, 0], body[0, 1], body[0, 2], body[0, 3], body[0, 5]
+    m, A, C, c, omega = body[0, layout.M], body[0, layout.A], body[0, layout.C], body[0, layout.CM], body[0, layout.OMEGA]
     if free:
         # p = lambda (A lambda + C omega): both roots real once the degree is proved by A != 0
         return (0, DECIDED_FLOAT) if A != 0.0 else (-1, UNDECIDED)

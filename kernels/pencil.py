@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import ball
+from . import ball, layout
 from .dd import two_sum
 from .charpoly import check_parent, path_matrix, structure
 from .options import kernel
@@ -33,14 +33,14 @@ def allocate(n, lmax, parent):
     check_parent(parent, n)
     T = np.empty((n, n), np.bool_)
     path_matrix(parent, T)
-    dd = np.empty((3, n, n, 3))  # J, M T, K T in double-double intervals
+    jmk = np.empty((3, n, n, 3))  # J, M T, K T in double-double intervals
     sub = np.empty((n, 3))
-    mat = np.empty((10, n, n))  # MT mid, rad; KT mid, rad; unused; M mid, rad; K mid, rad
-    vec = np.zeros((4, n))  # G mid, rad; sum E mid, rad
+    mat = np.empty((layout.PENCIL_MAT, n, n))  # planes named in layout: M T, K T, M, K balls (mid, rad)
+    vec = np.zeros((layout.PENCIL_VEC, n))  # rows named in layout: G, sum E balls (mid, rad)
     beta = np.zeros((2, n, max(1, lmax)))  # mid, rad
     cm = np.empty((n, n), np.complex128)
     cr = np.empty((n, n))
-    return T, dd, sub, mat, vec, beta, cm, cr
+    return layout.PencilWork(T, jmk, sub, mat, vec, beta, cm, cr)
 
 
 @kernel
@@ -56,16 +56,16 @@ def prepare(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
     Returns the number m of exact zero roots: columns of K T that are exactly zero, and modes with beta exactly 0
     (kappa = 2, or omega_k = 0), each a factor z of prod Q with no pole in Phi (``_liquid_real``).
     """
-    T, dd, sub, mat, vec, beta, cm, cr = ws
+    T, jmk, sub, mat, vec, beta = ws.T, ws.jmk, ws.sub, ws.mat, ws.vec, ws.beta
     n = body.shape[0]
     if not reuse:
-        structure(body, joint, at, g, parent, free, sub, dd[0], dd[1], dd[2])
+        structure(body, joint, at, g, parent, free, sub, jmk[0], jmk[1], jmk[2])
         for i in range(n):
             for j in range(n):
-                mat[0, i, j], mat[1, i, j] = _to_ball(dd[1, i, j])
-                mat[2, i, j], mat[3, i, j] = _to_ball(dd[2, i, j])
+                mat[layout.MT_MID, i, j], mat[layout.MT_RAD, i, j] = _to_ball(jmk[1, i, j])
+                mat[layout.KT_MID, i, j], mat[layout.KT_RAD, i, j] = _to_ball(jmk[2, i, j])
         # M and K themselves: (X T) T^-1 subtracts from column i the columns of the children of i
-        mat[6:] = mat[:4]
+        mat[layout.M_MID : layout.K_RAD + 1] = mat[layout.MT_MID : layout.KT_RAD + 1]
         for c in range(n - 1, 0, -1):
             for k in range(n):
                 for a in (6, 8):
@@ -74,22 +74,22 @@ def prepare(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
                     )
     m = 0
     for k in range(n):
-        vec[0, k], vec[1, k] = ball.rmul(body[k, 2], 0.0, body[k, 5], 0.0)
+        vec[layout.G_MID, k], vec[layout.G_RAD, k] = ball.rmul(body[k, layout.C], 0.0, body[k, layout.OMEGA], 0.0)
         sm, sr = 0.0, 0.0
         for l in range(nmodes[k]):
             sm, sr = ball.radd(sm, sr, E[k, l], 0.0)
             # kappa - 2 exactly as a float pair, so beta is an exact zero when kappa == 2
             h, lo = two_sum(kappa[k, l], -2.0)
-            t = ball.rmul(body[k, 5], 0.0, h, abs(lo))
-            if h == 0.0 or body[k, 5] == 0.0:
+            t = ball.rmul(body[k, layout.OMEGA], 0.0, h, abs(lo))
+            if h == 0.0 or body[k, layout.OMEGA] == 0.0:
                 beta[0, k, l], beta[1, k, l] = 0.0, 0.0
                 m += 1
             else:
                 beta[0, k, l], beta[1, k, l] = ball.rdiv(t[0], t[1], kappa[k, l], 0.0)
-        vec[2, k], vec[3, k] = sm, sr
+        vec[layout.ESUM_MID, k], vec[layout.ESUM_RAD, k] = sm, sr
     # the exact zero roots: a column of K T that is exactly zero makes that column of Phi T divisible by z
     for j in range(n):
-        if not _column_nonzero(mat[2], mat[3], j):
+        if not _column_nonzero(mat[layout.KT_MID], mat[layout.KT_RAD], j):
             m += 1
     return m
 
@@ -131,7 +131,7 @@ def real_matrix(x, body, E, nmodes, parent, ws, Sm, Sr):
     diagonal entry is huge, where T^t Phi T would spread it over a block whose
     elimination then cancels it away with its radius left behind.
     """
-    T, dd, sub, mat, vec, beta, cm, cr = ws
+    mat, vec, beta = ws.mat, ws.vec, ws.beta
     n = body.shape[0]
     x2, x2r = ball.rmul(x, 0.0, x, 0.0)  # with ETA: x * x may underflow
     for k in range(n):
@@ -139,18 +139,18 @@ def real_matrix(x, body, E, nmodes, parent, ws, Sm, Sr):
         if not ok:
             return False
         # d_k = x G_k - x^2 (x + omega_k) a_k - x (x + omega_k) e_k   (e_k: the modes without a pole)
-        wm, wr = ball.radd(x, 0.0, body[k, 5], 0.0)
+        wm, wr = ball.radd(x, 0.0, body[k, layout.OMEGA], 0.0)
         t = ball.rmul(x2, x2r, wm, wr)
         t = ball.rmul(t[0], t[1], am, ar)
-        gm, gr = ball.rmul(x, 0.0, vec[0, k], vec[1, k])
+        gm, gr = ball.rmul(x, 0.0, vec[layout.G_MID, k], vec[layout.G_RAD, k])
         dm, dr = ball.radd(gm, gr, -t[0], t[1])
         if em != 0.0:
             t = ball.rmul(x, 0.0, wm, wr)
             t = ball.rmul(t[0], t[1], em, er)
             dm, dr = ball.radd(dm, dr, -t[0], t[1])
         for j in range(k + 1):
-            m, r = ball.rmul(x2, x2r, mat[6, k, j], mat[7, k, j])
-            m, r = ball.radd(m, r, -mat[8, k, j], mat[9, k, j])
+            m, r = ball.rmul(x2, x2r, mat[layout.M_MID, k, j], mat[layout.M_RAD, k, j])
+            m, r = ball.radd(m, r, -mat[layout.K_MID, k, j], mat[layout.K_RAD, k, j])
             if j == k:
                 m, r = ball.radd(m, r, dm, dr)
             Sm[k, j], Sr[k, j] = m, r
@@ -159,11 +159,11 @@ def real_matrix(x, body, E, nmodes, parent, ws, Sm, Sr):
 
 @kernel
 def complex_matrix(z, zr, body, E, nmodes, ws):
-    """Balls of Phi(z) at the ball (z, zr) into ws[6], ws[7] (original coordinates, as ``real_matrix``).
+    """Balls of Phi(z) at the ball (z, zr) into ws.cm, ws.cr (original coordinates, as ``real_matrix``).
 
     Returns (ok, prod_kl (z + beta_kl) as a ball): ok False if z may be a pole.
     """
-    T, dd, sub, mat, vec, beta, cm, cr = ws
+    mat, vec, beta, cm, cr = ws.mat, ws.vec, ws.beta, ws.cm, ws.cr
     n = body.shape[0]
     z2 = ball.cmul(z, zr, z, zr)
     qm, qr = 1.0 + 0.0j, 0.0
@@ -177,14 +177,14 @@ def complex_matrix(z, zr, body, E, nmodes, ws):
             im, ir = ball.cdiv(E[k, l] + 0.0j, 0.0, dm, dr)
             am, ar = ball.cadd(am, ar, im, ir)
         # d_k = z G_k - z^2 (z + omega_k) a_k
-        wm, wr = ball.cadd(z, zr, body[k, 5] + 0.0j, 0.0)
+        wm, wr = ball.cadd(z, zr, body[k, layout.OMEGA] + 0.0j, 0.0)
         t = ball.cmul(z2[0], z2[1], wm, wr)
         t = ball.cmul(t[0], t[1], am, ar)
-        g = ball.cmul(z, zr, vec[0, k] + 0.0j, vec[1, k])
+        g = ball.cmul(z, zr, vec[layout.G_MID, k] + 0.0j, vec[layout.G_RAD, k])
         d = ball.cadd(g[0], g[1], -t[0], t[1])
         for j in range(k + 1):
-            m, r = ball.cmul(z2[0], z2[1], mat[6, k, j] + 0.0j, mat[7, k, j])
-            m, r = ball.cadd(m, r, -mat[8, k, j] + 0.0j, mat[9, k, j])
+            m, r = ball.cmul(z2[0], z2[1], mat[layout.M_MID, k, j] + 0.0j, mat[layout.M_RAD, k, j])
+            m, r = ball.cadd(m, r, -mat[layout.K_MID, k, j] + 0.0j, mat[layout.K_RAD, k, j])
             if j == k:
                 m, r = ball.cadd(m, r, d[0], d[1])
             cm[k, j], cr[k, j] = m, r
@@ -199,7 +199,7 @@ def complex_derivative(z, body, E, nmodes, ws, dm, dr):
     Returns sum_kl 1 / (z + beta_kl) as a ball (the logarithmic derivative of
     prod (z + beta_kl)); its radius is inf if z may be a pole.
     """
-    T, dd, sub, mat, vec, beta, cm, cr = ws
+    mat, vec, beta = ws.mat, ws.vec, ws.beta
     n = body.shape[0]
     lm, lr = 0.0j, 0.0
     for k in range(n):
@@ -216,17 +216,17 @@ def complex_derivative(z, body, E, nmodes, ws, dm, dr):
             em, er = ball.cmul(em, er, im, ir)
             bm, br = ball.cadd(bm, br, em, er)
         # d_k' = G_k - (3 z^2 + 2 z omega_k) a_k + z^2 (z + omega_k) b_k
-        w = body[k, 5]
+        w = body[k, layout.OMEGA]
         # 3 z + 2 w in floats errs by at most u |3 z| + u |3 z + 2 w| (2 w is exact)
         c3 = ball.cmul(z, 0.0, 3.0 * z + 2.0 * w, 2.0 * ball.U * (abs(3.0 * z) + abs(3.0 * z + 2.0 * w)) + ball.ETA)
         t1 = ball.cmul(c3[0], c3[1], am, ar)
         zz = ball.cmul(z, 0.0, z, 0.0)
         c2 = ball.cmul(zz[0], zz[1], z + w, 2.0 * ball.U * abs(z + w))
         t2 = ball.cmul(c2[0], c2[1], bm, br)
-        d = ball.cadd(vec[0, k] + 0.0j, vec[1, k], -t1[0], t1[1])
+        d = ball.cadd(vec[layout.G_MID, k] + 0.0j, vec[layout.G_RAD, k], -t1[0], t1[1])
         d = ball.cadd(d[0], d[1], t2[0], t2[1])
         for j in range(k + 1):
-            m, r = ball.cmul(2.0 * z, 0.0, mat[6, k, j] + 0.0j, mat[7, k, j])
+            m, r = ball.cmul(2.0 * z, 0.0, mat[layout.M_MID, k, j] + 0.0j, mat[layout.M_RAD, k, j])
             if j == k:
                 m, r = ball.cadd(m, r, d[0], d[1])
             dm[k, j], dr[k, j] = m, r
@@ -237,7 +237,7 @@ def complex_derivative(z, body, E, nmodes, ws, dm, dr):
 @kernel
 def float_matrices(z, body, E, nmodes, ws, F, dF):
     """Phi(z) and Phi'(z) in floats (as ``complex_matrix``); returns sum_kl 1 / (z + beta_kl)."""
-    T, dd, sub, mat, vec, beta, cm, cr = ws
+    mat, vec, beta = ws.mat, ws.vec, ws.beta
     n = body.shape[0]
     logq = 0.0j
     z2 = z * z
@@ -248,12 +248,12 @@ def float_matrices(z, body, E, nmodes, ws, F, dF):
             logq += inv
             a += E[k, l] * inv
             b += E[k, l] * inv * inv
-        w = body[k, 5]
-        d = z * vec[0, k] - z2 * (z + w) * a
-        dd_ = vec[0, k] - (3.0 * z2 + 2.0 * z * w) * a + z2 * (z + w) * b
+        w = body[k, layout.OMEGA]
+        d = z * vec[layout.G_MID, k] - z2 * (z + w) * a
+        dd_ = vec[layout.G_MID, k] - (3.0 * z2 + 2.0 * z * w) * a + z2 * (z + w) * b
         for j in range(k + 1):
-            f = z2 * mat[6, k, j] - mat[8, k, j]
-            df = 2.0 * z * mat[6, k, j]
+            f = z2 * mat[layout.M_MID, k, j] - mat[layout.K_MID, k, j]
+            df = 2.0 * z * mat[layout.M_MID, k, j]
             if j == k:
                 f += d
                 df += dd_
@@ -274,27 +274,27 @@ def linearisation(body, E, nmodes, parent, ws, C, Mo):
     steer the certificate, they prove nothing), so floats.  Mo (n, n) is scratch.
     False if M' is singular in floats.
     """
-    T, dd, sub, mat, vec, beta, cm, cr = ws
+    mat, vec, beta = ws.mat, ws.vec, ws.beta
     n = body.shape[0]
     C[:] = 0.0
     for i in range(n):
         for k in range(n):
-            Mo[k, i] = mat[6, k, i]
-        Mo[i, i] -= vec[2, i]
+            Mo[k, i] = mat[layout.M_MID, k, i]
+        Mo[i, i] -= vec[layout.ESUM_MID, i]
     try:
         Minv = np.linalg.inv(Mo)
     except Exception:  # noqa: BLE001 -- numba catches no narrower class; singular in floats: no approximations
         return False
-    MK = Minv @ mat[8]
+    MK = Minv @ mat[layout.K_MID]
     for k in range(n):
         C[k, n + k] = 1.0
         for j in range(n):
             C[n + k, j] = MK[k, j]
-            C[n + k, n + j] = -Minv[k, j] * vec[0, j]
+            C[n + k, n + j] = -Minv[k, j] * vec[layout.G_MID, j]
     col = 2 * n
     for j in range(n):
         for l in range(nmodes[j]):
-            gamma = body[j, 5] - beta[0, j, l]
+            gamma = body[j, layout.OMEGA] - beta[0, j, l]
             for k in range(n):
                 C[n + k, col] = Minv[k, j] * E[j, l] * gamma
             col += 1

@@ -33,6 +33,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from stabmap import kernels  # noqa: E402
+from stabmap.kernels import layout  # noqa: E402
 from bench_kernel import random_points, timed  # noqa: E402
 from stabmap.systems.gyroscopes import exact  # noqa: E402
 from stabmap.run.atlas import compute  # noqa: E402
@@ -82,10 +83,10 @@ def boundary_points(rng, nsys: int) -> PointArrays:
     grid = 10.0 ** np.linspace(-1, 3, 25)
     while len(chosen) < nsys:
         base = random_points(rng, 1, 2, 1)
-        base.body[..., 3] = np.abs(base.body[..., 3])  # top-heavy: unstable when slow, a boundary exists
+        base.body[..., layout.CM] = np.abs(base.body[..., layout.CM])  # top-heavy: unstable when slow, a boundary exists
         def label(w):
             p = _take(base, [0])
-            p.body[..., 5] = w
+            p.body[..., layout.OMEGA] = w
             return int(_exact_labels(p)[0])
         labels = [label(w) for w in grid]
         change = [i for i in range(len(grid) - 1) if labels[i] != labels[i + 1]]
@@ -100,7 +101,7 @@ def boundary_points(rng, nsys: int) -> PointArrays:
             else:
                 hi = mid
         pts = _take(base, [0] * len(rels))
-        pts.body[..., 5] = (hi * (1 + np.array(rels)))[:, None]
+        pts.body[..., layout.OMEGA] = (hi * (1 + np.array(rels)))[:, None]
         chosen.append(pts)
     return PointArrays(*(np.concatenate([getattr(p, f) for p in chosen]) for f in ("body", "joint", "g", "E", "kappa")),
                        chosen[0].nmodes, chosen[0].free)
@@ -111,16 +112,16 @@ def repeated_points(rng, npts: int) -> PointArrays:
     n = 4
     dy = lambda size: rng.integers(1, 65, size) / 64  # noqa: E731  (dyadic: products stay exact)
     body = np.empty((npts, n, 6))
-    body[..., 0] = 4 * dy((npts, 1))
-    body[..., 1] = dy((npts, 1)) / 16
-    body[..., 2] = dy((npts, 1)) / 16
-    body[..., 3] = dy((npts, 1)) / 2
-    body[..., 4] = dy((npts, 1))
-    body[..., 5] = rng.choice([-1, 1], (npts, 1)) * 2.0 ** rng.integers(-2, 9, (npts, 1))
+    body[..., layout.M] = 4 * dy((npts, 1))
+    body[..., layout.A] = dy((npts, 1)) / 16
+    body[..., layout.C] = dy((npts, 1)) / 16
+    body[..., layout.CM] = dy((npts, 1)) / 2
+    body[..., layout.S] = dy((npts, 1))
+    body[..., layout.OMEGA] = rng.choice([-1, 1], (npts, 1)) * 2.0 ** rng.integers(-2, 9, (npts, 1))
     E = body[..., 1:2] * dy((npts, 1, 1)) / 4 * np.ones((1, n, 1))
     kappa = rng.choice([-3.5, -1.25, 1.5, 3.0], (npts, 1, 1)) * np.ones((1, n, 1))
     half = npts // 2
-    body[:half, 0] = np.column_stack([4 * dy(half), dy(half) / 16, dy(half) / 16, dy(half) / 2, dy(half), body[:half, 0, 5]])
+    body[:half, 0] = np.column_stack([4 * dy(half), dy(half) / 16, dy(half) / 16, dy(half) / 2, dy(half), body[:half, 0, layout.OMEGA]])
     body[:half, 1:, 3:5] = 0.0  # a_k = 0 above the first body: the determinant splits
     joint = np.zeros((npts, n))
     fixed = PointArrays(body[:half], joint[:half], np.full(half, 9.8125), E[:half], kappa[:half], np.full(n, 1, np.int64), False)

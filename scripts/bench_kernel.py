@@ -46,6 +46,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from stabmap import kernels
+from stabmap.kernels import layout
 from stabmap.systems.gyroscopes import exact
 from stabmap.systems.gyroscopes.points import PointArrays
 
@@ -64,12 +65,12 @@ STATUSES = (
 def random_points(rng: np.random.Generator, npts: int, n: int, modes: int) -> PointArrays:
     """npts independent random fixed-support chains of n bodies with ``modes`` liquid modes each."""
     body = np.empty((npts, n, 6))
-    body[..., 0] = rng.uniform(0.2, 3.0, (npts, n))
-    body[..., 1] = rng.uniform(0.005, 0.1, (npts, n))
-    body[..., 2] = rng.uniform(0.0, 0.1, (npts, n))
-    body[..., 3] = rng.uniform(-0.2, 0.4, (npts, n))
-    body[..., 4] = rng.uniform(0.05, 0.6, (npts, n))
-    body[..., 5] = rng.uniform(-100, 100, (npts, 1))
+    body[..., layout.M] = rng.uniform(0.2, 3.0, (npts, n))
+    body[..., layout.A] = rng.uniform(0.005, 0.1, (npts, n))
+    body[..., layout.C] = rng.uniform(0.0, 0.1, (npts, n))
+    body[..., layout.CM] = rng.uniform(-0.2, 0.4, (npts, n))
+    body[..., layout.S] = rng.uniform(0.05, 0.6, (npts, n))
+    body[..., layout.OMEGA] = rng.uniform(-100, 100, (npts, 1))
     joint = rng.uniform(0, 200, (npts, n)) * (rng.random((npts, n)) < 0.7)
     lmax = max(1, modes)
     E = rng.uniform(1e-5, 3e-3, (npts, n, lmax))
@@ -95,7 +96,7 @@ def point_set(rng, kind: str, lines: int, per_line: int, n: int, modes: int) -> 
         return np.repeat(x, per_line, axis=0)
 
     body = rep(base.body)
-    body[..., 5] = np.tile(np.linspace(-150.0, 150.0, per_line), lines)[:, None]
+    body[..., layout.OMEGA] = np.tile(np.linspace(-150.0, 150.0, per_line), lines)[:, None]
     return PointArrays(body, rep(base.joint), rep(base.g), rep(base.E), rep(base.kappa), base.nmodes, base.free)
 
 

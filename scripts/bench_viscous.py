@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from stabmap import systems
+from stabmap.kernels import layout
 from stabmap.scene.grid import Axis, resample
 from stabmap.systems.gyroscopes import scene as scene_module
 from stabmap.systems.gyroscopes.points import point_arrays
@@ -194,7 +195,7 @@ def float_peer(scenes: list) -> tuple[list[np.ndarray], float, float]:
         pts = point_arrays(scene, values)
         eps, _, liquid, _ = dissipation(scene, values, pts)
         assert list(liquid) == list(range(scene.n))  # one viscous cavity on every body
-        inputs.append((*chain_matrices(pts), pts.body[..., 5], eps, scene.n))
+        inputs.append((*chain_matrices(pts), pts.body[..., layout.OMEGA], eps, scene.n))
     t0 = time.process_time()
     out = [peer_labels(peer_roots(M, G, K, omega, eps), n) for M, G, K, omega, eps, n in inputs]
     seconds = time.process_time() - t0

@@ -50,6 +50,7 @@ from pathlib import Path
 import flint
 import numpy as np
 
+from stabmap.kernels import layout
 from stabmap.systems.gyroscopes import decide as _decide
 from stabmap.systems.gyroscopes.outputs import DECIDED_BY
 from stabmap.systems.gyroscopes.paper import complex_pairs, det
@@ -209,8 +210,8 @@ def chain_points(n: int, prm: dict, joints: np.ndarray | None = None) -> PointAr
     body = np.empty((N, n, 6))
     for col, key in enumerate(("m", "A", "C", "c")):
         body[:, :, col] = prm[key][:, None]
-    body[:, :, 4] = 2.0 * prm["c"][:, None]  # s = 2c, exact in binary
-    body[:, :, 5] = prm["omega"][:, None]
+    body[:, :, layout.S] = 2.0 * prm["c"][:, None]  # s = 2c, exact in binary
+    body[:, :, layout.OMEGA] = prm["omega"][:, None]
     joint = np.zeros((N, n))
     if joints is not None and n > 1:
         joint[:, 1:] = joints

@@ -23,6 +23,7 @@ import numba
 import numpy as np
 from numba import prange
 
+from stabmap.kernels import layout
 from stabmap.systems.gyroscopes.points import point_arrays
 
 CHUNK = 256  # points per prange task: scratch is allocated once a task, not once a point
@@ -42,7 +43,7 @@ def _matrix(body, joint, at, g, E, kappa, nmodes, parent, free, J, MT, KT, sub, 
     J[:] = 0.0
     T[:] = False
     for k in range(n):
-        J[k, k] = body[k, 3]
+        J[k, k] = body[k, layout.CM]
         T[k, k] = True
         child = k
         i = parent[k]
@@ -55,20 +56,20 @@ def _matrix(body, joint, at, g, E, kappa, nmodes, parent, free, J, MT, KT, sub, 
         # The centre of mass stays at rest: subtract each column's mass-weighted mean.
         mt = 0.0
         for k in range(n):
-            mt += body[k, 0]
+            mt += body[k, layout.M]
         for i in range(n):
             s = 0.0
             for k in range(n):
-                s += body[k, 0] * J[k, i]
+                s += body[k, layout.M] * J[k, i]
             s /= mt
             for k in range(n):
                 J[k, i] -= s
     # M = diag(A) + J^T diag(m) J, then M T by adding every column into its parent's, children first.
     for i in range(n):
         for j in range(n):
-            acc = body[i, 1] if i == j else 0.0
+            acc = body[i, layout.A] if i == j else 0.0
             for k in range(n):
-                acc += body[k, 0] * J[k, i] * J[k, j]
+                acc += body[k, layout.M] * J[k, i] * J[k, j]
             MT[i, j] = acc
     for k in range(n):
         for j in range(n - 1, 0, -1):
@@ -82,8 +83,8 @@ def _matrix(body, joint, at, g, E, kappa, nmodes, parent, free, J, MT, KT, sub, 
         KT[0, 0] = joint[0]
         # a_k = m_k c_k + sum over children j of at_j * (mass of the subtree of j); children come after parents.
         for k in range(n - 1, -1, -1):
-            a = body[k, 0] * body[k, 3]
-            sub[k] = body[k, 0]
+            a = body[k, layout.M] * body[k, layout.CM]
+            sub[k] = body[k, layout.M]
             for j in range(k + 1, n):
                 if parent[j] == k:
                     a += at[j] * sub[j]
@@ -96,7 +97,7 @@ def _matrix(body, joint, at, g, E, kappa, nmodes, parent, free, J, MT, KT, sub, 
     P[:] = 0.0
     for k in range(n):
         L = nmodes[k]
-        omega = body[k, 5]
+        omega = body[k, layout.OMEGA]
         # Q = prod (lambda + beta_l), R = sum_l E_l prod_{l' != l} (lambda + beta_l'), beta = omega (kappa - 2) / kappa.
         q[:] = 0.0
         w[:] = 0.0
@@ -110,7 +111,7 @@ def _matrix(body, joint, at, g, E, kappa, nmodes, parent, free, J, MT, KT, sub, 
             for a in range(l + 1, 0, -1):
                 q[a] = q[a] * beta + q[a - 1]
             q[0] *= beta
-        G = body[k, 2] * omega
+        G = body[k, layout.C] * omega
         for j in range(n):
             # P_kj = Q (lambda^2 MT_kj + lambda G T_kj - KT_kj) - T_kj lambda^2 (lambda + omega) R
             mk, kk = MT[k, j], KT[k, j]

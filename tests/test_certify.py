@@ -665,7 +665,7 @@ def test_complex_matrix_and_derivative_enclose_exact(n, modes, free, kind):
         assert _mp_in(q, qm, qr), z
         for k in range(n):
             for j in range(n):
-                assert _mp_in(phi[k][j], ws[6][k, j], ws[7][k, j]), (z, k, j)
+                assert _mp_in(phi[k][j], ws.cm[k, j], ws.cr[k, j]), (z, k, j)
         lm, lr = pencil.complex_derivative(z, pts.body[0], pts.E[0], pts.nmodes, ws, dm, dr)
         if not math.isfinite(lr):
             continue
@@ -944,13 +944,13 @@ def _real_bounds(pts: PointArrays, p: int, z_of):
     body, joint, g, E, kappa, nmodes, free, parent, at = pts.kernel_args()
     n = body.shape[1]
     ws = certify.allocate(n, nmodes, parent)
-    pws, C, Mo, wr, wi, vdummy, z, Sm, Sr, feat, done = ws[0], ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[9], ws[10], ws[11], ws[18]
+    pws, C, Mo, wr, wi, vdummy, z, Sm, Sr, feat, done = ws.pws, ws.C, ws.Mo, ws.wr, ws.wi, ws.vdummy, ws.z, ws.Sm, ws.Sr, ws.feat, ws.done
     m = pencil.prepare(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, pws, False)
     degree = C.shape[0]
     d = degree - m
     assert pencil.linearisation(body[p], E[p], nmodes, parent, pws, C, Mo)
     assert kernels.approximations.eigenvalues(C, wr, wi, vdummy, z, degree, m)
-    poles = np.array([-pws[5][0, k, l] for k in range(n) for l in range(nmodes[k])])
+    poles = np.array([-pws.beta[0, k, l] for k in range(n) for l in range(nmodes[k])])
     z[:d] = z_of(z[:d].copy(), d, poles)
     args = (z, d, m, body[p], E[p], nmodes, parent, pws, feat, Sm, Sr, done)
     cheap = max(m, certify._real_roots_at_least(*args, False))

@@ -39,9 +39,10 @@ def viscous(scene, oblate: bool = False):
 
 def settles(points, i: int) -> bool | None:
     """The criterion at point i of ``points`` (None where the bodies spin at different rates)."""
+    from ..kernels import layout
     from ..systems.gyroscopes import exact
 
-    w = points.body[i, :, 5]
+    w = points.body[i, :, layout.OMEGA]
     if not np.all(w == w[0]):
         return None
     P, _ = exact.char_matrix(points.body[i], points.joint[i], points.g[i], points.E[i], points.kappa[i], points.nmodes,

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...kernels import layout
 from .nodes import NodeBoxes, degree, mechanical, spin_scaled
 from .parameters import parse_name
 from .points import PointArrays, point_arrays
@@ -138,8 +139,8 @@ def _spin_rows(scene: Scene, lo: PointArrays, hi: PointArrays, moves: dict[str, 
     """Boxes that every body spins through at one rate omega, not through 0: one spin axis moves, and every body's
     spin column with it (two spin axes over the same interval hold points where the bodies spin apart)."""
     spins = sum(moves[k].astype(int) for k in moves if _is_spin(scene, k))
-    w_lo = np.minimum(lo.body[..., 5], hi.body[..., 5])
-    w_hi = np.maximum(lo.body[..., 5], hi.body[..., 5])
+    w_lo = np.minimum(lo.body[..., layout.OMEGA], hi.body[..., layout.OMEGA])
+    w_hi = np.maximum(lo.body[..., layout.OMEGA], hi.body[..., layout.OMEGA])
     one_rate = np.all(w_lo == w_lo[:, :1], axis=1) & np.all(w_hi == w_hi[:, :1], axis=1) & (spins == 1)
     return np.flatnonzero(one_rate & (w_lo[:, 0] != w_hi[:, 0]) & ((w_lo[:, 0] > 0.0) | (w_hi[:, 0] < 0.0)))
 
@@ -160,12 +161,12 @@ def _spin_margin(scene: Scene, lower: dict, upper: dict, lo: PointArrays, hi: Po
         return
     npts = lo.body.shape[0]
     moves = np.broadcast_to(np.asarray(lower["S_g"]) != np.asarray(upper["S_g"]), (npts,))[:, None]
-    w_lo, w_hi = lo.body[..., 5], hi.body[..., 5]
+    w_lo, w_hi = lo.body[..., layout.OMEGA], hi.body[..., layout.OMEGA]
     moving = moves & (w_lo != w_hi)
     a, b = np.minimum(w_lo, w_hi), np.maximum(w_lo, w_hi)
     for _ in range(SPIN_MARGIN):
         a, b = np.nextafter(a, -np.inf), np.nextafter(b, np.inf)
-    lo.body[..., 5], hi.body[..., 5] = np.where(moving, a, w_lo), np.where(moving, b, w_hi)
+    lo.body[..., layout.OMEGA], hi.body[..., layout.OMEGA] = np.where(moving, a, w_lo), np.where(moving, b, w_hi)
 
 
 def _mechanical(scene: Scene, key: str) -> bool:
@@ -206,7 +207,7 @@ def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarra
     for axis in mech:
         rest = route(rest, (axis,), True)
     if rest.size:
-        out.append((rest, spin_scaled(plain.take(rest), lo.body[rest, 0, 5], hi.body[rest, 0, 5], spin_names[rest])))
+        out.append((rest, spin_scaled(plain.take(rest), lo.body[rest, 0, layout.OMEGA], hi.body[rest, 0, layout.OMEGA], spin_names[rest])))
     rest = np.setdiff1d(np.arange(npts), spin)
     for axis in mech:
         rest = route(rest, (axis,), False)

@@ -12,6 +12,7 @@ import functools
 import flint
 import numpy as np
 
+from ...kernels import layout
 from . import exact_disks, topology
 
 
@@ -105,12 +106,12 @@ def _parts(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=None):
     """(rows, M, K, spin, w, degree): each body's (betas, E) of its liquid modes, the rational M and K, C w, w."""
     n = len(body)
     parent = [k - 1 for k in range(n)] if parent is None else [int(p) for p in parent]
-    at = [0.0] + [body[parent[k]][4] for k in range(1, n)] if at is None else at
-    m = [_q(body[k][0]) for k in range(n)]
-    A = [_q(body[k][1]) for k in range(n)]
-    C = [_q(body[k][2]) for k in range(n)]
-    c = [_q(body[k][3]) for k in range(n)]
-    w = [_q(body[k][5]) for k in range(n)]
+    at = [0.0] + [body[parent[k]][layout.S] for k in range(1, n)] if at is None else at
+    m = [_q(body[k][layout.M]) for k in range(n)]
+    A = [_q(body[k][layout.A]) for k in range(n)]
+    C = [_q(body[k][layout.C]) for k in range(n)]
+    c = [_q(body[k][layout.CM]) for k in range(n)]
+    w = [_q(body[k][layout.OMEGA]) for k in range(n)]
     Kj = [_q(joint[k]) for k in range(n)]  # the joint of body k with its parent (k = 0: the base joint)
     arm = [_q(at[k]) for k in range(n)]
     zero = flint.fmpq(0)

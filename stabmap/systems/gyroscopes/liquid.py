@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import StabmapError
+from ...kernels import layout
 from ...scene.values import check_value
 from . import cavity
 from .parameters import CAVITY
@@ -448,7 +449,7 @@ def apply(c: Cavity, body: np.ndarray, sizes: dict[str, np.ndarray]):
         E = np.broadcast_to(np.array(c.E), body.shape[:-1] + (len(c.E),))
         kappa = np.broadcast_to(np.array(c.kappa), E.shape)
         if c.tail:
-            body[..., 1] -= c.deficit - math.fsum(c.E)
+            body[..., layout.A] -= c.deficit - math.fsum(c.E)
         return E, kappa
     a, h, rho = sizes["radius"], sizes["half_height"], sizes["density"]
     e, kappa, tail = (np.zeros(a.shape + (0,)), np.ones(a.shape + (0,)), 0.0) if c.viscous else scaled(c.shape, h / a, n_modes(c))
@@ -456,13 +457,13 @@ def apply(c: Cavity, body: np.ndarray, sizes: dict[str, np.ndarray]):
     if not c.liquid_in_body:
         m_f = cavity.frozen_mass(c.shape, a, h, rho)
         J_f, Jz_f = cavity.frozen_inertia(c.shape, a, h, rho)
-        m, A, C, cm = (body[..., i].copy() for i in range(4))
+        m, A, C, cm = (body[..., i].copy() for i in (layout.M, layout.A, layout.C, layout.CM))
         total = m + m_f
         new_c = (m * cm + m_f * c.centre) / total
-        body[..., 0] = total
-        body[..., 1] = A + m * (cm - new_c) ** 2 + J_f + m_f * (c.centre - new_c) ** 2
-        body[..., 2] = C + Jz_f
-        body[..., 3] = new_c
+        body[..., layout.M] = total
+        body[..., layout.A] = A + m * (cm - new_c) ** 2 + J_f + m_f * (c.centre - new_c) ** 2
+        body[..., layout.C] = C + Jz_f
+        body[..., layout.CM] = new_c
     if c.tail and not c.viscous:
-        body[..., 1] -= unit * tail
+        body[..., layout.A] -= unit * tail
     return unit[..., None] * e, kappa

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...kernels import layout
 from .parameters import parse_name
 from .points import PointArrays, point_arrays
 from .scene import Scene
@@ -115,7 +116,7 @@ def spin_scaled(box, w1: np.ndarray, w2: np.ndarray, names: np.ndarray | None = 
         return x[:, None].repeat(n + 1, axis=1)
 
     body, rbody = at_nodes(m.body), at_nodes(box.rbody)
-    body[..., 5], rbody[..., 5] = 1.0, 0.0
+    body[..., layout.OMEGA], rbody[..., layout.OMEGA] = 1.0, 0.0
     return NodeBoxes(body, rbody, at_nodes(m.joint), at_nodes(box.rjoint), at_nodes(m.g), at_nodes(box.rg), at_nodes(m.at),
                      at_nodes(box.rat), m.E, m.kappa, m.nmodes, m.free, m.parent, u, u_lo, u_hi, *_no_second(u.shape[0]), spin=True,
                      axis1=names)
@@ -202,7 +203,7 @@ def mechanical(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
                               axis2=names[1] if len(axes) == 2 else None)
     # spin-scaled: at node (u_i, t_j) the inputs at t_j with every spin 1 and the stiffness (joints, g) times u_i,
     # the product formed by the kernel (``spin``)
-    u_lo, u_hi = _u_interval(lo.body[sel, 0, 5], hi.body[sel, 0, 5])
+    u_lo, u_hi = _u_interval(lo.body[sel, 0, layout.OMEGA], hi.body[sel, 0, layout.OMEGA])
     n = scene.n
     u = chebyshev(u_lo, u_hi, n + 1)
 
@@ -211,7 +212,7 @@ def mechanical(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
         return np.repeat(x[:, None], n + 1, axis=1).reshape((sel.size, (n + 1) * count) + x.shape[2:])
 
     body, joint, g, at = tensor(body), tensor(joint), tensor(g), tensor(at)
-    body[..., 5] = 1.0
+    body[..., layout.OMEGA] = 1.0
     (axis,) = axes
     zeros = [np.zeros_like(x) for x in (body, joint, g, at)]
     return sel, NodeBoxes(body, zeros[0], joint, zeros[1], g, zeros[2], at, zeros[3], E, kappa, pts.nmodes, pts.free,

@@ -10,6 +10,7 @@ import re
 from dataclasses import dataclass, replace
 
 from ...errors import StabmapError
+from ...kernels.layout import BODY_COLUMNS
 from ...scene.values import Parameter, did_you_mean
 
 BODY = {
@@ -20,7 +21,6 @@ BODY = {
     "s": Parameter("s", "m", "distance between the lower and upper joints of body {k}", 0.0, False),
     "omega": Parameter("omega", "rad s-1", "spin rate of body {k}", None, False),
 }
-BODY_COLUMNS = ("m", "A", "C", "c", "s", "omega")  # column order of the kernels' body array
 JOINT = Parameter("K", "N m rad-1", "stiffness of joint {k}", 0.0, False)
 BASE = Parameter("K", "N m rad-1", "stiffness of the base joint", 0.0, False)
 # A tree (scene [topology]): where body k's joint sits on its parent's axis, up positive.

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...kernels import layout
 from . import liquid, ratios, topology
 from .parameters import BODY_COLUMNS, SCANNABLE_CAVITY, parse_name
 from .scene import Scene
@@ -51,7 +52,7 @@ class PointArrays:
 def chain_positions(body: np.ndarray) -> np.ndarray:
     """Joint positions ``at`` (..., n) of a chain from the bodies' s: at_k = s_{k-1}, at_0 = 0."""
     at = np.zeros(body.shape[:-1])
-    at[..., 1:] = body[..., :-1, 4]
+    at[..., 1:] = body[..., :-1, layout.S]
     return at
 
 
@@ -97,7 +98,7 @@ def point_arrays(scene: Scene, values: dict[str, np.ndarray]) -> PointArrays:
         elif name.kind == "global":
             for k in range(scene.n):
                 if not own_omega[k]:
-                    body[..., k, 5] = value
+                    body[..., k, layout.OMEGA] = value
         elif name.kind == "every_body":
             body[..., BODY_COLUMNS.index(name.symbol)] = value[..., None]
         elif name.kind == "every_joint":

@@ -15,7 +15,7 @@ from fractions import Fraction
 import flint
 import numpy as np
 
-from ...kernels import REAL, ROOTS_FAILED, roots_block
+from ...kernels import REAL, ROOTS_FAILED, layout, roots_block
 from ...kernels.firstorder import RATE_OK, first_order_block
 from ..gyroscopes import exact, ratios, stokes, topology
 from ..gyroscopes.decide import decide as decide_frozen
@@ -57,7 +57,7 @@ def dissipation(scene, values: dict, points: PointArrays):
         eps.append(e)
         # the roundings of the closed form (a few dozen operations) and of rho P / nu, and the tensor's stated accuracy
         eps_r.append(np.abs(e) * (np.asarray(rel) + 64.0 * U) + 1e-300)
-        reynolds = np.maximum(reynolds, np.abs(points.body[:, i, 5]) * a * a / nu)
+        reynolds = np.maximum(reynolds, np.abs(points.body[:, i, layout.OMEGA]) * a * a / nu)
     return (np.ascontiguousarray(np.stack(eps, axis=1)), np.ascontiguousarray(np.stack(eps_r, axis=1)),
             np.array(liquid, dtype=np.int64), reynolds)
 
@@ -85,8 +85,8 @@ def _gravity_free_columns(body, at, parent, ideal) -> int:
     beyond = [[k] for k in range(n)]  # the bodies whose path to the base passes body k (k included)
     for k in range(n - 1, 0, -1):  # a regular numbering: children after their parents
         beyond[parent[k]] += beyond[k]
-    mass = [sum((Fraction(body[i, 0]) for i in beyond[k]), Fraction(0)) for k in range(n)]
-    a = [Fraction(body[k, 0]) * Fraction(body[k, 3]) for k in range(n)]
+    mass = [sum((Fraction(body[i, layout.M]) for i in beyond[k]), Fraction(0)) for k in range(n)]
+    a = [Fraction(body[k, layout.M]) * Fraction(body[k, layout.CM]) for k in range(n)]
     for i in range(1, n):
         a[parent[i]] += Fraction(at[i]) * mass[i]
     return sum(1 for j in range(n) if ideal[j] and all(a[k] == 0 for k in beyond[j]))
@@ -170,8 +170,8 @@ def _exact(points, i, eps, eps_r, liquid, zeros, row, label, by, rate) -> None:
     derivs = []
     for k in liquid:
         body = points.body[i].copy()
-        h = body[k, 1] if body[k, 1] != 0.0 else 1.0
-        body[k, 1] += h
+        h = body[k, layout.A] if body[k, layout.A] != 0.0 else 1.0
+        body[k, layout.A] += h
         derivs.append((exact.char_poly(body, *args[1:]) - p) / exact._q(h))
     nonzero = flint.fmpq_poly(coeffs[m0:])
     sig, sig_r, freq, open_ = [], [], [], []
@@ -181,7 +181,7 @@ def _exact(points, i, eps, eps_r, liquid, zeros, row, label, by, rate) -> None:
         dk = [flint.arb_poly([flint.arb(c) for c in d.coeffs()]) for d in derivs]
         for root, mult in nonzero.complex_roots():
             x = root.real  # every root is real here (N_c = 0 proved)
-            q = sum((flint.arb(float(eps[j]), float(eps_r[j])) * (x + flint.arb(float(points.body[i, k, 5]))) * dk[j](x)
+            q = sum((flint.arb(float(eps[j]), float(eps_r[j])) * (x + flint.arb(float(points.body[i, k, layout.OMEGA]))) * dk[j](x)
                      for j, k in enumerate(liquid)), flint.arb(0))
             s = _split(p, x, q, mult)
             if s is None:
