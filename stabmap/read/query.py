@@ -442,11 +442,11 @@ def boundaries(ds: xr.Dataset, along: str | None = None, /, **sel) -> xr.Dataset
     xarray.Dataset
         A tidy table, one entry per boundary along the dimension ``boundary`` (``.to_dataframe()`` gives a
         pandas table). Coordinates: the other axes' grid values of each boundary's line; axes fixed by
-        ``sel`` are scalar coordinates (the scene's fixed parameters stay in the atlas). Variables: ``boundary_lower``/``boundary_upper`` (the bracketing grid
-        values, lower < upper, in the units of ``along``), ``<label>_below``/``<label>_above``
-        (the label at them, e.g. ``n_complex_pairs_below``), ``inferred_below``/``inferred_above`` (True where that side was not computed but
-        inferred from cell corners). Attributes: ``along``, ``n_lines``, ``n_lines_with_boundary``,
-        ``selection`` and ``comment``.
+        ``sel`` are scalar coordinates (the scene's fixed parameters stay in the atlas). Variables:
+        ``boundary_lower``/``boundary_upper`` (the bracketing grid values, lower < upper, in the units of ``along``),
+        ``<label>_below``/``<label>_above`` (the label at them, e.g. ``n_complex_pairs_below``),
+        ``inferred_below``/``inferred_above`` (True where that side was not computed but inferred from cell corners).
+        Attributes: ``along``, ``n_lines``, ``n_lines_with_boundary``, ``selection`` and ``comment``.
 
     Examples
     --------
@@ -468,7 +468,7 @@ def boundaries(ds: xr.Dataset, along: str | None = None, /, **sel) -> xr.Dataset
     def var(values, long_name, **attrs):
         return ("boundary", values, {"long_name": long_name, **attrs})
 
-    coords = {d: _coord(sub, d, "boundary", sub[d].values[p]) for d, p in zip(others, position)}
+    coords = {d: _coord(sub, d, "boundary", sub[d].values[p]) for d, p in zip(others, position, strict=True)}
     coords.update(fixed_coords(sub, axes))
     out = xr.Dataset(
         {
@@ -555,7 +555,8 @@ def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | Non
                                f"{next((d for d in dims if d != along), 'another grid axis')}")
         over = check_axis(ds, over, dims, "over")
         if axes[over].fixed:
-            raise StabmapError(f"{given('over', over)} is also fixed by {over}={axes[over].requested:g}; give {over} a range (lo, hi) or leave it out")
+            raise StabmapError(f"{given('over', over)} is also fixed by {over}={axes[over].requested:g}; "
+                               f"give {over} a range (lo, hi) or leave it out")
         extra = [d for d in others if d != over]
         if extra:
             example = ", ".join(f"{d}={float(ds[d][0]):g}" for d in extra)
@@ -582,7 +583,9 @@ def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | Non
                 found.value_before, f"{label.name} at unstable_below", units="1",
                 comment=f"{label.fill} where there is no unstable_below",
             ),
-            "stable_to_scan_end": var(found.true_to_end, f"stable at every grid value of {along} from smallest_stable to the end of the searched range"),
+            "stable_to_scan_end": var(
+                found.true_to_end, f"stable at every grid value of {along} from smallest_stable to the end of the searched range"
+            ),
             "inferred": var(found.flag_at, "smallest_stable was not computed (inferred from its grid cell's corners)"),
             "inferred_below": var(found.flag_before, "unstable_below was not computed (inferred from its grid cell's corners)"),
         },
@@ -639,7 +642,8 @@ def parse_selection(items: list[str], *, ranges: bool = True, option: str = "") 
             raise StabmapError(f"{key} is given twice; give each axis once")
         ends = value.split(":")
         if len(ends) > 2 or (len(ends) == 2 and not ranges):
-            raise StabmapError(f"{prefix}{item!r}: a range is NAME=LO:HI, e.g. {key}=0:10" if ranges else f"{prefix}{item!r}: give one value, e.g. {key}=42.5")
+            fix = f"a range is NAME=LO:HI, e.g. {key}=0:10" if ranges else f"give one value, e.g. {key}=42.5"
+            raise StabmapError(f"{prefix}{item!r}: {fix}")
         try:
             numbers = [_end(e.strip(), f"{prefix}{key}") for e in ends]
         except StabmapError:  # an unknown unit, named

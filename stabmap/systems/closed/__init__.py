@@ -135,7 +135,7 @@ class Closed(System):
 def _gammas(c1sq: np.ndarray, c2sq: np.ndarray) -> list:
     """gamma = c2^2/c1^2 exactly at every point (one fmpq per distinct pair of doubles)."""
     pairs = {}
-    return [pairs.setdefault((a, b), space_proofs.gamma_of(a, b)) for a, b in zip(c1sq.tolist(), c2sq.tolist())]
+    return [pairs.setdefault((a, b), space_proofs.gamma_of(a, b)) for a, b in zip(c1sq.tolist(), c2sq.tolist(), strict=True)]
 
 
 def _guess(fam, lengths, c1sq, h, j):

@@ -55,7 +55,7 @@ def roots_at(scene, values: dict[str, float]) -> list[Root]:
     D = scene.degree
     poly_roots = _distinct(*exact_roots(points, 0, D)[:3])
     shares = _shares(points, scene, [z for z, *_ in poly_roots])
-    out = [Root(z, r, m, "real" if kind == 0 else "complex pair", _origin(s), s) for (z, r, m, kind), s in zip(poly_roots, shares)]
+    out = [Root(z, r, m, "real" if kind == 0 else "complex pair", _origin(s), s) for (z, r, m, kind), s in zip(poly_roots, shares, strict=True)]
     return sorted(out, key=lambda root: (root.value.real, root.value.imag))
 
 

@@ -40,6 +40,9 @@ _RELEASE_KEYS = {"node", "direction"}
 _LOAD_KEYS = {"F", "M"}
 _BODY_KEYS = {"mass", "centre", "gravity", "acceleration", "omega", "alpha", "inertia"}
 _ANY = Parameter("", "", "")
+# the TOML file and the Python scene take the load in the same two ways: one message for both
+_ONE_LOAD = ("give the load either as a [load] table (F and M) or as a [body] table (mass, centre, gravity, motion), "
+             "exactly one of the two")
 
 Vector = tuple[float, float, float]
 
@@ -152,7 +155,7 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
     if "nodes" not in data:
         raise StabmapError("nodes is missing: give the node positions, e.g. nodes = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] [m]")
     if ("load" in data) == ("body" in data):
-        raise StabmapError("give the load either as a [load] table (F and M) or as a [body] table (mass, centre, gravity, motion), exactly one of the two")
+        raise StabmapError(_ONE_LOAD)
     values = {k: data[k] for k in ("title", "load_factor") if k in data}
     if not isinstance(data["nodes"], list) or not data["nodes"]:
         raise StabmapError(f"nodes must be a non-empty list of [x, y, z] positions [m], got {data['nodes']!r}")
@@ -208,11 +211,11 @@ def _validate(scene: Scene) -> None:
     put("nodes", tuple(tuple(p) for p in nodes.tolist()))
     if not all(isinstance(r, Release) for r in scene.releases):
         raise StabmapError("releases must be Release(node, direction) entries")
-    checked = check_releases([(r.node, r.direction) for r in scene.releases], scene.n)
-    put("releases", tuple(Release(r.node, _vector(r.direction, f"releases[{k}].direction")) for k, (r, _) in enumerate(zip(scene.releases, checked))))
+    check_releases([(r.node, r.direction) for r in scene.releases], scene.n)
+    put("releases", tuple(Release(r.node, _vector(r.direction, f"releases[{k}].direction")) for k, r in enumerate(scene.releases)))
     put("load_factor", check_value("load_factor", scene.load_factor, parameters.LOAD_FACTOR))
     if (scene.load is None) == (scene.body is None):
-        raise StabmapError("give the load either as a [load] table (F and M) or as a [body] table (mass, centre, gravity, motion), exactly one of the two")
+        raise StabmapError(_ONE_LOAD)
     if scene.load is not None:
         if not isinstance(scene.load, Load):
             raise StabmapError(f"load must be a Load(F, M), got {scene.load!r}")
