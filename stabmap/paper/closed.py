@@ -101,7 +101,7 @@ def in_space() -> list[str]:
         scene = example(name)
         ds = critical(scene, "ratio", progress=False)
         meaning = _meanings(ds)
-        scan = scene.axis("ratio")
+        scan = next(a.array for a in scene.grid if a.name == "ratio")
         lo, hi = ds["boundary_lower"].values, ds["boundary_upper"].values
         ends = [(a + b) / 2 for a, b in zip(lo, hi, strict=True) if np.isfinite(a)]
         classes = [meaning.get(int(ds["stability_at_scan_start"]), "?")]
@@ -115,9 +115,9 @@ def in_space() -> list[str]:
             left = right
         lines.append(f"- {family}: " + "; ".join(stretches) + ".")
     for twist, what in ((0, "plane ring (27), j = 1"), (1, "twisted ring (26), one turn of twist (m = 1)")):
-        classes = {n: closed.solve("ring", [1.0] * n, twist=twist).stability for n in range(4 if not twist else 3, 17)}
-        stable = [n for n, c in classes.items() if c == "stable"]
-        other = {n: c for n, c in classes.items() if c != "stable"}
+        by_n = {n: closed.solve("ring", [1.0] * n, twist=twist).stability for n in range(4 if not twist else 3, 17)}
+        stable = [n for n, c in by_n.items() if c == "stable"]
+        other = {n: c for n, c in by_n.items() if c != "stable"}
         text = f"stable in space for n = {', '.join(map(str, stable))}" if stable else "stable in space for no n"
         if other:
             text += "; " + ", ".join(f"{c} for n = {n}" for n, c in other.items())

@@ -82,7 +82,13 @@ def closed_form_along(scene, case: Case, row: float) -> list[tuple[float, int, i
     chain = _chains(scene, {other: np.array([row]), case.along: np.array([scan[0]])})[0]
     _set_symbolic(chain, case.along)
     lo, hi = sorted((float(scan[0]), float(scan[-1])))
-    return paper.closed_form_boundaries(paper.factors(chain, case.closed_form), lo, hi)
+    return paper.closed_form_boundaries(paper.factors(chain, _closed_form(case)), lo, hi)
+
+
+def _closed_form(case: Case) -> str:
+    if case.closed_form is None:
+        raise ValueError(f"{case.name}: the paper has no closed form for this case")
+    return case.closed_form
 
 
 def _set_symbolic(chain: paper.Chain, name: str) -> None:
@@ -95,7 +101,7 @@ def _set_symbolic(chain: paper.Chain, name: str) -> None:
 
 def closed_form_pairs_at(scene, case: Case, values: dict[str, np.ndarray]) -> np.ndarray:
     """N_c from the closed form at every point (C order of the broadcast values)."""
-    return np.array([paper.closed_form_pairs(paper.factors(ch, case.closed_form)) for ch in _chains(scene, values)])
+    return np.array([paper.closed_form_pairs(paper.factors(ch, _closed_form(case))) for ch in _chains(scene, values)])
 
 
 def grid_values(ds) -> dict[str, np.ndarray]:

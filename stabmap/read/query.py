@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -94,15 +95,16 @@ class AxisSelection:
     def describe(self) -> str:
         """One line of text, e.g. ``K_1 = 3 -> nearest grid value 3.0150754 N m rad-1``."""
         units = f" {self.units}" if self.units else ""
-        if self.fixed:
+        req = self.requested
+        if req is not None and not isinstance(req, tuple):  # fixed (a local name, so the type checker narrows it)
             note = " (outside the grid: nearest end)" if self.outside else ""
-            return f"{self.name} = {self.requested:g} -> nearest grid value {self.values[0]:.8g}{units}{note}"
+            return f"{self.name} = {req:g} -> nearest grid value {self.values[0]:.8g}{units}{note}"
         lo, hi = self.bounds
         n = len(self.values)
         span = f"{n} grid value{'s' if n != 1 else ''}, {lo:.8g} .. {hi:.8g}{units}"
-        if self.requested is None:
+        if req is None:
             return f"{self.name}: all {span}"
-        a, b = self.requested
+        a, b = req
         return f"{self.name} in [{'-inf' if a is None else f'{a:g}'}, {'inf' if b is None else f'{b:g}'}]: {span}"
 
 
@@ -306,14 +308,14 @@ def label_at(ds: xr.Dataset, **point: float) -> Label:
     )
     system = systems.of_atlas(ds.attrs)
     sel, = compute(sel)  # one point of every variable: a lazy atlas reads one chunk of each
-    values = {}
-    for v in system.atlas_variables:
-        if v.name in sel:
-            x = sel[v.name].values
-            if v.flags:  # a flag variable on a dimension of its own (root_kind, say): one meaning per entry
-                values[v.name] = v.meaning(int(x)) if x.ndim == 0 else [v.meaning(int(e)) for e in x.ravel()]
+    values: dict[str, object] = {}
+    for var in system.atlas_variables:
+        if var.name in sel:
+            x = sel[var.name].values
+            if var.flags:  # a flag variable on a dimension of its own (root_kind, say): one meaning per entry
+                values[var.name] = var.meaning(int(x)) if x.ndim == 0 else [var.meaning(int(e)) for e in x.ravel()]
             else:
-                values[v.name] = x.item() if x.ndim == 0 else x
+                values[var.name] = x.item() if x.ndim == 0 else x
     return Label(
         requested={k: float(v) for k, v in point.items()},
         grid_point={d: float(sel[d]) for d in dims},
@@ -392,7 +394,7 @@ def stable_system(ds: xr.Dataset, question: str):
     return system
 
 
-def _lines(sub: xr.Dataset, along: str) -> tuple[list[str], np.ndarray, object, object]:
+def _lines(sub: xr.Dataset, along: str) -> tuple[list[str], np.ndarray, Any, Any]:
     """Other axes, the ascending grid of ``along``, and the label and the inferred flag as (other axes..., along).
 
     The two arrays are those of the Dataset, transposed: dask arrays (not read yet) for a lazy atlas.

@@ -65,7 +65,7 @@ def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
               + (f" (proved in [{_value(label.values[k + '_lower'])}, {_value(label.values[k + '_upper'])}])" if k + "_lower" in bounds else "")
               for k, v in shown]
     if label.provenance is not None:
-        how = label.values[label.provenance]
+        how = str(label.values[label.provenance])  # a flag's meaning
         # How the point was decided qualifies its verdict (stability, else the label: the critical node), not
         # whichever variable happens to be last.
         names = [k for k, _ in shown]

@@ -278,9 +278,9 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
         return buf.getvalue().rstrip("\n")
     s = critical_summary(ds)
     if fmt == "json":
-        rows = [{k: (None if v is pd.NA else plain_value(v)) for k, v in r.items()} for r in table.to_dict(orient="records")]
+        records = [{k: (None if v is pd.NA else plain_value(v)) for k, v in r.items()} for r in table.to_dict(orient="records")]
         head = {"stabmap_query": "critical_values", "along": along, "along_units": s["units"], "label": lab,
-                "comment": ds.attrs.get("comment", ""), "units": {k: v for k, v in units.items() if v}, "rows": rows}
+                "comment": ds.attrs.get("comment", ""), "units": {k: v for k, v in units.items() if v}, "rows": records}
         return json_text(head)
     system = systems.of_atlas(ds.attrs)
     sym = system.label_symbol

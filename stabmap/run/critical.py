@@ -122,7 +122,7 @@ def check_along(scene: SceneBase, along: str | None) -> tuple[int, str]:
     axes if it is not one."""
     names = [a.name for a in scene.grid]
     default = along is None
-    along = systems.of(scene).default_axis if default else along
+    along = systems.of(scene).default_axis if along is None else along
     if along not in names:
         have = ", ".join(names) if names else "none (the scene has no [grid])"
         # without along, say which default was taken, and how to choose another
@@ -401,7 +401,9 @@ def _table(label: np.ndarray, scan: np.ndarray, b: _Brackets, gaps: _Brackets, s
     bounds[0, b.owner, slot], bounds[1, b.owner, slot] = b.lo, b.hi
     counts[0, b.owner, slot], counts[1, b.owner, slot] = b.label_lo, b.label_hi
     n_gaps = np.diff(gstarts).astype(np.int32)
-    return _Table(n_int, *ends, *bounds, *counts, flat[:, 0].copy(), n_gaps, *gap_ends, whole)
+    return _Table(n_intervals=n_int, lower=ends[0], upper=ends[1], lower_outer=ends[2], upper_outer=ends[3],
+                  b_lower=bounds[0], b_upper=bounds[1], label_below=counts[0], label_above=counts[1], start=flat[:, 0].copy(),
+                  n_gaps=n_gaps, gap_lower=gap_ends[0], gap_upper=gap_ends[1], whole=whole)
 
 
 def _stable_intervals(label_start: int, scan: np.ndarray, b: _Brackets, stable: int) -> list[tuple[float, float, float, float]]:

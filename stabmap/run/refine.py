@@ -218,7 +218,9 @@ class _Evaluator:
     def finish(self) -> dict[str, np.ndarray]:
         """Every variable on the grid, the points not computed given the values their label implies."""
         rest = ~self.computed
-        for k, v in self.system.inferred(self.label[rest]).items():
+        filled = self.system.inferred(self.label[rest])
+        assert filled is not None  # compute_refined refuses a system without System.inferred before it starts
+        for k, v in filled.items():
             if k in self.arrays:  # an output the scene left out (System.outputs)
                 self.arrays[k][rest] = v
         self.arrays[CELL.name][...] = np.where(rest, CELL.value("not_proved"), CELL.value("node_only"))
@@ -290,14 +292,14 @@ def _reopen(ev: _Evaluator, level: _Level, split: np.ndarray, margin: int) -> No
     shape = ev.scene.shape
     active = split & _any_corner(level, ~ev.computed)
     while active.any():
-        cells, points = [], []
+        cell_slices, point_slices = [], []
         for axis, n in enumerate(shape):
             hit = np.flatnonzero(np.any(active, axis=tuple(a for a in range(active.ndim) if a != axis)))
             # margin + 1: a cell next to an active one can be wrong, and the margin grows from there.
             c0, c1 = max(0, hit[0] - margin - 1), min(active.shape[axis], hit[-1] + 2 + margin)
-            cells.append(slice(c0, c1))
-            points.append(slice(c0, min(n, c1 + 1)))
-        cells, points = tuple(cells), tuple(points)
+            cell_slices.append(slice(c0, c1))
+            point_slices.append(slice(c0, min(n, c1 + 1)))
+        cells, points = tuple(cell_slices), tuple(point_slices)
         sub = _Level.build(tuple(p.stop - p.start for p in points), (1,) * len(shape))
         again = _step(ev, sub, active[cells], margin, points)
         active = np.zeros_like(active)

@@ -61,7 +61,7 @@ def roots_at(scene, values: dict[str, float]) -> list[Root]:
 
 def _distinct(z, r, kind):
     """(value, radius, multiplicity, kind) per distinct root: ``exact_roots`` repeats a multiple root."""
-    out = []
+    out: list[list] = []  # [value, radius, multiplicity, kind], the multiplicity counted up
     for i in range(len(z)):
         if kind[i] < 0:
             continue
