@@ -87,7 +87,8 @@ def atlas(scene, example, output, png, threads, workers, scheduler, chunk_points
         with quiet_dask_logs(scheduler is not None or workers is not None):
             _report(jobs.atlas(
                 jobs.scene(scene, example), output, png=png, refine=refine, coarse_stride=coarse_stride, margin=margin,
-                prove_cells=not node_by_node, resume=resume, overwrite=overwrite, chunk_points=chunk_points, progress=not quiet, **_where(scheduler, workers, threads),
+                prove_cells=not node_by_node, resume=resume, overwrite=overwrite, chunk_points=chunk_points, progress=not quiet,
+                **_where(scheduler, workers, threads),
             ))
     except KeyboardInterrupt:
         raise Interrupted(jobs.interrupted(output)) from None

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -28,9 +29,11 @@ def scene(path: str | Path | None = None, example: str | None = None):
     from .examples import example as bundled
     from .systems import load_scene
 
-    if (path is None) == (example is None):
-        raise StabmapError("give a scene file or --example NAME (not both); see 'stabmap examples'")
-    return load_scene(path) if path is not None else bundled(example)
+    if path is not None and example is None:
+        return load_scene(path)
+    if example is not None and path is None:
+        return bundled(example)
+    raise StabmapError("give a scene file or --example NAME (not both); see 'stabmap examples'")
 
 
 def check_grid(scene, source: str = "the scene") -> None:
@@ -98,10 +101,10 @@ def atlas(
     t0 = time.perf_counter()
     where = {"client": client, "workers": workers, "threads": threads, "progress": progress, "chunk_points": chunk_points}
     if refine:
-        options = {"coarse_stride": refining.check_coarse_stride(coarse_stride)}
-        options["margin"] = refining.check_margin(refining.DEFAULT_MARGIN if margin is None else margin)
+        stride = refining.check_coarse_stride(coarse_stride)
+        cells = refining.check_margin(refining.DEFAULT_MARGIN if margin is None else margin)
         with _no_checkpoint():
-            ds = refining.compute_refined(scene, **options, **where)
+            ds = refining.compute_refined(scene, coarse_stride=stride, margin=cells, **where)
         write_atlas(ds, output)
         stats = summary_line(system, summary(ds), ds.attrs.get("n_evaluated_points"))
     else:
@@ -215,7 +218,7 @@ def info(path: str | Path, limit: int = 8) -> str:
 
 def query(
     path: str | Path,
-    items: list[str] = (),
+    items: Sequence[str] = (),
     *,
     fraction: bool = False,
     boundaries: str | None = None,
@@ -319,7 +322,7 @@ def plot(
     *,
     x: str | None = None,
     y: str | None = None,
-    sel: list[str] = (),
+    sel: Sequence[str] = (),
     facet: str | None = None,
     max_panels: int | None = None,
     overwrite: bool = False,
@@ -343,9 +346,10 @@ def plot(
             raise StabmapError(f"{param(extra[0])} applies to atlases; {path} holds critical values (fix other axes with {param('sel')})")
         figures.plot_critical(ds, output, sel=chosen)
         return Done([f"wrote {output}"])
-    options = {"x": x, "y": y, "sel": chosen, "facet": facet, "max_panels": figures.MAX_PANELS if max_panels is None else max_panels}
-    figures.plot_atlas(ds, output, **options)
-    return Done([f"note: {note}" for note in figures.plan_figure(ds, **options).notes] + [f"wrote {output}"])
+    panels = figures.MAX_PANELS if max_panels is None else max_panels
+    figures.plot_atlas(ds, output, x=x, y=y, sel=chosen, facet=facet, max_panels=panels)
+    plan = figures.plan_figure(ds, x=x, y=y, sel=chosen, facet=facet, max_panels=panels)
+    return Done([f"note: {note}" for note in plan.notes] + [f"wrote {output}"])
 
 
 def examples(show: str | None = None) -> list[str]:

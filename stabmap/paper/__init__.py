@@ -70,8 +70,8 @@ def check(systems=None, *, out: str | Path | None = None, quick: bool = False, c
     texts, problems = [], []
     for name, module in modules.items():
         where = None if out is None else out / name
-        takes = _options(module.run)
-        done = module.run(out=where, **{k: v for k, v in {"quick": quick, **named}.items() if k in takes})
+        options = _options(module.run)
+        done = module.run(out=where, **{k: v for k, v in {"quick": quick, **named}.items() if k in options})
         texts.append(f"## {name}\n{done['text']}" + ("" if where is None else f"\nfigures in {where}/"))
         problems += done["problems"]
     texts.append("all agree with the papers" if not problems else f"{len(problems)} disagreements with the papers")

@@ -50,13 +50,13 @@ def check_case(name: str, expected, out: Path | None = None) -> dict:
     meaning = _meanings(ds)
     lo, hi = ds["boundary_lower"].values, ds["boundary_upper"].values
     found = [((a + b) / 2, meaning.get(int(s), str(s)), meaning.get(int(t), str(t)), b - a)
-             for a, b, s, t in zip(lo, hi, ds["stability_below"].values, ds["stability_above"].values) if np.isfinite(a)]
+             for a, b, s, t in zip(lo, hi, ds["stability_below"].values, ds["stability_above"].values, strict=True) if np.isfinite(a)]
     problems = []
     if len(found) != len(expected):
         problems.append(f"{name}: located {len(found)} boundaries {[(round(t, 10), b, a) for t, b, a, _ in found]}, "
                         f"the closed form has {len(expected)}")
     worst = 0.0
-    for (t, below, above, width), (x, xb, xa) in zip(found, expected):
+    for (t, below, above, _), (x, xb, xa) in zip(found, expected, strict=False):  # a count mismatch is reported above
         err = abs(t - x) / abs(x)
         worst = max(worst, err)
         if err > RTOL or (below, above) != (xb, xa):
@@ -101,23 +101,23 @@ def in_space() -> list[str]:
         scene = example(name)
         ds = critical(scene, "ratio", progress=False)
         meaning = _meanings(ds)
-        scan = scene.axis("ratio")
+        scan = next(a.array for a in scene.grid if a.name == "ratio")
         lo, hi = ds["boundary_lower"].values, ds["boundary_upper"].values
-        ends = [(a + b) / 2 for a, b in zip(lo, hi) if np.isfinite(a)]
+        ends = [(a + b) / 2 for a, b in zip(lo, hi, strict=True) if np.isfinite(a)]
         classes = [meaning.get(int(ds["stability_at_scan_start"]), "?")]
-        classes += [meaning.get(int(t), str(t)) for t, a in zip(ds["stability_above"].values, lo) if np.isfinite(a)]
+        classes += [meaning.get(int(t), str(t)) for t, a in zip(ds["stability_above"].values, lo, strict=True) if np.isfinite(a)]
         start = float(scan[0])
         stops = ends + [float(scan[-1])]
         stretches = []
         left = start
-        for cls, right in zip(classes, stops):
+        for cls, right in zip(classes, stops, strict=True):
             stretches.append(f"{cls} for h2/h1 in [{left:.10g}, {right:.10g}]" if abs(right - left) > 1e-9 * right else f"{cls} at {right:.10g}")
             left = right
         lines.append(f"- {family}: " + "; ".join(stretches) + ".")
     for twist, what in ((0, "plane ring (27), j = 1"), (1, "twisted ring (26), one turn of twist (m = 1)")):
-        classes = {n: closed.solve("ring", [1.0] * n, twist=twist).stability for n in range(4 if not twist else 3, 17)}
-        stable = [n for n, c in classes.items() if c == "stable"]
-        other = {n: c for n, c in classes.items() if c != "stable"}
+        by_n = {n: closed.solve("ring", [1.0] * n, twist=twist).stability for n in range(4 if not twist else 3, 17)}
+        stable = [n for n, c in by_n.items() if c == "stable"]
+        other = {n: c for n, c in by_n.items() if c != "stable"}
         text = f"stable in space for n = {', '.join(map(str, stable))}" if stable else "stable in space for no n"
         if other:
             text += "; " + ", ".join(f"{c} for n = {n}" for n, c in other.items())

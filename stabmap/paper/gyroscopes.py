@@ -82,7 +82,13 @@ def closed_form_along(scene, case: Case, row: float) -> list[tuple[float, int, i
     chain = _chains(scene, {other: np.array([row]), case.along: np.array([scan[0]])})[0]
     _set_symbolic(chain, case.along)
     lo, hi = sorted((float(scan[0]), float(scan[-1])))
-    return paper.closed_form_boundaries(paper.factors(chain, case.closed_form), lo, hi)
+    return paper.closed_form_boundaries(paper.factors(chain, _closed_form(case)), lo, hi)
+
+
+def _closed_form(case: Case) -> str:
+    if case.closed_form is None:
+        raise ValueError(f"{case.name}: the paper has no closed form for this case")
+    return case.closed_form
 
 
 def _set_symbolic(chain: paper.Chain, name: str) -> None:
@@ -95,7 +101,7 @@ def _set_symbolic(chain: paper.Chain, name: str) -> None:
 
 def closed_form_pairs_at(scene, case: Case, values: dict[str, np.ndarray]) -> np.ndarray:
     """N_c from the closed form at every point (C order of the broadcast values)."""
-    return np.array([paper.closed_form_pairs(paper.factors(ch, case.closed_form)) for ch in _chains(scene, values)])
+    return np.array([paper.closed_form_pairs(paper.factors(ch, _closed_form(case))) for ch in _chains(scene, values)])
 
 
 def grid_values(ds) -> dict[str, np.ndarray]:
@@ -161,7 +167,8 @@ def check_case(case: Case, *, quick: bool, rows: int, out: Path | None) -> dict:
     t_atlas = time.perf_counter() - t0
     grid_rows = next(a.array for a in scene.grid if a.name == other)
     picks = grid_rows[np.linspace(0, grid_rows.size - 1, rows + 2).round().astype(int)[1:-1]]
-    row_scene = dataclasses.replace(scene, grid=tuple(a if a.name != other else Axis(other, tuple(float(v) for v in picks), "values") for a in scene.grid))
+    row_axis = Axis(other, tuple(float(v) for v in picks), "values")
+    row_scene = dataclasses.replace(scene, grid=tuple(a if a.name != other else row_axis for a in scene.grid))
     crit = critical(row_scene, case.along, progress=False)
     problems, notes, matched, worst = [], [], 0, 0.0
     if case.closed_form is not None:
@@ -170,7 +177,7 @@ def check_case(case: Case, *, quick: bool, rows: int, out: Path | None) -> dict:
         wrong = np.argwhere(expected != ds["n_complex_pairs"].values)
         dims = ds["n_complex_pairs"].dims
         for idx in wrong[:5]:
-            at = ", ".join(f"{d} = {ds[d].values[i]:.10g}" for d, i in zip(dims, idx))
+            at = ", ".join(f"{d} = {ds[d].values[i]:.10g}" for d, i in zip(dims, idx, strict=True))
             problems.append(f"{case.name}: {at}: engine N_c = {ds['n_complex_pairs'].values[tuple(idx)]}, closed form {expected[tuple(idx)]}")
         if len(wrong) > 5:
             problems.append(f"{case.name}: {len(wrong)} points of the map disagree with the closed form in all")
@@ -181,13 +188,13 @@ def check_case(case: Case, *, quick: bool, rows: int, out: Path | None) -> dict:
         # The paper's determinant, exactly: every atlas point on the row and both ends of every bracket.
         line = ds["n_complex_pairs"].sel({other: row}).values
         exact = paper_pairs_at(scene, {case.along: scan, other: np.array([row])})
-        for v, e, x in zip(scan, line, exact):
+        for v, e, x in zip(scan, line, exact, strict=True):
             if e != x:
                 problems.append(f"{where}, {case.along} = {v:.10g}: engine N_c = {e}, paper's determinant {x}")
         ends = np.array([[lo, hi] for lo, hi, _, _ in found]).ravel()
         if ends.size:
             exact_ends = paper_pairs_at(scene, {case.along: ends, other: np.array([row])}).reshape(-1, 2)
-            for (lo, hi, below, above), (xb, xa) in zip(found, exact_ends):
+            for (lo, hi, below, above), (xb, xa) in zip(found, exact_ends, strict=True):
                 if (xb, xa) != (below, above):
                     problems.append(f"{where}: bracket [{lo:.12g}, {hi:.12g}] has N_c {below} -> {above}, paper's determinant {xb} -> {xa}")
         if case.closed_form is None:
@@ -216,7 +223,8 @@ def check_case(case: Case, *, quick: bool, rows: int, out: Path | None) -> dict:
             worst = max(worst, err)
             matched += 1
             if (below, above) != (cb, ca):
-                problems.append(f"{where}: engine boundary {mid:.12g} (N_c {below} -> {above}), closed form {t:.12g} ({cb} -> {ca}), rel. diff {err:.1e}")
+                problems.append(f"{where}: engine boundary {mid:.12g} (N_c {below} -> {above}), "
+                                f"closed form {t:.12g} ({cb} -> {ca}), rel. diff {err:.1e}")
     if out is not None:
         _figure(case, scene, ds, crit, picks, out / f"{case.name}.png")
     return {

@@ -23,10 +23,12 @@ def run(*, out: Path | None = None) -> dict:
     """Compute the plate's atlas and compare it with the closed forms; its figure into ``out`` (None: none)."""
     from ..examples import example
     from ..run import atlas
+    from ..systems.reactions.scene import Scene
     from ..systems.reactions.solver import closed_form
 
     t0 = time.perf_counter()
     scene = example(NAME)
+    assert isinstance(scene, Scene) and scene.body is not None  # the example: a plate whose load is its weight
     ds = atlas.compute(scene, progress=False)
     nodes = np.array(scene.nodes, dtype=float)
     a = float(np.abs(nodes[:, 0]).max())

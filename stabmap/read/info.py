@@ -90,7 +90,8 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
         c = ds[d]
         shown = display_range(c)
         lines.append(
-            f"    {d:<{name_width}} {plural(c.size, 'point'):>11}  {float(c.min()):.6g} .. {float(c.max()):.6g}{unit_suffix(c.attrs.get('units'))}{shown}  "
+            f"    {d:<{name_width}} {plural(c.size, 'point'):>11}  "
+            f"{float(c.min()):.6g} .. {float(c.max()):.6g}{unit_suffix(c.attrs.get('units'))}{shown}  "
             f"({c.attrs.get('scale', '')})  {c.attrs.get('long_name', '')}"
         )
     # auxiliary coordinates: what a ratio axis (S_g, C/A, h/a) moves, and S_g where M_alpha acts (docs/projectile.md)
@@ -116,7 +117,8 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
         degenerate = f", degenerate: {s['degenerate']}" if s["degenerate"] else ""
         absent = f", absent: {s['absent']}" if s["absent"] else ""
         undecided = f", undecided (not proved): {s['undecided']}" if s["undecided"] else ""
-        lines.append(f"  points: {s['points']}, {system.stable_word}: {s['stable']} ({100 * s['stable_fraction']:.2f} %)" + degenerate + absent + undecided)
+        stable = f"{system.stable_word}: {s['stable']} ({100 * s['stable_fraction']:.2f} %)"
+        lines.append(f"  points: {s['points']}, {stable}" + degenerate + absent + undecided)
     else:
         lines.append(f"  points: {s['points']}")
     flags = system.variable(system.label).flags
@@ -190,7 +192,7 @@ def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
         gaps = g["n_undecided"].values, g["undecided_lower"].transpose("point", "gap").values, g["undecided_upper"].transpose("point", "gap").values
     lines = []
     for p, label in enumerate(table["point"].values[:limit or None]):
-        where = ", ".join(f"{d} = {v:g}" for d, v in zip(dims, label)) if dims else "the scene"
+        where = ", ".join(f"{d} = {v:g}" for d, v in zip(dims, label, strict=True)) if dims else "the scene"
         parts = [
             f"{lo[p, k]:.10g} ({'scan start' if np.isnan(olo[p, k]) else 'boundary'}) to "
             f"{hi[p, k]:.10g} ({'scan end' if np.isnan(ohi[p, k]) else 'boundary'})"
@@ -201,7 +203,7 @@ def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
         lines.append(f"{where}: stable {along}{shown} " + ("; ".join(parts) if parts else "nowhere in the scan"))
         if gaps is not None and gaps[0][p]:
             n = int(gaps[0][p])
-            pieces = [f"{a:.10g} to {b:.10g}" for a, b in zip(gaps[1][p, :n][:gaps_shown], gaps[2][p, :n][:gaps_shown])]
+            pieces = [f"{a:.10g} to {b:.10g}" for a, b in zip(gaps[1][p, :n][:gaps_shown], gaps[2][p, :n][:gaps_shown], strict=True)]
             more = f" and {n - gaps_shown} more (--all lists every one)" if gaps_shown and n > gaps_shown else ""
             lines.append(f"  not proved inside {n} gap{'s' if n > 1 else ''}: " + "; ".join(pieces) + more)
     if limit and lo.shape[0] > limit:

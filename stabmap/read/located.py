@@ -87,8 +87,8 @@ def located_boundaries(ds: xr.Dataset, along: str | None = None, /, *, progress:
     gaps = crit[["undecided_lower", "undecided_upper"]]
     gaps = gaps.stack(g=others + ["gap"]) if others else gaps.rename({"gap": "g"})
     open_ = np.isfinite(gaps["undecided_lower"].values)
-    out["undecided_lower"] = ("gap", gaps["undecided_lower"].values[open_], {"units": units, "long_name": f"start of a stretch of {along} not decided"})
-    out["undecided_upper"] = ("gap", gaps["undecided_upper"].values[open_], {"units": units, "long_name": f"end of a stretch of {along} not decided"})
+    for name, end in (("undecided_lower", "start"), ("undecided_upper", "end")):
+        out[name] = ("gap", gaps[name].values[open_], {"units": units, "long_name": f"{end} of a stretch of {along} not decided"})
     for d in others:
         out.coords[f"gap_{d}"] = ("gap", gaps[d].values[open_], dict(ds[d].attrs))
     lines = int(np.prod([crit.sizes[d] for d in others])) if others else 1
@@ -115,7 +115,7 @@ def located_smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: s
         if extra:
             raise StabmapError(f"{given('over', over)}: fix the other axes as well ({', '.join(f'{d}=...' for d in extra)})")
     crit, sub, axes = _critical(ds, along, sel, progress, threads)
-    others = [d for d in crit["n_stable_intervals"].dims]
+    others = list(crit["n_stable_intervals"].dims)
     lower = crit[f"{along}_stable_lower"].isel(interval=0).values
     outer = crit[f"{along}_stable_lower_outer"].isel(interval=0).values
     upper_outer = crit[f"{along}_stable_upper_outer"].isel(interval=0).values

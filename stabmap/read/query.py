@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -94,15 +95,16 @@ class AxisSelection:
     def describe(self) -> str:
         """One line of text, e.g. ``K_1 = 3 -> nearest grid value 3.0150754 N m rad-1``."""
         units = f" {self.units}" if self.units else ""
-        if self.fixed:
+        req = self.requested
+        if req is not None and not isinstance(req, tuple):  # fixed (a local name, so the type checker narrows it)
             note = " (outside the grid: nearest end)" if self.outside else ""
-            return f"{self.name} = {self.requested:g} -> nearest grid value {self.values[0]:.8g}{units}{note}"
+            return f"{self.name} = {req:g} -> nearest grid value {self.values[0]:.8g}{units}{note}"
         lo, hi = self.bounds
         n = len(self.values)
         span = f"{n} grid value{'s' if n != 1 else ''}, {lo:.8g} .. {hi:.8g}{units}"
-        if self.requested is None:
+        if req is None:
             return f"{self.name}: all {span}"
-        a, b = self.requested
+        a, b = req
         return f"{self.name} in [{'-inf' if a is None else f'{a:g}'}, {'inf' if b is None else f'{b:g}'}]: {span}"
 
 
@@ -306,14 +308,14 @@ def label_at(ds: xr.Dataset, **point: float) -> Label:
     )
     system = systems.of_atlas(ds.attrs)
     sel, = compute(sel)  # one point of every variable: a lazy atlas reads one chunk of each
-    values = {}
-    for v in system.atlas_variables:
-        if v.name in sel:
-            x = sel[v.name].values
-            if v.flags:  # a flag variable on a dimension of its own (root_kind, say): one meaning per entry
-                values[v.name] = v.meaning(int(x)) if x.ndim == 0 else [v.meaning(int(e)) for e in x.ravel()]
+    values: dict[str, object] = {}
+    for var in system.atlas_variables:
+        if var.name in sel:
+            x = sel[var.name].values
+            if var.flags:  # a flag variable on a dimension of its own (root_kind, say): one meaning per entry
+                values[var.name] = var.meaning(int(x)) if x.ndim == 0 else [var.meaning(int(e)) for e in x.ravel()]
             else:
-                values[v.name] = x.item() if x.ndim == 0 else x
+                values[var.name] = x.item() if x.ndim == 0 else x
     return Label(
         requested={k: float(v) for k, v in point.items()},
         grid_point={d: float(sel[d]) for d in dims},
@@ -392,7 +394,7 @@ def stable_system(ds: xr.Dataset, question: str):
     return system
 
 
-def _lines(sub: xr.Dataset, along: str) -> tuple[list[str], np.ndarray, object, object]:
+def _lines(sub: xr.Dataset, along: str) -> tuple[list[str], np.ndarray, Any, Any]:
     """Other axes, the ascending grid of ``along``, and the label and the inferred flag as (other axes..., along).
 
     The two arrays are those of the Dataset, transposed: dask arrays (not read yet) for a lazy atlas.
@@ -442,11 +444,11 @@ def boundaries(ds: xr.Dataset, along: str | None = None, /, **sel) -> xr.Dataset
     xarray.Dataset
         A tidy table, one entry per boundary along the dimension ``boundary`` (``.to_dataframe()`` gives a
         pandas table). Coordinates: the other axes' grid values of each boundary's line; axes fixed by
-        ``sel`` are scalar coordinates (the scene's fixed parameters stay in the atlas). Variables: ``boundary_lower``/``boundary_upper`` (the bracketing grid
-        values, lower < upper, in the units of ``along``), ``<label>_below``/``<label>_above``
-        (the label at them, e.g. ``n_complex_pairs_below``), ``inferred_below``/``inferred_above`` (True where that side was not computed but
-        inferred from cell corners). Attributes: ``along``, ``n_lines``, ``n_lines_with_boundary``,
-        ``selection`` and ``comment``.
+        ``sel`` are scalar coordinates (the scene's fixed parameters stay in the atlas). Variables:
+        ``boundary_lower``/``boundary_upper`` (the bracketing grid values, lower < upper, in the units of ``along``),
+        ``<label>_below``/``<label>_above`` (the label at them, e.g. ``n_complex_pairs_below``),
+        ``inferred_below``/``inferred_above`` (True where that side was not computed but inferred from cell corners).
+        Attributes: ``along``, ``n_lines``, ``n_lines_with_boundary``, ``selection`` and ``comment``.
 
     Examples
     --------
@@ -468,7 +470,7 @@ def boundaries(ds: xr.Dataset, along: str | None = None, /, **sel) -> xr.Dataset
     def var(values, long_name, **attrs):
         return ("boundary", values, {"long_name": long_name, **attrs})
 
-    coords = {d: _coord(sub, d, "boundary", sub[d].values[p]) for d, p in zip(others, position)}
+    coords = {d: _coord(sub, d, "boundary", sub[d].values[p]) for d, p in zip(others, position, strict=True)}
     coords.update(fixed_coords(sub, axes))
     out = xr.Dataset(
         {
@@ -555,7 +557,8 @@ def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | Non
                                f"{next((d for d in dims if d != along), 'another grid axis')}")
         over = check_axis(ds, over, dims, "over")
         if axes[over].fixed:
-            raise StabmapError(f"{given('over', over)} is also fixed by {over}={axes[over].requested:g}; give {over} a range (lo, hi) or leave it out")
+            raise StabmapError(f"{given('over', over)} is also fixed by {over}={axes[over].requested:g}; "
+                               f"give {over} a range (lo, hi) or leave it out")
         extra = [d for d in others if d != over]
         if extra:
             example = ", ".join(f"{d}={float(ds[d][0]):g}" for d in extra)
@@ -582,7 +585,9 @@ def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | Non
                 found.value_before, f"{label.name} at unstable_below", units="1",
                 comment=f"{label.fill} where there is no unstable_below",
             ),
-            "stable_to_scan_end": var(found.true_to_end, f"stable at every grid value of {along} from smallest_stable to the end of the searched range"),
+            "stable_to_scan_end": var(
+                found.true_to_end, f"stable at every grid value of {along} from smallest_stable to the end of the searched range"
+            ),
             "inferred": var(found.flag_at, "smallest_stable was not computed (inferred from its grid cell's corners)"),
             "inferred_below": var(found.flag_before, "unstable_below was not computed (inferred from its grid cell's corners)"),
         },
@@ -639,7 +644,8 @@ def parse_selection(items: list[str], *, ranges: bool = True, option: str = "") 
             raise StabmapError(f"{key} is given twice; give each axis once")
         ends = value.split(":")
         if len(ends) > 2 or (len(ends) == 2 and not ranges):
-            raise StabmapError(f"{prefix}{item!r}: a range is NAME=LO:HI, e.g. {key}=0:10" if ranges else f"{prefix}{item!r}: give one value, e.g. {key}=42.5")
+            fix = f"a range is NAME=LO:HI, e.g. {key}=0:10" if ranges else f"give one value, e.g. {key}=42.5"
+            raise StabmapError(f"{prefix}{item!r}: {fix}")
         try:
             numbers = [_end(e.strip(), f"{prefix}{key}") for e in ends]
         except StabmapError:  # an unknown unit, named

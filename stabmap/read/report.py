@@ -43,7 +43,8 @@ def render(result, fmt: str = "text", *, limit: int = 40, atlas: xr.Dataset | No
         head["fixed"] = {k: float(result[k]) for k in _fixed_axes(result)}
         head["rows"] = frame.to_dict(orient="records")
         if "undecided_lower" in result:
-            head["undecided"] = [[float(a), float(b)] for a, b in zip(result["undecided_lower"].values, result["undecided_upper"].values)]
+            gaps = zip(result["undecided_lower"].values, result["undecided_upper"].values, strict=True)
+            head["undecided"] = [[float(a), float(b)] for a, b in gaps]
         return json_text(head)
     return (_boundaries_text if kind == "boundaries" else _smallest_text)(result, frame, limit)
 
@@ -64,7 +65,7 @@ def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
               + (f" (proved in [{_value(label.values[k + '_lower'])}, {_value(label.values[k + '_upper'])}])" if k + "_lower" in bounds else "")
               for k, v in shown]
     if label.provenance is not None:
-        how = label.values[label.provenance]
+        how = str(label.values[label.provenance])  # a flag's meaning
         # How the point was decided qualifies its verdict (stability, else the label: the critical node), not
         # whichever variable happens to be last.
         names = [k for k, _ in shown]
@@ -185,7 +186,7 @@ def short_number(v) -> str:
 
 def text_table(header: list[str], rows: list[list[str]]) -> list[str]:
     widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(header)]
-    return ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in [header, *rows]]
+    return ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in [header, *rows]]
 
 
 def _head(result: xr.Dataset) -> list[str]:
@@ -240,7 +241,9 @@ def _gaps_text(b: xr.Dataset, along: str) -> list[str]:
     head = f"{b.attrs['located_by']}; "
     if not n:
         return [head + f"the list is complete: every other stretch of {along} is proved to keep its label"]
-    shown = [f"{a:.10g} .. {c:.10g}" for a, c in zip(b["undecided_lower"].values[:6], b["undecided_upper"].values[:6])] if "undecided_lower" in b else []
+    shown: list[str] = []
+    if "undecided_lower" in b:
+        shown = [f"{a:.10g} .. {c:.10g}" for a, c in zip(b["undecided_lower"].values[:6], b["undecided_upper"].values[:6], strict=True)]
     more = f" and {n - len(shown)} more" if n > len(shown) else ""
     return [head + f"complete but for {n} stretch{'es' if n != 1 else ''} not decided, where a change may hide: "
             + "; ".join(shown) + more]
@@ -253,7 +256,7 @@ def _smallest_text(s: xr.Dataset, frame, limit: int) -> str:
     lo, hi = s.attrs["along_range"]
     lines = [f"smallest stable {along}{u}, searched upward over {s.attrs['along_grid_values']} grid values {lo:.8g} .. {hi:.8g}"]
     lines += _head(s)
-    others = [d for d in s["smallest_stable"].dims]
+    others = list(s["smallest_stable"].dims)
     header = [f"{d} [{s[d].attrs['units']}]" if s[d].attrs.get("units") else d for d in others]
     header += [f"smallest stable {along}", "unstable below", f"{sym} below", "stable to end"]
     rows = []

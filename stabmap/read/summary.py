@@ -103,4 +103,4 @@ def volume_shares(ds: xr.Dataset) -> dict[str, float]:
         shape[axis] = -1
         weight = weight * da.from_array(w, chunks=(cell.chunks[axis],)).reshape(shape)
     sums = compute(*(da.where(cell == v, weight, 0.0).sum() for v, _ in CELL.flags))
-    return {m: float(x) / total if total else float("nan") for (_, m), x in zip(CELL.flags, sums)}
+    return {m: float(x) / total if total else float("nan") for (_, m), x in zip(CELL.flags, sums, strict=True)}

@@ -43,7 +43,7 @@ def _lines(ds: xr.Dataset) -> tuple[list[str], dict[str, np.ndarray]]:
     """The other grid axes and their values on every line, lines in C order (the order of a reshape)."""
     dims = list(ds["n_stable_intervals"].dims)
     grids = np.meshgrid(*(ds[d].values for d in dims), indexing="ij") if dims else []
-    return dims, {d: g.ravel() for d, g in zip(dims, grids)}
+    return dims, {d: g.ravel() for d, g in zip(dims, grids, strict=True)}
 
 
 def _flat(ds: xr.Dataset, name: str, dims: list[str], slot: str | None = None) -> np.ndarray:
@@ -70,7 +70,7 @@ def _intervals(ds: xr.Dataset, along: str, dims: list[str]) -> tuple[np.ndarray,
     whole_name = f"{along}_stable_whole"
     # files made before box proofs have no <along>_stable_whole: their intervals were not proved between scan values
     whole = _flat(ds, whole_name, dims, "interval")[line, k] == 1 if whole_name in ds else np.zeros(line.size, dtype=bool)
-    columns = {n: v[line, k] for n, v in zip(names, (lo, hi, olo, ohi))}
+    columns = {n: v[line, k] for n, v in zip(names, (lo, hi, olo, ohi), strict=True)}
     columns.update({"from_scan_start": np.isnan(olo[line, k]), "to_scan_end": np.isnan(ohi[line, k]), "proved_throughout": whole})
     return line, k, columns
 
@@ -132,14 +132,15 @@ def critical_table(ds: xr.Dataset) -> pd.DataFrame:
         parts.append(pd.DataFrame({"row": kind, "line": line, **{d: coords[d][line] for d in dims}, **columns}))
 
     line, _, iv = _intervals(ds, along, dims)
-    stable = dict(zip((lower, upper, olo, ohi), (iv[f"{along}_stable_{e}"] for e in ("lower", "upper", "lower_outer", "upper_outer"))))
+    stable = dict(zip((lower, upper, olo, ohi), (iv[f"{along}_stable_{e}"] for e in ("lower", "upper", "lower_outer", "upper_outer")), strict=True))
     rows("stable_interval", line, **stable, **{k: iv[k].astype(object) for k in ("from_scan_start", "to_scan_end", "proved_throughout")})
     b_lo, b_hi = _flat(ds, "boundary_lower", dims, "boundary"), _flat(ds, "boundary_upper", dims, "boundary")
     below, above = _flat(ds, f"{lab}_below", dims, "boundary"), _flat(ds, f"{lab}_above", dims, "boundary")
     line, k = np.nonzero(np.isfinite(b_lo))
     meanings = dict(label.flags)
     shown = (lambda v: pd.Series(v).map(meanings).to_numpy(dtype=object)) if label.flags else (lambda v: v.astype(np.int64))
-    rows("boundary", line, **{lower: b_lo[line, k], upper: b_hi[line, k], f"{lab}_below": shown(below[line, k]), f"{lab}_above": shown(above[line, k])})
+    rows("boundary", line, **{lower: b_lo[line, k], upper: b_hi[line, k],
+                              f"{lab}_below": shown(below[line, k]), f"{lab}_above": shown(above[line, k])})
     if "undecided_lower" in ds:  # critical files made before box proofs have no gaps
         g_lo, g_hi = _flat(ds, "undecided_lower", dims, "gap"), _flat(ds, "undecided_upper", dims, "gap")
         line, k = np.nonzero(np.isfinite(g_lo))
@@ -198,7 +199,7 @@ def critical_summary(ds: xr.Dataset) -> dict:
     out = {
         "kind": KIND, "along": along, "units": units, "scan_range": tuple(scan), "lines": nlines,
         "stable_intervals": int(line.size),
-        "n_stable_intervals": dict(sorted(zip(*(v.tolist() for v in np.unique(n_int, return_counts=True))))),
+        "n_stable_intervals": dict(sorted(zip(*(v.tolist() for v in np.unique(n_int, return_counts=True)), strict=True))),
         "boundaries": int(n_bound.sum()), "undecided_gaps": int(n_gaps.sum()), "lines_with_gaps": int(np.count_nonzero(n_gaps)),
         "intervals_with_gap_inside": int(np.count_nonzero(~iv["proved_throughout"])),
         "stable_length": float(length.sum()), "stable_length_proved": float(length[iv["proved_throughout"]].sum()),
@@ -277,9 +278,9 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
         return buf.getvalue().rstrip("\n")
     s = critical_summary(ds)
     if fmt == "json":
-        rows = [{k: (None if v is pd.NA else plain_value(v)) for k, v in r.items()} for r in table.to_dict(orient="records")]
+        records = [{k: (None if v is pd.NA else plain_value(v)) for k, v in r.items()} for r in table.to_dict(orient="records")]
         head = {"stabmap_query": "critical_values", "along": along, "along_units": s["units"], "label": lab,
-                "comment": ds.attrs.get("comment", ""), "units": {k: v for k, v in units.items() if v}, "rows": rows}
+                "comment": ds.attrs.get("comment", ""), "units": {k: v for k, v in units.items() if v}, "rows": records}
         return json_text(head)
     system = systems.of_atlas(ds.attrs)
     sym = system.label_symbol

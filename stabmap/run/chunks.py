@@ -63,9 +63,9 @@ def tile_locations(shape: tuple[int, ...], tile: tuple[int, ...], seed: int = 0)
     """Locations ((start, stop) per axis) of PROBE_RUNS whole tiles at random places of the grid (seeded: repeatable),
     for an atlas decided cell by cell: its points cost what their tile's proofs cost, not what a point's does."""
     rng = np.random.default_rng(seed)
-    counts = [-(-n // t) for n, t in zip(shape, tile)]
+    counts = [-(-n // t) for n, t in zip(shape, tile, strict=True)]
     picks = [rng.integers(0, c, PROBE_RUNS) for c in counts]
-    return [tuple((int(i) * t, min(n, (int(i) + 1) * t)) for i, t, n in zip(at, tile, shape)) for at in zip(*picks)]
+    return [tuple((int(i) * t, min(n, (int(i) + 1) * t)) for i, t, n in zip(at, tile, shape, strict=True)) for at in zip(*picks, strict=True)]
 
 
 def check_chunk_points(value) -> int | None:
@@ -89,18 +89,18 @@ def chunk_shape(shape: tuple[int, ...], points: int, order: tuple[int, ...] | No
     order = tuple(range(len(shape))) if order is None else tuple(order)
     tile = (1,) * len(shape) if tile is None else tuple(tile)
     # counted in tiles: a chunk of whole tiles, about ``points`` points (at least one tile)
-    ntiles = [-(-n // t) for n, t in zip(shape, tile)]
+    ntiles = [-(-n // t) for n, t in zip(shape, tile, strict=True)]
     chunks = list(ntiles)
     budget = max(1, points // math.prod(tile))
     for d in reversed(order):
         chunks[d] = max(1, min(ntiles[d], budget))
         budget = max(1, budget // chunks[d])
-    return tuple(min(n, c * t) for n, c, t in zip(shape, chunks, tile))
+    return tuple(min(n, c * t) for n, c, t in zip(shape, chunks, tile, strict=True))
 
 
 def chunk_locations(shape: tuple[int, ...], chunks: tuple[int, ...]) -> list[tuple[tuple[int, int], ...]]:
     """Every chunk as ((start, stop) per axis), in C order of the chunk grid."""
-    per_axis = [[(a, min(a + c, size)) for a in range(0, size, c)] for size, c in zip(shape, chunks)]
+    per_axis = [[(a, min(a + c, size)) for a in range(0, size, c)] for size, c in zip(shape, chunks, strict=True)]
     return [tuple(loc) for loc in itertools.product(*per_axis)]
 
 

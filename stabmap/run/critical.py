@@ -113,7 +113,7 @@ class _Counts:
         if system.provenance is None:
             return
         values, n = np.unique(results[system.provenance], return_counts=True)
-        for v, c in zip(values.tolist(), n.tolist()):
+        for v, c in zip(values.tolist(), n.tolist(), strict=True):
             self.provenance[v] = self.provenance.get(v, 0) + c
 
 
@@ -122,7 +122,7 @@ def check_along(scene: SceneBase, along: str | None) -> tuple[int, str]:
     axes if it is not one."""
     names = [a.name for a in scene.grid]
     default = along is None
-    along = systems.of(scene).default_axis if default else along
+    along = systems.of(scene).default_axis if along is None else along
     if along not in names:
         have = ", ".join(names) if names else "none (the scene has no [grid])"
         # without along, say which default was taken, and how to choose another
@@ -306,7 +306,7 @@ def _search(run, scene, along, others, active: _Brackets, boxes: bool, rtol, ato
 def _owners(others, shape, owner: np.ndarray) -> dict[str, np.ndarray]:
     """The values of the other axes at the grid points ``owner`` (flat indices into them)."""
     idx = np.unravel_index(owner, shape) if shape else ()
-    return {a.name: a.array[i] for a, i in zip(others, idx)}
+    return {a.name: a.array[i] for a, i in zip(others, idx, strict=True)}
 
 
 def _corners(others, shape, along, seg: _Brackets) -> tuple[dict, dict]:
@@ -321,8 +321,8 @@ def _join(brackets: _Brackets, gaps: _Brackets, rtol: float, atol: float) -> tup
     if len(gaps):
         keep = np.ones(len(gaps), dtype=bool)
         small = np.flatnonzero(_converged(gaps, rtol / 4, atol / 4))
-        ends = {"lo": {(o, x): i for i, (o, x) in enumerate(zip(brackets.owner.tolist(), brackets.lo.tolist()))},
-                "hi": {(o, x): i for i, (o, x) in enumerate(zip(brackets.owner.tolist(), brackets.hi.tolist()))}}
+        ends = {"lo": {(o, x): i for i, (o, x) in enumerate(zip(brackets.owner.tolist(), brackets.lo.tolist(), strict=True))},
+                "hi": {(o, x): i for i, (o, x) in enumerate(zip(brackets.owner.tolist(), brackets.hi.tolist(), strict=True))}}
         changed = True
         while changed:  # a chain of gaps joins one by one, from the bracket outwards
             changed = False
@@ -401,7 +401,9 @@ def _table(label: np.ndarray, scan: np.ndarray, b: _Brackets, gaps: _Brackets, s
     bounds[0, b.owner, slot], bounds[1, b.owner, slot] = b.lo, b.hi
     counts[0, b.owner, slot], counts[1, b.owner, slot] = b.label_lo, b.label_hi
     n_gaps = np.diff(gstarts).astype(np.int32)
-    return _Table(n_int, *ends, *bounds, *counts, flat[:, 0].copy(), n_gaps, *gap_ends, whole)
+    return _Table(n_intervals=n_int, lower=ends[0], upper=ends[1], lower_outer=ends[2], upper_outer=ends[3],
+                  b_lower=bounds[0], b_upper=bounds[1], label_below=counts[0], label_above=counts[1], start=flat[:, 0].copy(),
+                  n_gaps=n_gaps, gap_lower=gap_ends[0], gap_upper=gap_ends[1], whole=whole)
 
 
 def _stable_intervals(label_start: int, scan: np.ndarray, b: _Brackets, stable: int) -> list[tuple[float, float, float, float]]:
@@ -456,8 +458,10 @@ def _dataset(system, scene, along, others, scan, labels, brackets, gaps, proved:
         f"{along}_stable_upper_outer": (iv, grid(t.upper_outer), along_attrs(
             "value just above a stable interval", f"{proved} unstable; the boundary lies in [upper, upper_outer); "
             "NaN where the interval ends at the scan range end (it may continue above)")),
-        "boundary_lower": (bd, grid(t.b_lower), along_attrs(f"lower end of the bracket of a change of {lab}", f"{lab}_below holds here, {proved}; NaN pads")),
-        "boundary_upper": (bd, grid(t.b_upper), along_attrs(f"upper end of the bracket of a change of {lab}", f"{lab}_above holds here, {proved}; a change lies in (lower, upper]; NaN pads")),
+        "boundary_lower": (bd, grid(t.b_lower), along_attrs(
+            f"lower end of the bracket of a change of {lab}", f"{lab}_below holds here, {proved}; NaN pads")),
+        "boundary_upper": (bd, grid(t.b_upper), along_attrs(
+            f"upper end of the bracket of a change of {lab}", f"{lab}_above holds here, {proved}; a change lies in (lower, upper]; NaN pads")),
         f"{lab}_below": (bd, grid(t.label_below), count_attrs(f"{lab} at boundary_lower")),
         f"{lab}_above": (bd, grid(t.label_above), count_attrs(f"{lab} at boundary_upper")),
         f"{along}_stable_whole": (iv, grid(t.whole), {

@@ -86,7 +86,7 @@ class _Level:
     @classmethod
     def build(cls, shape: tuple[int, ...], strides: tuple[int, ...]) -> _Level:
         nodes = []
-        for n, t in zip(shape, strides):
+        for n, t in zip(shape, strides, strict=True):
             idx = np.arange(0, n, t)
             if idx[-1] != n - 1:
                 idx = np.append(idx, n - 1)
@@ -101,21 +101,21 @@ class _Level:
     def corners(self) -> list[tuple[slice, ...]]:
         """For each of the 2^d corners, the slice of the node lattice that gives it for every cell."""
         per_axis = []
-        for idx, c in zip(self.nodes, self.ncells):
+        for idx, c in zip(self.nodes, self.ncells, strict=True):
             upper = slice(1, c + 1) if idx.size > 1 else slice(0, 1)  # a one-point axis: both corners coincide
             per_axis.append((slice(0, c), upper))
         return list(itertools.product(*per_axis))
 
     def at_nodes(self, grid_array: np.ndarray) -> np.ndarray:
         """The values of a grid array at the nodes (a view where every stride is 1)."""
-        for axis, (idx, t) in enumerate(zip(self.nodes, self.strides)):
+        for axis, (idx, t) in enumerate(zip(self.nodes, self.strides, strict=True)):
             if t > 1:
                 grid_array = np.take(grid_array, idx, axis=axis)
         return grid_array
 
     def on_grid(self, cell_array: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
         """A per-cell array spread over the grid points each cell owns (a point on a face goes to the upper cell)."""
-        for axis, (n, t, c) in enumerate(zip(shape, self.strides, self.ncells)):
+        for axis, (n, t, c) in enumerate(zip(shape, self.strides, self.ncells, strict=True)):
             cell_array = np.take(cell_array, np.minimum(np.arange(n) // t, c - 1), axis=axis)
         return cell_array
 
@@ -154,7 +154,7 @@ def _dilate(mask: np.ndarray, cells: int) -> np.ndarray:
 
 def _children(split: np.ndarray, finer: _Level, halves: tuple[bool, ...]) -> np.ndarray:
     """Active cells of the next level: every child of a split cell (child k of an axis that halves has parent k // 2)."""
-    for axis, (c, h) in enumerate(zip(finer.ncells, halves)):
+    for axis, (c, h) in enumerate(zip(finer.ncells, halves, strict=True)):
         if h:
             split = np.take(split, np.arange(c) // 2, axis=axis)
     return split
@@ -218,7 +218,9 @@ class _Evaluator:
     def finish(self) -> dict[str, np.ndarray]:
         """Every variable on the grid, the points not computed given the values their label implies."""
         rest = ~self.computed
-        for k, v in self.system.inferred(self.label[rest]).items():
+        filled = self.system.inferred(self.label[rest])
+        assert filled is not None  # compute_refined refuses a system without System.inferred before it starts
+        for k, v in filled.items():
             if k in self.arrays:  # an output the scene left out (System.outputs)
                 self.arrays[k][rest] = v
         self.arrays[CELL.name][...] = np.where(rest, CELL.value("not_proved"), CELL.value("node_only"))
@@ -226,7 +228,7 @@ class _Evaluator:
 
     def _decide(self, flat: np.ndarray, stride: int) -> dict[str, np.ndarray]:
         idx = np.unravel_index(flat, self.scene.shape)
-        values = {axis.name: axis.array[i] for axis, i in zip(self.scene.grid, idx)}
+        values = {axis.name: axis.array[i] for axis, i in zip(self.scene.grid, idx, strict=True)}
         npts, before = flat.size, self.evaluated
 
         def show(done):
@@ -249,7 +251,7 @@ def _step(ev: _Evaluator, level: _Level, active: np.ndarray, margin: int, box: t
     wrong = np.zeros(level.ncells, dtype=bool)
     if need.any():
         sel = np.nonzero(need)
-        points = tuple(idx[s] + b.start for idx, s, b in zip(level.nodes, sel, box))
+        points = tuple(idx[s] + b.start for idx, s, b in zip(level.nodes, sel, box, strict=True))
         bad = ev.evaluate(points, max(level.strides))
         if bad.any():
             wrong_nodes = np.zeros(need.shape, dtype=bool)
@@ -290,14 +292,14 @@ def _reopen(ev: _Evaluator, level: _Level, split: np.ndarray, margin: int) -> No
     shape = ev.scene.shape
     active = split & _any_corner(level, ~ev.computed)
     while active.any():
-        cells, points = [], []
+        cell_slices, point_slices = [], []
         for axis, n in enumerate(shape):
             hit = np.flatnonzero(np.any(active, axis=tuple(a for a in range(active.ndim) if a != axis)))
             # margin + 1: a cell next to an active one can be wrong, and the margin grows from there.
             c0, c1 = max(0, hit[0] - margin - 1), min(active.shape[axis], hit[-1] + 2 + margin)
-            cells.append(slice(c0, c1))
-            points.append(slice(c0, min(n, c1 + 1)))
-        cells, points = tuple(cells), tuple(points)
+            cell_slices.append(slice(c0, c1))
+            point_slices.append(slice(c0, min(n, c1 + 1)))
+        cells, points = tuple(cell_slices), tuple(point_slices)
         sub = _Level.build(tuple(p.stop - p.start for p in points), (1,) * len(shape))
         again = _step(ev, sub, active[cells], margin, points)
         active = np.zeros_like(active)

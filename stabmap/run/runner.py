@@ -272,7 +272,7 @@ def quiet_dask_logs(enabled: bool = True) -> Iterator[None]:
     try:
         yield
     finally:
-        for h, level in zip(handlers, levels):
+        for h, level in zip(handlers, levels, strict=True):
             h.setLevel(level)
 
 

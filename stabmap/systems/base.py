@@ -26,9 +26,9 @@ abstract properties that a subclass overrides with a plain class attribute.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import replace
+from dataclasses import Field, replace
 from pathlib import Path
-from typing import ClassVar
+from typing import Any, ClassVar, Generic, Self, TypeVar
 
 import numpy as np
 
@@ -41,9 +41,16 @@ from ..store.variables import CELL, Variable
 class SceneBase(ABC):
     """What every system's scene dataclass shares (its own fields: ``title: str`` and ``grid: tuple[Axis, ...]``)."""
 
-    system: ClassVar[str]  # the name of its System
+    # every subclass is a dataclass (declared, not set: what ``dataclasses.replace`` needs to type-check)
+    __dataclass_fields__: ClassVar[dict[str, Field[Any]]]
     title: str
     grid: tuple[Axis, ...]
+
+    @property
+    def system(self) -> str:
+        """The name of its System: a class attribute of most scenes (``system: ClassVar[str] = "closed"``), a property
+        where the scene's content chooses it (a gyroscopes' scene with a viscous liquid is a ``viscous`` one)."""
+        raise NotImplementedError(f"{type(self).__name__} does not name its system")
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -51,7 +58,7 @@ class SceneBase(ABC):
 
     @classmethod
     @abstractmethod
-    def from_dict(cls, table: dict, base_dir: Path | None = None) -> SceneBase:
+    def from_dict(cls, table: dict, base_dir: Path | None = None) -> Self:
         """The scene of a scene file's TOML table (its ``system`` key removed); errors name the key and the fix.
         Relative file names in the table are taken from ``base_dir``."""
 
@@ -72,7 +79,7 @@ class SceneBase(ABC):
         group a heading of ``System.fixed_groups`` (``""``: the whole scene).  Default: nothing."""
         return []
 
-    def with_grid(self, grid: tuple[Axis, ...]) -> SceneBase:
+    def with_grid(self, grid: tuple[Axis, ...]) -> Self:
         """The same scene on ``grid`` (a subset of its own, ``read.subset``), with every choice this scene made from
         its grid kept as it is, so that each point is decided as before."""
         return replace(self, grid=tuple(grid))
@@ -82,7 +89,10 @@ class SceneBase(ABC):
         return text.dumps({"system": self.system, **self.to_dict()})
 
 
-class System(ABC):
+SceneT = TypeVar("SceneT", bound=SceneBase)
+
+
+class System(ABC, Generic[SceneT]):
     """A system: one subpackage of ``stabmap.systems`` holds a subclass and registers its instance.
 
     Required (abstract): ``name``, ``title``, ``references``, ``variables``, ``label``, ``label_symbol``,
@@ -167,7 +177,7 @@ class System(ABC):
 
     @property
     @abstractmethod
-    def scene_type(self) -> type[SceneBase]: ...
+    def scene_type(self) -> type[SceneT]: ...
 
     @property
     @abstractmethod
@@ -193,25 +203,25 @@ class System(ABC):
                             "value the label never takes (e.g. fill=-2), that pads tables where a line has no value")
 
     # ------------------------------------------------------------------ scenes
-    def scene_from_dict(self, table: dict, base_dir: Path | None = None) -> SceneBase:
+    def scene_from_dict(self, table: dict, base_dir: Path | None = None) -> SceneT:
         """The scene of a TOML table (without its ``system`` key); errors name the key and the fix.
         Default: ``scene_type.from_dict``."""
         return self.scene_type.from_dict(table, base_dir)
 
-    def parameter(self, scene: SceneBase, name: str) -> Parameter:
+    def parameter(self, scene: SceneT, name: str) -> Parameter:
         """Units, long name and limits of the scannable ``name``; a StabmapError for a name this scene cannot scan."""
         return scene.parameter(name)
 
-    def fixed_values(self, scene: SceneBase) -> dict[str, float]:
+    def fixed_values(self, scene: SceneT) -> dict[str, float]:
         """The scene's scalar parameters that are not grid axes, by their scannable names (scalar coordinates)."""
         return scene.fixed_values()
 
-    def derived_coords(self, scene: SceneBase) -> dict[str, tuple]:
+    def derived_coords(self, scene: SceneT) -> dict[str, tuple]:
         """Auxiliary coordinates computed from the grid, ``{name: (dims, values, attrs)}``, dims among the grid
         axes (e.g. what a ratio axis moves).  They replace a fixed parameter of the same name.  Default: none."""
         return {}
 
-    def attrs(self, scene: SceneBase) -> dict:
+    def attrs(self, scene: SceneT) -> dict:
         """Global attributes that describe the scene beyond its TOML (netCDF-safe values)."""
         return {}
 
@@ -233,36 +243,36 @@ class System(ABC):
         return [("", list(names))] if names else []
 
     # ------------------------------------------------------------------ points
-    def labels_only(self, scene: SceneBase) -> SceneBase:
+    def labels_only(self, scene: SceneT) -> SceneT:
         """``scene`` with every optional output off: what a computation that needs the label alone (critical
         values) evaluates.  Default: the scene itself."""
         return scene
 
-    def dims(self, scene: SceneBase) -> dict[str, int]:
+    def dims(self, scene: SceneT) -> dict[str, int]:
         """Sizes of the dimensions of ``variables`` beyond the grid's."""
         return {}
 
-    def dim_coords(self, scene: SceneBase) -> dict[str, tuple[np.ndarray, dict]]:
+    def dim_coords(self, scene: SceneT) -> dict[str, tuple[np.ndarray, dict]]:
         """Coordinates of the dimensions beyond the grid's: ``{dim: (values, attrs)}`` (default: none)."""
         return {}
 
-    def fastest_axes(self, scene: SceneBase) -> tuple[int, ...]:
+    def fastest_axes(self, scene: SceneT) -> tuple[int, ...]:
         """Grid axes that should vary fastest within a block (e.g. those that leave the expensive set-up alone)."""
         return ()
 
     @abstractmethod
-    def input_bytes(self, scene: SceneBase) -> int:
+    def input_bytes(self, scene: SceneT) -> int:
         """Bytes of one point's inputs to ``evaluate`` (its share of a block's arrays): caps the chunks' size."""
 
     @abstractmethod
-    def evaluate(self, scene: SceneBase, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    def evaluate(self, scene: SceneT, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Decide points: ``values`` maps grid-axis names to arrays that broadcast to the points' shape S.
 
         Returns every variable of ``variables``, each an array of shape S + its own ``dims``.
         Axes not in ``values`` take the scene's fixed values.
         """
 
-    def prove_boxes(self, scene: SceneBase, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+    def prove_boxes(self, scene: SceneT, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
         """(label, proved) of each box: ``proved[i]`` says that the label is ``label[i]`` at every point of box i.
 
         Box i holds the points whose grid-axis values lie between ``lower[name][i]`` and ``upper[name][i]``
@@ -273,18 +283,18 @@ class System(ABC):
         """
         return None
 
-    def prove_and_cut_boxes(self, scene: SceneBase, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+    def prove_and_cut_boxes(self, scene: SceneT, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
         """``prove_boxes``, and for each box not proved the grid axes worth cutting it along: (label, proved, cut),
         ``cut[name][i]`` for each axis named (``stabmap.run.cells`` halves box i along those).  Default: every axis."""
         label, proved = self.prove_boxes(scene, lower, upper)
         return label, proved, {k: np.ones(np.shape(label), dtype=bool) for k in lower}
 
-    def box_cost(self, scene: SceneBase) -> float:
+    def box_cost(self, scene: SceneT) -> float:
         """What one box proof of a box along this scene's grid axes costs, in proofs of one point (default 1):
         the budget of box proofs in an atlas (``stabmap.run.cells``)."""
         return 1.0
 
-    def box_axes(self, scene: SceneBase) -> set[str]:
+    def box_axes(self, scene: SceneT) -> set[str]:
         """The grid axes along which ``prove_boxes`` can prove a box of this scene (default: none)."""
         return set()
 
@@ -295,13 +305,13 @@ class System(ABC):
         """
         raise NotImplementedError(f"the {self.name} system proves boxes but does not say what a box-proved node holds")
 
-    def roots(self, scene: SceneBase, values: dict[str, float]) -> tuple[list, str] | None:
+    def roots(self, scene: SceneT, values: dict[str, float]) -> tuple[list, str] | None:
         """Every characteristic root at one point (``stabmap.read.roots``): a list of records with ``value``,
         ``radius``, ``multiplicity``, ``kind``, ``origin``, ``liquid_share`` and ``growth_rate``, and the rule that
         decided ``origin``.  None (the default): the system has no such roots."""
         return None
 
-    def at_proved_nodes(self, scene: SceneBase, values: dict[str, np.ndarray], label: np.ndarray) -> dict[str, np.ndarray] | None:
+    def at_proved_nodes(self, scene: SceneT, values: dict[str, np.ndarray], label: np.ndarray) -> dict[str, np.ndarray] | None:
         """Variables of ``outputs(scene)`` that the system computes at nodes whose ``label`` a box proof holds (1-D arrays
         of grid-axis ``values``), over ``proved_box``'s.  None (the default): ``proved_box`` says all."""
         return None
@@ -314,12 +324,12 @@ class System(ABC):
         return None
 
     # ------------------------------------------------------------------ outputs
-    def outputs(self, scene: SceneBase) -> tuple[Variable, ...]:
+    def outputs(self, scene: SceneT) -> tuple[Variable, ...]:
         """The ``variables`` that ``evaluate`` returns and an atlas of ``scene`` stores (default: all of them);
         a system whose scenes opt in or out of some outputs names those left out here."""
         return tuple(self.variables)
 
-    def atlas_outputs(self, scene: SceneBase) -> tuple[Variable, ...]:
+    def atlas_outputs(self, scene: SceneT) -> tuple[Variable, ...]:
         """Every variable of an atlas of ``scene``: its ``outputs`` and ``cell``."""
         return self.outputs(scene) + (CELL,)
 

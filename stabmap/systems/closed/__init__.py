@@ -34,7 +34,7 @@ REFERENCES = (
 )
 
 
-class Closed(System):
+class Closed(System[Scene]):
     name = "closed"
     title = "planar and twisted equilibria of a closed chain of elastic joints, with their forces and stability in space"
     references = REFERENCES
@@ -107,7 +107,7 @@ class Closed(System):
             g = None if gamma is None else [gamma[i] for i in pts]
             if scene.lengths:  # the scene's lengths: one proof per gamma (c1^2 and h leave the labels alone)
                 guess = _guess(fam, lengths[:1], c1sq[:1], h[:1], j)
-                done = {}
+                done: dict = {}  # gamma -> its proof
                 verdicts = proofs.Verdicts.of([
                     done[x] if x in done else done.setdefault(x, space_proofs.prove_lengths(fam, j, m, scene.lengths, x, guess))
                     for x in (g or [None] * pts.size)])
@@ -134,8 +134,8 @@ class Closed(System):
 
 def _gammas(c1sq: np.ndarray, c2sq: np.ndarray) -> list:
     """gamma = c2^2/c1^2 exactly at every point (one fmpq per distinct pair of doubles)."""
-    pairs = {}
-    return [pairs.setdefault((a, b), space_proofs.gamma_of(a, b)) for a, b in zip(c1sq.tolist(), c2sq.tolist())]
+    pairs: dict = {}
+    return [pairs.setdefault((a, b), space_proofs.gamma_of(a, b)) for a, b in zip(c1sq.tolist(), c2sq.tolist(), strict=True)]
 
 
 def _guess(fam, lengths, c1sq, h, j):

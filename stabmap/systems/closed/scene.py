@@ -114,7 +114,7 @@ class Scene(SceneBase):
         return fixed_values(self)
 
     def to_dict(self) -> dict:
-        out = {"title": self.title, "family": self.family}
+        out: dict[str, object] = {"title": self.title, "family": self.family}
         if self.model != "spatial":
             out["model"] = self.model
         if self.lengths:
@@ -159,8 +159,10 @@ def fixed_values(scene: Scene, all_names: bool = False) -> dict[str, float]:
         out["ratio"] = 1.0 if scene.ratio is None else scene.ratio
         out["h1"] = 1.0 if scene.h1 is None else scene.h1
     if scene.ring:
-        if scene.n is not None or scene.lengths:
-            out["n"] = float(len(scene.lengths) if scene.lengths else scene.n)
+        if scene.lengths:
+            out["n"] = float(len(scene.lengths))
+        elif scene.n is not None:
+            out["n"] = float(scene.n)
         out["j"] = float(1 if scene.j is None else scene.j)
         out["twist"] = float(0 if scene.twist is None else scene.twist)
     out["c1sq"] = 1.0 if scene.c1sq is None else scene.c1sq
@@ -210,7 +212,7 @@ def _validate(scene: Scene) -> None:
     names = {a.name for a in scene.grid}
     for key in _RING_ONLY:
         if key in names:
-            for i, v in enumerate(scene.axis(key)):
+            for i, v in enumerate(scene.values_of(key)):
                 checks.whole(f"grid.{key}.values[{i + 1}]", v, {"n": 3, "j": 1, "twist": 0}[key])
     if scene.ring and not explicit and scene.n is None and "n" not in names:
         raise StabmapError("n is missing: a ring needs its number of bodies; set n = 6 (say), scan n in [grid], or give lengths = [...]")

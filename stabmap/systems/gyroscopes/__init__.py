@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...store.variables import Variable
 from ..base import System
 from .outputs import ALL_VARIABLES, BY_BOX, BY_INFERRED, FREQUENCY_VARIABLES, GROWTH_VARIABLES, N_COMPLEX_PAIRS, VARIABLES, stability_from_pairs
 from .scene import Body, Scene
@@ -24,11 +25,11 @@ REFERENCES = (
 )
 
 
-class Gyroscopes(System):
+class Gyroscopes(System[Scene]):
     name = "gyroscopes"
     title = "chains and trees of Lagrange gyroscopes with liquid-filled cavities"
     references = REFERENCES
-    variables = ALL_VARIABLES
+    variables: tuple[Variable, ...] = ALL_VARIABLES
     label = N_COMPLEX_PAIRS.name
     label_symbol = "N_c"
     label_title = "complex root pairs N$_c$"
@@ -64,7 +65,9 @@ class Gyroscopes(System):
     def fixed_groups(self, names: list[str]) -> list[tuple[str, list[str]]]:
         # The whole scene (g, omega), the joints K_0.. (K_0 the support's, K_k between bodies k and k+1),
         # then one group a body: m_k, A_k, C_k, c_k, s_k, omega_k, at_k and its cavity's parameters.
-        scene, joints, bodies = [], [], {}
+        scene: list[str] = []
+        joints: list[str] = []
+        bodies: dict[int, list[str]] = {}
         for name in names:
             head, _, index = name.rpartition("_")
             if not index.isdigit() or not head:
@@ -105,6 +108,7 @@ class Gyroscopes(System):
         from .points import point_arrays
 
         one = point_arrays(scene, {})
+        assert one.at is not None  # PointArrays.__post_init__ fills it
         return sum(a.nbytes for a in (one.body, one.joint, one.g, one.E, one.kappa, one.at)) + 8
 
     def evaluate(self, scene: Scene, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

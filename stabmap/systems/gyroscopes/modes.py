@@ -55,13 +55,13 @@ def roots_at(scene, values: dict[str, float]) -> list[Root]:
     D = scene.degree
     poly_roots = _distinct(*exact_roots(points, 0, D)[:3])
     shares = _shares(points, scene, [z for z, *_ in poly_roots])
-    out = [Root(z, r, m, "real" if kind == 0 else "complex pair", _origin(s), s) for (z, r, m, kind), s in zip(poly_roots, shares)]
+    out = [Root(z, r, m, "real" if kind == 0 else "complex pair", _origin(s), s) for (z, r, m, kind), s in zip(poly_roots, shares, strict=True)]
     return sorted(out, key=lambda root: (root.value.real, root.value.imag))
 
 
 def _distinct(z, r, kind):
     """(value, radius, multiplicity, kind) per distinct root: ``exact_roots`` repeats a multiple root."""
-    out = []
+    out: list[list] = []  # [value, radius, multiplicity, kind], the multiplicity counted up
     for i in range(len(z)):
         if kind[i] < 0:
             continue

@@ -138,7 +138,7 @@ class Scene(SceneBase):
         return replace(self, bodies=bodies, grid=tuple(grid))
 
     def to_dict(self) -> dict:
-        out = {"title": self.title, "support": self.support}
+        out: dict[str, object] = {"title": self.title, "support": self.support}
         if not self.free:
             out["g"] = self.g
         if self.omega is not None:
@@ -154,7 +154,7 @@ class Scene(SceneBase):
             out["topology"] = {"parent": list(self.topology.parent), "at": list(self.topology.at)}
         bodies = []
         for b in self.bodies:
-            body = {"m": b.m, "A": b.A, "C": b.C, "c": b.c}
+            body: dict[str, object] = {"m": b.m, "A": b.A, "C": b.C, "c": b.c}
             if self.topology is None:
                 body["s"] = b.s
             if b.omega is not None:
@@ -427,7 +427,7 @@ def fixed_values(scene: Scene) -> dict[str, float]:
         if b.cavity is not None and (b.cavity.geometric or b.cavity.viscous):
             for key in SCANNABLE_CAVITY if b.cavity.geometric else ("radius", "density"):
                 out[f"{key}_{k}"] = getattr(b.cavity, key)
-            if b.cavity.viscous:
+            if b.cavity.viscosity is not None:  # the cavity is viscous
                 out[f"viscosity_{k}"] = b.cavity.viscosity
     if not scene.free and not ratios.projectile(scene):  # M_alpha takes the base joint's place
         out["K_0"] = scene.K_0

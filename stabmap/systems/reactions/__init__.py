@@ -32,7 +32,7 @@ REFERENCES = (
 )
 
 
-class Reactions(System):
+class Reactions(System[Scene]):
     name = "reactions"
     title = "reactions of n point nodes holding a rigid body, by the least sum of squares"
     references = REFERENCES

@@ -20,6 +20,7 @@ c_x = { start = -0.4, stop = 0.4, num = 81 }
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar
@@ -40,6 +41,9 @@ _RELEASE_KEYS = {"node", "direction"}
 _LOAD_KEYS = {"F", "M"}
 _BODY_KEYS = {"mass", "centre", "gravity", "acceleration", "omega", "alpha", "inertia"}
 _ANY = Parameter("", "", "")
+# the TOML file and the Python scene take the load in the same two ways: one message for both
+_ONE_LOAD = ("give the load either as a [load] table (F and M) or as a [body] table (mass, centre, gravity, motion), "
+             "exactly one of the two")
 
 Vector = tuple[float, float, float]
 
@@ -111,7 +115,11 @@ class Scene(SceneBase):
     @property
     def vectors(self) -> dict[str, Vector]:
         """The scene's load vectors by the prefix of their scannable names."""
-        return {"F": self.load.F, "M": self.load.M} if self.load is not None else self.body.vectors
+        if self.load is not None:
+            return {"F": self.load.F, "M": self.load.M}
+        if self.body is None:  # __post_init__ lets no such scene through
+            raise StabmapError(_ONE_LOAD)
+        return self.body.vectors
 
     def parameter(self, name: str) -> Parameter:
         """The parameter a grid axis called ``name`` scans, or a StabmapError saying why it cannot be scanned."""
@@ -128,14 +136,14 @@ class Scene(SceneBase):
         return parameters.parse(name, self.n, self.kind)[0]
 
     def to_dict(self) -> dict:
-        out = {"title": self.title, "nodes": [list(p) for p in self.nodes]}
+        out: dict[str, object] = {"title": self.title, "nodes": [list(p) for p in self.nodes]}
         if self.releases:
             out["releases"] = [{"node": r.node, "direction": list(r.direction)} for r in self.releases]
         if self.load_factor != 1.0:
             out["load_factor"] = self.load_factor
         if self.load is not None:
             out["load"] = {"F": list(self.load.F), "M": list(self.load.M)}
-        else:
+        elif self.body is not None:  # always: a scene has a load or a body (__post_init__)
             b = self.body
             out["body"] = {"mass": b.mass, "centre": list(b.centre), "gravity": list(b.gravity),
                            "acceleration": list(b.acceleration), "omega": list(b.omega), "alpha": list(b.alpha),
@@ -152,7 +160,7 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
     if "nodes" not in data:
         raise StabmapError("nodes is missing: give the node positions, e.g. nodes = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] [m]")
     if ("load" in data) == ("body" in data):
-        raise StabmapError("give the load either as a [load] table (F and M) or as a [body] table (mass, centre, gravity, motion), exactly one of the two")
+        raise StabmapError(_ONE_LOAD)
     values = {k: data[k] for k in ("title", "load_factor") if k in data}
     if not isinstance(data["nodes"], list) or not data["nodes"]:
         raise StabmapError(f"nodes must be a non-empty list of [x, y, z] positions [m], got {data['nodes']!r}")
@@ -187,7 +195,8 @@ def from_dict(data: dict, base_dir: str | Path | None = None) -> Scene:
 def _vector(value, where: str, info: Parameter = _ANY) -> Vector:
     if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 3:
         raise StabmapError(f"{where} must be a 3-vector [x, y, z], got {value!r}")
-    return tuple(check_value(f"{where}[{d}]", v, info) for d, v in enumerate(value))
+    x, y, z = (check_value(f"{where}[{d}]", v, info) for d, v in enumerate(value))
+    return x, y, z
 
 
 def _validate(scene: Scene) -> None:
@@ -208,11 +217,11 @@ def _validate(scene: Scene) -> None:
     put("nodes", tuple(tuple(p) for p in nodes.tolist()))
     if not all(isinstance(r, Release) for r in scene.releases):
         raise StabmapError("releases must be Release(node, direction) entries")
-    checked = check_releases([(r.node, r.direction) for r in scene.releases], scene.n)
-    put("releases", tuple(Release(r.node, _vector(r.direction, f"releases[{k}].direction")) for k, (r, _) in enumerate(zip(scene.releases, checked))))
+    check_releases([(r.node, r.direction) for r in scene.releases], scene.n)
+    put("releases", tuple(Release(r.node, _vector(r.direction, f"releases[{k}].direction")) for k, r in enumerate(scene.releases)))
     put("load_factor", check_value("load_factor", scene.load_factor, parameters.LOAD_FACTOR))
     if (scene.load is None) == (scene.body is None):
-        raise StabmapError("give the load either as a [load] table (F and M) or as a [body] table (mass, centre, gravity, motion), exactly one of the two")
+        raise StabmapError(_ONE_LOAD)
     if scene.load is not None:
         if not isinstance(scene.load, Load):
             raise StabmapError(f"load must be a Load(F, M), got {scene.load!r}")
@@ -225,7 +234,7 @@ def _validate(scene: Scene) -> None:
     _check_distinct_on_grid(scene)
 
 
-def _checked_body(b: Body) -> Body:
+def _checked_body(b: object) -> Body:
     if not isinstance(b, Body):
         raise StabmapError(f"body must be a Body(mass, ...), got {b!r}")
     mass = check_value("body.mass", b.mass, parameters.MASS)
@@ -234,6 +243,7 @@ def _checked_body(b: Body) -> Body:
     raw = b.inertia
     if isinstance(raw, (str, bytes)) or not hasattr(raw, "__len__") or len(raw) != 3:
         raise StabmapError(f"body.inertia must be 3 principal moments [Ixx, Iyy, Izz] or a 3x3 tensor [kg m2], got {raw!r}")
+    rows: list[Sequence[float]]
     if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in raw):
         rows = [[check_value(f"body.inertia[{d}]", v, _ANY) if e == d else 0.0 for e in range(3)] for d, v in enumerate(raw)]
     else:
@@ -244,7 +254,8 @@ def _checked_body(b: Body) -> Body:
         raise StabmapError("body.inertia must be symmetric (I[i][j] = I[j][i]); give the tensor about the centre of mass")
     if size and np.linalg.eigvalsh((I + I.T) / 2).min() < -1e-12 * size:
         raise StabmapError("body.inertia has a negative principal moment; an inertia tensor is positive semi-definite")
-    return Body(mass=mass, inertia=tuple(tuple(r) for r in I.tolist()), **vectors)
+    r0, r1, r2 = ((float(x), float(y), float(z)) for x, y, z in I.tolist())
+    return Body(mass=mass, inertia=(r0, r1, r2), **vectors)
 
 
 def _check_directions(scene: Scene) -> None:
