@@ -372,7 +372,7 @@ def decompose(C, aw):
     _products(X, mats[3], Z, An, Mp, yk, yb, n, D)
     try:
         Y[:] = np.linalg.inv(Z)
-    except Exception:  # noqa: BLE001 -- numba catches no narrower class; a singular B X: no decomposition
+    except Exception:  # numba catches no narrower class; a singular B X: no decomposition
         return False
     return True
 
@@ -544,7 +544,7 @@ def refine(aw):
         if not worst < SCHULZ:
             try:
                 Y[:] = np.linalg.inv(Z)
-            except Exception:  # noqa: BLE001 -- numba catches no narrower class; a singular B X
+            except Exception:  # numba catches no narrower class; a singular B X
                 return -1.0
             break
         if worst < 2.0**-30:  # an error of Y this small only widens the discs by its square
@@ -690,7 +690,7 @@ def certify(body, E, nmodes, parent, m, pws, C, Mo, aw, warm):
     ``warm``: first refine the decomposition left by the previous point; cold (the eigenvectors of
     the float linearisation, into C with scratch Mo) if that fails or there is none.
     """
-    size, state = aw.size, aw.state
+    state = aw.state
     pencil_balls(body, E, nmodes, pws, aw)
     if warm and state[layout.AAO_HELD] == 1:
         extrapolate(aw)

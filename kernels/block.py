@@ -73,7 +73,8 @@ def count_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out_
     starts = np.empty(n + 1, np.int64)
     for p in range(npts):
         reuse = same_structure(body, joint, at, g, p)
-        out_nc[p], out_status[p] = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, reuse)
+        out_nc[p], out_status[p] = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs,
+                                                       starts, reuse)
 
 
 @kernel
@@ -139,7 +140,8 @@ def decide_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_nc, out
         nc, st = -1, UNDECIDED
         if sturm_first:
             again = reuse and coefficients_last == p - 1
-            nc, st = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, again, False)
+            nc, st = _count_coefficients(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, cs, starts, again,
+                                         False)
             coefficients_last = p
         if st == UNDECIDED:
             # M and K in the certificate's workspace are those of the last point it saw

@@ -14,7 +14,6 @@ from .scaling import nonzero_span, rescale, rescale_by, root_scale
 from .status import DECIDED_INCLUSION, UNDECIDED, ZERO_POLYNOMIAL
 from .sturm import count_complex_pairs
 
-
 SPLIT = 4.0  # a box whose probed values move this many times more along one axis than the other is cut across it alone
 
 

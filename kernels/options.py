@@ -71,10 +71,9 @@ SHIPPED = Path(__file__).parent / "_cache" / f"kernels-{DIGEST}"  # filled by th
 
 def cache_dir() -> Path:
     """Where compiled kernels of this exact source and toolchain are cached."""
-    root = os.environ.get("STABMAP_CACHE_DIR")
-    if not root:
-        root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "stabmap"
-    return Path(root) / f"kernels-{DIGEST}"
+    given = os.environ.get("STABMAP_CACHE_DIR")
+    root = Path(given) if given else Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "stabmap"
+    return root / f"kernels-{DIGEST}"
 
 
 def _writable(path: Path) -> bool:

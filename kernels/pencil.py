@@ -22,8 +22,8 @@ from __future__ import annotations
 import numpy as np
 
 from . import ball, layout
-from .dd import two_sum
 from .charpoly import check_parent, path_matrix, structure
+from .dd import two_sum
 from .options import kernel
 
 
@@ -56,7 +56,7 @@ def prepare(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
     Returns the number m of exact zero roots: columns of K T that are exactly zero, and modes with beta exactly 0
     (kappa = 2, or omega_k = 0), each a factor z of prod Q with no pole in Phi (``_liquid_real``).
     """
-    T, jmk, sub, mat, vec, beta = ws.T, ws.jmk, ws.sub, ws.mat, ws.vec, ws.beta
+    jmk, sub, mat, vec, beta = ws.jmk, ws.sub, ws.mat, ws.vec, ws.beta
     n = body.shape[0]
     if not reuse:
         structure(body, joint, at, g, parent, free, sub, jmk[0], jmk[1], jmk[2])
@@ -283,7 +283,7 @@ def linearisation(body, E, nmodes, parent, ws, C, Mo):
         Mo[i, i] -= vec[layout.ESUM_MID, i]
     try:
         Minv = np.linalg.inv(Mo)
-    except Exception:  # noqa: BLE001 -- numba catches no narrower class; singular in floats: no approximations
+    except Exception:  # numba catches no narrower class; singular in floats: no approximations
         return False
     MK = Minv @ mat[layout.K_MID]
     for k in range(n):

@@ -18,7 +18,7 @@ from __future__ import annotations
 from . import dd
 from .options import kernel
 from .scaling import nonzero_span, rescale, root_scale
-from .status import DECIDED_FLOAT, ZERO_POLYNOMIAL, UNDECIDED
+from .status import DECIDED_FLOAT, UNDECIDED, ZERO_POLYNOMIAL
 
 
 @kernel

@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from pathlib import Path
+from typing import Any
 
 import flint
 import numpy as np
@@ -25,7 +26,7 @@ import numpy as np
 CASES = ("paper-n1-fixed", "paper-n1-free", "paper-n2-fixed", "paper-n2-free", "paper-n3-fixed", "paper-n3-free",
          "paper-n3-fixed-split")
 # A viscous liquid in every body, given by its tensor: the label does not depend on its size (docs/viscous.md)
-LIQUID = {"shape": "table", "tensor": (1e-9, 1e-9), "radius": 0.01, "density": 1000.0, "viscosity": 0.1}
+LIQUID: dict[str, Any] = {"shape": "table", "tensor": (1e-9, 1e-9), "radius": 0.01, "density": 1000.0, "viscosity": 0.1}
 
 
 def viscous(scene, oblate: bool = False):
@@ -71,7 +72,7 @@ def run(*, out: Path | None = None, quick: bool = False) -> dict:
             label = ds["asymptotic_stability"].values.reshape(-1)
             axes = [a.name for a in scene.grid]
             grids = np.meshgrid(*(ds[k].values for k in axes), indexing="ij")
-            points = point_arrays(scene, {k: g.reshape(-1) for k, g in zip(axes, grids)})
+            points = point_arrays(scene, {k: g.reshape(-1) for k, g in zip(axes, grids, strict=True)})
             agree = wrong = 0
             for i in np.flatnonzero(label >= 0):
                 expected = settles(points, int(i))
@@ -81,7 +82,8 @@ def run(*, out: Path | None = None, quick: bool = False) -> dict:
                     agree += 1
                 else:
                     wrong += 1
-                    problems.append(f"{name}{' oblate' if oblate else ''}: point {dict(zip(axes, (float(g.reshape(-1)[i]) for g in grids)))} "
+                    point = dict(zip(axes, (float(g.reshape(-1)[i]) for g in grids), strict=True))
+                    problems.append(f"{name}{' oblate' if oblate else ''}: point {point} "
                                     f"labelled {int(label[i])}, the criterion says {'settles' if expected else 'grows'}")
             case = f"{name}{' (C x 4)' if oblate else ''}"
             rows.append(f"| {case} | {label.size} | {100 * np.mean(label == ASYMPTOTICALLY_STABLE):.1f} % | "

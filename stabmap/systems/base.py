@@ -26,6 +26,7 @@ abstract properties that a subclass overrides with a plain class attribute.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import Field, replace
 from pathlib import Path
 from typing import Any, ClassVar, Generic, Self, TypeVar
@@ -350,7 +351,7 @@ class System(ABC, Generic[SceneT]):
         return var.meaning(value).replace("_", " ") if var.flags else f"{self.label} = {value}"
 
     # figures
-    def figure_text(self, text: str, units) -> str:
+    def figure_text(self, text: str, units: Callable[[str], str]) -> str:
         """``text`` of this system (a coordinate's ``long_name``, a note of its scene) as a figure writes it.
 
         A figure has less room than ``stabmap info``: a system may shorten a phrase its names all repeat, and write

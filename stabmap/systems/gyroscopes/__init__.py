@@ -12,6 +12,8 @@ the modules beside it:
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from ...store.variables import Variable
@@ -180,7 +182,7 @@ class Gyroscopes(System[Scene]):
                 **not_computed(label, proved=False)}
 
     # figures
-    def figure_text(self, text: str, units) -> str:
+    def figure_text(self, text: str, units: Callable[[str], str]) -> str:
         # Each body's A is "about its centre of mass" (parameters.py); an axis label has no room to say it again.
         text = text.replace(" about its centre of mass", "")
         for unit in ("kg m2", "m7"):  # what notes() writes after numbers: a liquid's E, a viscous liquid's tensor

@@ -56,7 +56,8 @@ def box_axes(scene: Scene) -> set[str]:
     """The grid axes along which a box can be enclosed: all but those whose kernel inputs are not monotone in them.
 
     Every kernel input is then a copy of one scanned value, or that value minus a constant (a cavity's tail), or
-    rounded once from it (C = C/A times A, -M_alpha), so the inputs at a box's two corners bound the inputs at every point of it.  Not enclosed: a cavity's size
+    rounded once from it (C = C/A times A, -M_alpha), so the inputs at a box's two corners bound the inputs at every
+    point of it.  Not enclosed: a cavity's size
     or density (the modes depend on them), and a column (m, A, C, c) of a body whose cavity's liquid stabmap
     adds (liquid_in_body = false: the frozen liquid moves the centre of mass with them).
     """
@@ -187,7 +188,7 @@ def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarra
     others = sum((m.astype(int) for k, m in moves.items() if not _is_spin(scene, k)), np.zeros(npts, dtype=int))
     mech = [k for k in lower if _mechanical(scene, k)]
     plain = _plain(lo, hi)
-    out = []
+    out: list[tuple[np.ndarray, BoxArrays | NodeBoxes]] = []
 
     spin_names = np.full(npts, None, dtype=object)  # the spin axis a box moves
     for k in lower:

@@ -4,13 +4,24 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...kernels import DECIDED_ALLATONCE, DECIDED_DISKS, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL, box_block, decide_block, nodes_box_block
+from ...kernels import (
+    DECIDED_ALLATONCE,
+    DECIDED_DISKS,
+    DECIDED_INCLUSION,
+    DECIDED_INERTIA,
+    UNDECIDED,
+    ZERO_POLYNOMIAL,
+    box_block,
+    decide_block,
+    nodes_box_block,
+)
 from . import exact
-from .outputs import BY_ALLATONCE, BY_DISKS, BY_EXACT, BY_INCLUSION, BY_INERTIA, BY_STURM
 from .boxes import BoxArrays, NodeBoxes, boxes, unenclosed
+from .outputs import BY_ALLATONCE, BY_DISKS, BY_EXACT, BY_INCLUSION, BY_INERTIA, BY_STURM
 from .points import PointArrays
 
-_BY_STATUS = {DECIDED_ALLATONCE: BY_ALLATONCE, DECIDED_INCLUSION: BY_INCLUSION, DECIDED_INERTIA: BY_INERTIA, DECIDED_DISKS: BY_DISKS, UNDECIDED: BY_EXACT}
+_BY_STATUS = {DECIDED_ALLATONCE: BY_ALLATONCE, DECIDED_INCLUSION: BY_INCLUSION, DECIDED_INERTIA: BY_INERTIA, DECIDED_DISKS: BY_DISKS,
+              UNDECIDED: BY_EXACT}
 
 
 def decided_by_from_status(status: np.ndarray) -> np.ndarray:

@@ -73,7 +73,7 @@ def int_matrix(body, joint, g, E, kappa, nmodes, free: bool, parent=None, at=Non
 def _liquid(betas: list, Es: list, x):
     """(Q, R) = (prod_l (x + beta_l), sum_l E_l prod_{m != l} (x + beta_m)) for x an fmpq or an fmpq_poly."""
     Q, R = 1 + 0 * x, 0 * x
-    for beta, e in zip(betas, Es):
+    for beta, e in zip(betas, Es, strict=True):
         R = R * (x + beta) + e * Q
         Q = Q * (x + beta)
     return Q, R
@@ -176,7 +176,7 @@ def _interpolate(ys: list) -> flint.fmpq_poly:
     diffs = [y.numer() * (den // y.denom()) for y in ys]
     lead = [diffs[0]]
     while len(diffs) > 1:
-        diffs = [b - a for a, b in zip(diffs, diffs[1:])]
+        diffs = [b - a for a, b in zip(diffs, diffs[1:], strict=False)]  # neighbours: one fewer
         lead.append(diffs[0])
     coef, fact = [], flint.fmpz(1)
     for j, d in enumerate(lead):

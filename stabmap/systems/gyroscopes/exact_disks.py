@@ -74,7 +74,7 @@ def count(coefs: list, degrees: list) -> int | None:
             # axis by 2^-30 of itself: real approximations of a cluster that holds a complex pair stay real
             # under the real iteration, and a real root's centre comes back to the axis in a step or two.
             tilt = [flint.acb(0, 2.0**-30 * (-1) ** i) if step == 0 else 0 for i in range(d)]
-            centres = [(c - w + c * t).mid() for c, w, t in zip(centres, W, tilt)]
+            centres = [(c - w + c * t).mid() for c, w, t in zip(centres, W, tilt, strict=True)]
     finally:
         flint.ctx.prec = old
     return None
@@ -87,7 +87,7 @@ def _corrections(mats: tuple, a, centres: list) -> list | None:
     """
     prods = flint.acb_poly.from_roots(centres).derivative().evaluate(centres, algorithm="iter")
     out = []
-    for x, q in zip(centres, prods):
+    for x, q in zip(centres, prods, strict=True):
         real = x.imag.is_zero()
         coefs = mats[0] if real else mats[1]
         x = x.real if real else x
@@ -111,7 +111,7 @@ def _real_if_separated(centres: list, W: list, d: int) -> int | None:
     """
     z = np.empty(len(centres), dtype=complex)
     radius = np.empty(len(centres))
-    for i, (c, w) in enumerate(zip(centres, W)):
+    for i, (c, w) in enumerate(zip(centres, W, strict=True)):
         z[i] = complex(float(c.real.mid()), float(c.imag.mid()))
         moved = abs(c - flint.acb(z[i].real, z[i].imag)).upper()
         radius[i] = math.nextafter(float((w.abs_upper() * d + moved).upper()), math.inf)
@@ -134,7 +134,7 @@ def _deflate(coefs: list, degrees: list):
     det A = x^zeros det A'; a liquid mode with beta = 0 (kappa = 2, or omega = 0) puts the factor x in its
     body's whole row, and a root exactly at 0 would otherwise sit under a disk it cannot be told apart from.
     """
-    coefs = [c for c in coefs]
+    coefs = list(coefs)
     degrees = list(degrees)
     n, zeros = coefs[0].nrows(), 0
     for k in range(n):

@@ -19,6 +19,7 @@ import math
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any, cast
 
 import numpy as np
 
@@ -84,7 +85,7 @@ class Cavity:
     def to_dict(self) -> dict:
         """The ``cavity`` table of the body in a scene file."""
         if self.viscous:
-            keys = ("shape", "radius", "half_height", "density", "viscosity", "liquid_in_body") if self.geometric else \
+            keys: tuple[str, ...] = ("shape", "radius", "half_height", "density", "viscosity", "liquid_in_body") if self.geometric else \
                 ("shape", "tensor", "radius", "density", "viscosity")
             out = {k: list(v) if isinstance(v := getattr(self, k), tuple) else v for k in keys}
             if self.geometric and not self.liquid_in_body:
@@ -187,7 +188,7 @@ def check(c: Cavity, where: str) -> Cavity:
         return _check_viscous(c, where)
     if not c.geometric:
         return _check_table(c, where)
-    sizes = {key: check_value(f"{where}.{key}", getattr(c, key), CAVITY[key]) for key in ("radius", "half_height", "density")}
+    sizes: dict[str, Any] = {key: check_value(f"{where}.{key}", getattr(c, key), CAVITY[key]) for key in ("radius", "half_height", "density")}
     modes, tolerance = _check_modes(c, where)
     for key in ("tail", "liquid_in_body"):
         if not isinstance(getattr(c, key), bool):
@@ -205,7 +206,7 @@ def _check_viscous(c: Cavity, where: str) -> Cavity:
     if c.E or c.kappa or (c.modes not in (None, 0)) or c.mode_tolerance is not None:
         raise StabmapError(f"{where}: a viscous liquid has no modes (docs/viscous.md); remove modes, E and kappa, or remove viscosity")
     keys = ("radius", "half_height", "density") if c.geometric else ("radius", "density")
-    sizes = {key: check_value(f"{where}.{key}", getattr(c, key), CAVITY[key]) for key in keys}
+    sizes: dict[str, Any] = {key: check_value(f"{where}.{key}", getattr(c, key), CAVITY[key]) for key in keys}
     if c.geometric:
         if not isinstance(c.liquid_in_body, bool):
             raise StabmapError(f"{where}.liquid_in_body must be true or false, got {c.liquid_in_body!r}")
@@ -259,10 +260,11 @@ def _check_table(c: Cavity, where: str) -> Cavity:
     bad = [i for i, v in enumerate(kappa) if abs(v) <= 1.0]
     if bad:
         raise StabmapError(f"{where}.kappa[{bad[0] + 1}] = {kappa[bad[0]]}: a cavity mode has |kappa| > 1")
-    extra = {k: check_value(f"{where}.{k}", v, CAVITY["E"]) for k in ("inertia", "deficit") if (v := getattr(c, k)) is not None}
+    extra: dict[str, Any] = {k: check_value(f"{where}.{k}", v, CAVITY["E"]) for k in ("inertia", "deficit") if (v := getattr(c, k)) is not None}
     total = math.fsum(E)
     if "inertia" in extra and total > extra["inertia"]:
-        raise StabmapError(f"{where}: sum(E) = {total:g} exceeds the frozen liquid's transverse inertia {extra['inertia']:g}; the modes cannot hold more than the liquid")
+        raise StabmapError(f"{where}: sum(E) = {total:g} exceeds the frozen liquid's transverse inertia {extra['inertia']:g}; "
+                           "the modes cannot hold more than the liquid")
     if "deficit" in extra and total > extra["deficit"]:
         raise StabmapError(f"{where}: sum(E) = {total:g} exceeds deficit = {extra['deficit']:g} (the sum over all modes); check both")
     return replace(c, E=E, kappa=kappa, tail="deficit" in extra, **extra)
@@ -292,7 +294,7 @@ def _read_table(name, where: str, base_dir: Path | None) -> dict:
     for number, row in enumerate(rows[1:], start=2):
         if len(row) != len(header):
             raise StabmapError(f"{where}: {str(path)!r} row {number} has {len(row)} fields; the header has {len(header)}")
-        for h, cell in zip(header, row):
+        for h, cell in zip(header, row, strict=True):  # lengths checked just above
             try:
                 columns[h].append(float(cell))
             except ValueError:
@@ -305,7 +307,7 @@ def n_modes(c: Cavity | None) -> int:
         return 0
     if not c.geometric:
         return len(c.E)
-    return c.kept if c.modes == AUTO else c.modes
+    return c.kept if c.modes == AUTO else cast(int, c.modes)  # a whole number once the scene has checked it
 
 
 def choose(c: Cavity, where: str, axes: dict[str, np.ndarray], inertia: float) -> Cavity:
@@ -323,8 +325,9 @@ def choose(c: Cavity, where: str, axes: dict[str, np.ndarray], inertia: float) -
     # Tails scale as density radius^5 at a fixed ratio: per N, the largest over the grid.
     unit = (float(np.max(axes["density"])) * np.repeat(a, len(h)) ** 5)[:, None]
     if c.modes != AUTO:
-        _, _, tails = cavity.scaled_tails(c.shape, q, c.modes)
-        return _chosen(c, c.modes, tails, rows, unit, inertia)
+        modes = cast(int, c.modes)  # a whole number once the scene has checked it
+        _, _, tails = cavity.scaled_tails(c.shape, q, modes)
+        return _chosen(c, modes, tails, rows, unit, inertia)
     tolerance = tolerance_of(c)
     limit = AUTO_MAX_MODES if c.mode_tolerance is None else cavity.MAX_MODES
     n_max = 1 if c.shape == "spheroid" else min(8, limit)
@@ -353,7 +356,8 @@ def tolerance_of(c: Cavity) -> float:
 def describe(c: Cavity) -> str:
     """How many modes the cavity keeps and why, in one line (``stabmap info``)."""
     if c.viscous:
-        what = f"a {c.shape}" if c.geometric else f"a tensor table (P_t = {c.tensor[0]:.4g} m7, P_a = {c.tensor[1]:.4g} m7)"
+        tensor = cast(tuple[float, float], c.tensor)  # a viscous table has one (checked with the scene)
+        what = f"a {c.shape}" if c.geometric else f"a tensor table (P_t = {tensor[0]:.4g} m7, P_a = {tensor[1]:.4g} m7)"
         return f"viscous liquid in {what}: no modes, Chernousko's first order (docs/viscous.md)"
     if not c.geometric:
         return f"table cavity, {len(c.E)} modes" + (", the rest lumped into A (deficit given)" if c.tail else "")
@@ -395,7 +399,8 @@ def check_body(c: Cavity, where: str, extremes: dict[str, tuple[float, float]]) 
     if not c.geometric:
         total = math.fsum(c.E)
         if total > extremes["A"][0]:
-            raise StabmapError(f"{where}: sum(E) = {total:g} exceeds A = {extremes['A'][0]:g}, which includes the frozen liquid; the modes cannot hold more than the liquid")
+            raise StabmapError(f"{where}: sum(E) = {total:g} exceeds A = {extremes['A'][0]:g}, which includes the frozen liquid; "
+                               "the modes cannot hold more than the liquid")
         return
     big = {k: extremes[k][1] for k in ("radius", "half_height", "density")}
     m_f = float(cavity.frozen_mass(c.shape, **big))
@@ -419,7 +424,7 @@ def scaled(shape: str, q: np.ndarray, n: int):
     q = np.asarray(q, dtype=np.float64)
     unique, inverse = np.unique(q, return_inverse=True)
     # Atlas chunks run on threads: read each entry once and never rely on it staying cached.
-    found = {float(v): _scaled.get((shape, n, float(v))) for v in unique}
+    found: dict[float, Any] = {float(v): _scaled.get((shape, n, float(v))) for v in unique}
     missing = np.array([v for v, row in found.items() if row is None])
     if len(missing):
         e, kappa = cavity.scaled_modes(shape, missing, n)
@@ -449,7 +454,7 @@ def apply(c: Cavity, body: np.ndarray, sizes: dict[str, np.ndarray]):
         E = np.broadcast_to(np.array(c.E), body.shape[:-1] + (len(c.E),))
         kappa = np.broadcast_to(np.array(c.kappa), E.shape)
         if c.tail:
-            body[..., layout.A] -= c.deficit - math.fsum(c.E)
+            body[..., layout.A] -= cast(float, c.deficit) - math.fsum(c.E)  # a table's tail comes with its deficit
         return E, kappa
     a, h, rho = sizes["radius"], sizes["half_height"], sizes["density"]
     e, kappa, tail = (np.zeros(a.shape + (0,)), np.ones(a.shape + (0,)), 0.0) if c.viscous else scaled(c.shape, h / a, n_modes(c))

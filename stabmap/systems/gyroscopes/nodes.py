@@ -197,10 +197,10 @@ def mechanical(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
     if not spin:
         second = (nodes[axes[1]][keep], ranges[axes[1]][0][keep], ranges[axes[1]][1][keep]) if len(axes) == 2 else _no_second(sel.size)
         t, t_lo, t_hi = nodes[axes[0]][keep], ranges[axes[0]][0][keep], ranges[axes[0]][1][keep]
-        arrays = [a for x in (body, joint, g, at) for a in (x, np.zeros_like(x))]
+        rbody, rjoint, rg, rat = (np.zeros_like(x) for x in (body, joint, g, at))
         names = [np.full(sel.size, a, dtype=object) for a in axes]
-        return sel, NodeBoxes(*arrays, E, kappa, pts.nmodes, pts.free, pts.parent, t, t_lo, t_hi, *second, axis1=names[0],
-                              axis2=names[1] if len(axes) == 2 else None)
+        return sel, NodeBoxes(body, rbody, joint, rjoint, g, rg, at, rat, E, kappa, pts.nmodes, pts.free, pts.parent, t, t_lo, t_hi,
+                              *second, axis1=names[0], axis2=names[1] if len(axes) == 2 else None)
     # spin-scaled: at node (u_i, t_j) the inputs at t_j with every spin 1 and the stiffness (joints, g) times u_i,
     # the product formed by the kernel (``spin``)
     u_lo, u_hi = _u_interval(lo.body[sel, 0, layout.OMEGA], hi.body[sel, 0, layout.OMEGA])

@@ -10,7 +10,7 @@ import re
 from dataclasses import dataclass, replace
 
 from ...errors import StabmapError
-from ...kernels.layout import BODY_COLUMNS
+from ...kernels.layout import BODY_COLUMNS as BODY_COLUMNS  # the scenes name the columns as the kernels do (points.py)
 from ...scene.values import Parameter, did_you_mean
 
 BODY = {

@@ -28,8 +28,9 @@ class PointArrays:
     kappa: np.ndarray  # (npts, n, Lmax)
     nmodes: np.ndarray  # (n,) int64
     free: bool
-    parent: np.ndarray | None = None  # (n,) int64: parent[0] = -1, 0 <= parent[k] < k
-    at: np.ndarray | None = None  # (npts, n): position of each joint on the parent's axis
+    # Given as None, these two are the chain's and filled in by __post_init__: never None afterwards.
+    parent: np.ndarray = None  # (n,) int64: parent[0] = -1, 0 <= parent[k] < k
+    at: np.ndarray = None  # (npts, n): position of each joint on the parent's axis
 
     def __post_init__(self):
         npts, n = self.body.shape[:2]
@@ -40,7 +41,7 @@ class PointArrays:
         if self.parent.shape != (n,) or self.at.shape != (npts, n):
             raise ValueError(f"parent must have shape ({n},) and at ({npts}, {n})")
 
-    def kernel_args(self):
+    def kernel_args(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool, np.ndarray, np.ndarray]:
         return self.body, self.joint, self.g, self.E, self.kappa, self.nmodes, self.free, self.parent, self.at
 
     def take(self, rows: np.ndarray) -> PointArrays:

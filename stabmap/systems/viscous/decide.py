@@ -15,7 +15,7 @@ from fractions import Fraction
 import flint
 import numpy as np
 
-from ...kernels import REAL, ROOTS_FAILED, layout, roots_block
+from ...kernels import ROOTS_FAILED, layout, roots_block
 from ...kernels.firstorder import RATE_OK, first_order_block
 from ..gyroscopes import exact, ratios, stokes, topology
 from ..gyroscopes.decide import decide as decide_frozen
@@ -43,7 +43,7 @@ def dissipation(scene, values: dict, points: PointArrays):
         if cav is None or not cav.viscous:
             continue
 
-        def get(key):
+        def get(key, k=k, cav=cav):  # bound now: called only in this iteration, but bound all the same
             return np.broadcast_to(np.asarray(arrays.get(f"{key}_{k + 1}", getattr(cav, key)), dtype=np.float64), shape).reshape(-1)
 
         nu, rho, a = get("viscosity"), get("density"), get("radius")
