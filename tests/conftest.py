@@ -14,6 +14,31 @@ def pytest_collection_modifyitems(config, items):
     if covered:
         config.hook.pytest_deselected(items=covered)
         items[:] = [item for item in items if item not in covered]
+    items[:] = slow_first(items, int(getattr(config, "workerinput", {}).get("workercount", 1)))
+
+
+def slow_first(items: list, workers: int) -> list:
+    """``items`` in the order that lets ``workers`` pytest-xdist workers (``--dist worksteal``) end together.
+
+    Worksteal hands each worker one contiguous share of the list (the first ``len // workers`` to the first, and so
+    on) and later moves tests from the end of the longest queue to an idle worker.  A minutes-long test left at the
+    end of a share would run last, alone, while the other worker waits (three minutes of a 22-minute suite when
+    docs/paper-cases.md's commands did).  So each share starts with its part of the tests marked slow, dealt out in
+    turn, and ends with quick tests that stealing can balance.  The set of tests is unchanged; only their order.
+    """
+    if workers <= 1:
+        return items
+    slow = [item for item in items if item.get_closest_marker("slow")]
+    quick = [item for item in items if not item.get_closest_marker("slow")]
+    out, left = [], len(items)
+    for w in range(workers):
+        size = left // (workers - w)  # what worksteal sends this worker first
+        share = slow[w::workers]
+        take = max(0, size - len(share))
+        out += share + quick[:take]
+        quick = quick[take:]
+        left -= len(share) + take
+    return out + quick
 
 
 # ------------------------------------------------------------------------------------------- shared scenes

@@ -142,3 +142,28 @@ def test_the_readme_installs_the_lint_tools_ci_pins():
     line = next(x for x in (ROOT / "README.md").read_text().splitlines() if x.startswith("pip install 'ruff"))
     assert re.findall(r"'([^']+)'", line.split("#")[0]) == pinned
     assert "dependency-groups" in (ROOT / ".ci" / "run").read_text()
+
+
+def test_slow_tests_start_each_workers_share():
+    """conftest.slow_first: the same tests, each worker's first share (as worksteal cuts it) led by slow ones."""
+    from conftest import slow_first
+
+    class Item:
+        def __init__(self, n, slow):
+            self.n, self.slow = n, slow
+
+        def get_closest_marker(self, name):
+            return object() if name == "slow" and self.slow else None
+
+    items = [Item(n, n % 7 == 3) for n in range(101)]
+    for workers in (1, 2, 3):
+        out = slow_first(items, workers)
+        assert sorted(i.n for i in out) == list(range(101))
+        left, start = len(out), 0
+        for w in range(workers if workers > 1 else 0):
+            size = left // (workers - w)
+            share = out[start : start + size]
+            slow = [i.slow for i in share]
+            assert slow == sorted(slow, reverse=True) and sum(slow) in (len(items[3::7]) // workers, -(-len(items[3::7]) // workers))
+            start, left = start + size, left - size
+    assert slow_first(items, 1) is items
