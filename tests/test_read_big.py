@@ -136,12 +136,12 @@ def big_map(tmp_path_factory):
 def test_blocks_keep_every_stability_boundary(big_map):
     """Every pair of neighbouring points of different stability lies in a block drawn black, or on the edge of
     two blocks whose stability differs (a thick line)."""
-    from stabmap.read.plot import _block_classes
+    from stabmap.read.plot import block_classes
 
     nc = big_map["n_complex_pairs"].transpose("K_1", "omega").values
     factors = (7, 9)
     b = blocks.reduce_blocks(nc, None, 0, factors)
-    _, state = _block_classes(b, 0)
+    _, state = block_classes(b, 0)
     stable = nc == 0
     for axis in (0, 1):
         lo = [slice(None)] * 2

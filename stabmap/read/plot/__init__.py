@@ -60,8 +60,6 @@ from .palette import (
 from .reduce import reduce_panels
 from .saving import check_figure_path, plot_atlas, plot_critical, save_figure
 
-_block_classes = block_classes  # the name tests/test_read_big.py imports
-
 __all__ = [
     "ABSENT_COLOUR", "DEGENERATE_COLOUR", "MAX_PANELS", "STABLE_COLOUR", "UNDECIDED_COLOUR", "UNSTABLE_COLOUR",
     "FigurePlan", "atlas_figure", "axis_label", "block_classes", "boundary_widths", "captioned_figure",
