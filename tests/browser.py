@@ -9,8 +9,9 @@ Use::
 
     with browser() as new_page:          # one Chromium for a test module: it takes about a second to start
         page = new_page().open(html_path)
-        page.hover("map", 1.5, 31.6)
-        assert "label=r1c1" in page.text("readout")
+        page.hover("map", 1.5, 31.6)             # data coordinates; log axes too
+        page.wait_text("readout", "label=r1c1")  # the Div re-renders after the hover callback, not at once
+        page.move_slider("slider-K_1", 1)        # waits for the model's value
 
 The JS below reaches into BokehJS 3.9's view tree (``Bokeh.index``), which is not a public API: if a bokeh upgrade
 breaks a test here, look first at :data:`JS_HELPERS`.
