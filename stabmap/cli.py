@@ -152,21 +152,24 @@ def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, roo
                               over=over, locate=locate, roots=roots, fmt=fmt or "text", limit=limit, output=output, overwrite=overwrite))
 
 
-@cli.command(short_help="Draw an atlas (or critical values) to a PNG or PDF file.")
+@cli.command(short_help="Draw an atlas (or critical values) to a PNG or PDF file, or an interactive HTML page.")
 @click.argument("atlas")
 @click.argument("items", nargs=-1, metavar="[NAME=VALUE]...")
-@click.option("-o", "--output", required=True, help="PNG or PDF file")
+@click.option("-o", "--output", required=True, help="PNG or PDF file, or an .html page (interactive: a slider per further axis)")
 @click.option("--x", help="axis along x (default: the first axis not fixed or faceted)")
 @click.option("--y", help="axis along y (default: the next one)")
 @click.option("--sel", multiple=True, metavar="NAME=VALUE", help="fix an axis at this value (nearest grid value); also NAME=VALUE after the atlas")
 @click.option("--facet", metavar="NAME", help="axis drawn as one panel per value (default: the third axis; a fourth gives rows)")
 @click.option("--max-panels", type=int, metavar="N", help="at most N panels, evenly spaced values (default 12)")
+@click.option("--max-mb", type=float, metavar="MB",
+              help="an .html page's size bound: slider values beyond it are left out, evenly spaced ones kept (default 20)")
 @_overwrite
-def plot(atlas, items, output, x, y, sel, facet, max_panels, overwrite):
-    """Draw an atlas: a map of its classes, small multiples for 3 or 4 axes (docs/plots.md)."""
+def plot(atlas, items, output, x, y, sel, facet, max_panels, max_mb, overwrite):
+    """Draw an atlas: a map of its classes, small multiples for 3 or 4 axes (docs/plots.md); or write an interactive
+    page (.html, no server needed: docs/explore.md)."""
     from . import jobs
 
-    _report(jobs.plot(atlas, output, x=x, y=y, sel=[*sel, *items], facet=facet, max_panels=max_panels, overwrite=overwrite))
+    _report(jobs.plot(atlas, output, x=x, y=y, sel=[*sel, *items], facet=facet, max_panels=max_panels, max_mb=max_mb, overwrite=overwrite))
 
 
 @cli.command(short_help="Stable intervals of one parameter (the critical spin rates, say), ends to 1e-10.")

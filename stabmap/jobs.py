@@ -325,21 +325,43 @@ def plot(
     sel: Sequence[str] = (),
     facet: str | None = None,
     max_panels: int | None = None,
+    max_mb: float | None = None,
     overwrite: bool = False,
 ) -> Done:
-    """``stabmap plot``: draw an atlas (or critical values) to a PNG or PDF file (an existing one only if ``overwrite``)."""
+    """``stabmap plot``: draw an atlas (or critical values) to a PNG or PDF file, or write its interactive page (.html);
+    an existing output only if ``overwrite``."""
     from .read import plot as figures
     from .read.query import parse_selection
     from .scene.units import in_si
     from .store.dataset import is_critical
     from .store.files import check_new_output, open_atlas
 
-    figures.check_figure_path(output)
+    page = Path(output).suffix.lower() in (".html", ".htm")
+    if page:
+        from .read import explore
+
+        explore.check_page_path(output)
+        extra = [name for name, v in (("facet", facet), ("max_panels", max_panels)) if v is not None]
+        if extra:
+            raise StabmapError(f"{param(extra[0])} applies to PNG and PDF figures; an .html page has a slider for every further axis "
+                               f"(fix one with {param('sel')})")
+    else:
+        figures.check_figure_path(output)
+        if max_mb is not None:
+            raise StabmapError(f"{param('max_mb')} applies to .html pages; {output} is a figure (use a .html name for a page)")
     check_new_output(output, overwrite)
     ds = open_atlas(path, lazy=True)  # read chunk by chunk: bounded memory at any size
     chosen = parse_selection(list(sel), ranges=False, option="--sel")
     # A spin rate given with its unit (--sel omega="14000 rpm") in the file's units, rad/s.
     chosen = {k: in_si(f"--sel {k}", v, str(ds[k].attrs.get("units", ""))) if k in ds.coords else v for k, v in chosen.items()}
+    if page:
+        if is_critical(ds) and x is not None:
+            raise StabmapError(f"{param('x')} applies to atlases; along x a critical-values page shows the scanned axis")
+        bound = explore.MAX_MB if max_mb is None else max_mb
+        made = (explore.critical_page(ds, y=y, sel=chosen, max_mb=bound) if is_critical(ds)
+                else explore.atlas_page(ds, x=x, y=y, sel=chosen, max_mb=bound))
+        made.save(output)
+        return Done([f"note: {note}" for note in made.notes] + [f"wrote {output} ({Path(output).stat().st_size / 1e6:.1f} MB)"])
     if is_critical(ds):
         extra = [name for name, v in (("x", x), ("y", y), ("facet", facet), ("max_panels", max_panels)) if v is not None]
         if extra:

@@ -11,6 +11,7 @@ operation keeps working and returns plain Datasets):
 >>> ds.stabmap.boundaries("omega", K_1=3).to_dataframe()
 >>> ds.stabmap.smallest_stable("omega", over="K_1").smallest_stable.plot()
 >>> ds.stabmap.plot("map.png", sel={"K_1": 3})
+>>> ds.stabmap.explore()                                   # the interactive page, inline in Jupyter
 >>> stabmap.open_atlas("critical.nc").stabmap.to_dataframe()    # one row per stable interval
 >>> ds.stability.sel(K_1=3).stabmap.plot()            # xarray's own plot, in stabmap's colours
 >>> ds.n_complex_pairs.sel(K_1=3).plot(**ds.stabmap.style())
@@ -88,6 +89,14 @@ class StabmapAccessor:
         if is_critical(self._ds):
             return plot_critical(self._ds, path, **kw)
         return plot_atlas(self._ds, path, **kw)
+
+    def explore(self, **kw):
+        """The interactive page of this atlas or critical-values file, shown inline in Jupyter (a bokeh page in an
+        iframe, scripts inlined): :func:`stabmap.read.explore.explore` (``x=``, ``y=``, ``sel=``, ``max_mb=``).
+        ``.save("atlas.html")`` writes it to a file; ``.layout`` is the bokeh layout, for ``bokeh.io.show``."""
+        from .explore import explore
+
+        return explore(self._ds, **kw)
 
     def style(self, name: str | None = None) -> dict:
         """Arguments of xarray's ``plot`` that draw the class variable ``name`` (default: the label, e.g.

@@ -77,7 +77,8 @@ def rows_cols(n_rows: int, n_cols: int, max_panels: int) -> tuple[int, int]:
     return best
 
 
-def _check_sel(ds: xr.Dataset, dims: list[str], sel: dict) -> None:
+def check_sel(ds: xr.Dataset, dims: list[str], sel: dict) -> None:
+    """Each axis fixed by ``sel`` is a grid axis of ``dims`` and its value a finite number."""
     for k, v in sel.items():
         if k in ds.coords and ds[k].ndim == 0 and k not in dims:
             raise StabmapError(f"{given('sel', ..., k)}: fixed at {float(ds[k]):g}{unit_suffix(ds[k].attrs.get('units'))} in this atlas, "
@@ -88,7 +89,7 @@ def _check_sel(ds: xr.Dataset, dims: list[str], sel: dict) -> None:
             raise StabmapError(f"{given('sel', v, k)}: give a finite number, e.g. {given('sel', float(ds[k][0]), k)}")
 
 
-def _check_roles(dims: list[str], sel: dict, roles: list[tuple[str, str]]) -> None:
+def check_roles(dims: list[str], sel: dict, roles: list[tuple[str, str]]) -> None:
     """Each of x, y and facet (``roles``: parameter, axis) names an axis of ``dims`` not fixed by ``sel``, once."""
     for opt, name in roles:
         if name not in dims:
@@ -119,8 +120,8 @@ def plan_figure(
     if not dims:
         raise StabmapError("this atlas has no axis to plot (a single point); use 'stabmap info' or 'stabmap query'")
     sel = dict(sel or {})
-    _check_sel(ds, dims, sel)
-    _check_roles(dims, sel, [(opt, name) for opt, name in (("x", x), ("y", y), ("facet", facet)) if name is not None])
+    check_sel(ds, dims, sel)
+    check_roles(dims, sel, [(opt, name) for opt, name in (("x", x), ("y", y), ("facet", facet)) if name is not None])
     free = [d for d in dims if d not in sel]
     if not free:
         raise StabmapError(f"{param('sel')} fixes every axis ({', '.join(dims)}); leave one or two free to draw, or use 'stabmap query'")

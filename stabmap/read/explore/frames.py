@@ -1,0 +1,86 @@
+"""The frames of an atlas page: for each slider setting, the map of the two drawn axes read once (chunk by chunk
+for a lazy atlas), reduced to blocks no smaller than a screen pixel (:func:`stabmap.read.blocks.reduce_blocks`),
+with its blocks' states and its boundaries on cell edges, as the PNG maps draw them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from ..blocks import block_factors, reduce_blocks
+from ..plot.geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, cell_edges, touches_stability
+from ..plot.labels import log_axis
+from .plan import PagePlan
+from .states import Legend, block_colours, pack
+
+MAP_PIXELS = (450, 600)  # (y, x) pixels of the page's map: blocks are no smaller than one
+WIDEST = {"stability": 2.5, "classes": 1.0}  # [px] boundary widths between wide regions (narrower beside thin bands)
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One slider setting: every block's packed state (rows along y), the label's counts, and the boundary
+    segments as columns x0, y0, x1, y1, width [px] (float32), thick (stability) and thin (other classes)."""
+
+    keys: np.ndarray
+    counts: dict[int, int]
+    stability: np.ndarray
+    classes: np.ndarray
+
+
+@dataclass(frozen=True)
+class MapGrid:
+    """The drawn grid: block ``factors`` (y, x), block edges ``xe`` and ``ye`` in data coordinates (a strip's y runs
+    from 0 to 1) and which of x, y are drawn on a log scale."""
+
+    factors: tuple[int, int]
+    xe: np.ndarray
+    ye: np.ndarray
+    log: tuple[bool, bool]
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return len(self.ye) - 1, len(self.xe) - 1
+
+
+def map_grid(ds: xr.Dataset, plan: PagePlan, pixels: tuple[int, int] = MAP_PIXELS) -> MapGrid:
+    """Blocks of the drawn axes no smaller than a pixel of a map ``pixels`` (y, x) in size, and their edges."""
+    shape = (ds.sizes[plan.y] if plan.y else 1, ds.sizes[plan.x])
+    factors = block_factors(shape, pixels if plan.y else (1, pixels[1]))
+    log = (log_axis(ds, plan.x), plan.y is not None and log_axis(ds, plan.y))
+    xe = block_edges(cell_edges(np.asarray(ds[plan.x], dtype=float), "log" if log[0] else None), factors[1])
+    ye = (block_edges(cell_edges(np.asarray(ds[plan.y], dtype=float), "log" if log[1] else None), factors[0]) if plan.y
+          else np.array([0.0, 1.0]))
+    return MapGrid(factors, xe, ye, log)
+
+
+def frame_map(da: xr.DataArray, plan: PagePlan, at: dict[str, int]):
+    """``da`` at one slider setting ``at`` (fixed axes already selected), as (y, x); a strip as (1, x); lazy."""
+    a = da.isel(at).transpose(*((plan.y, plan.x) if plan.y else (plan.x,))).data
+    return a if plan.y else a[None, :]
+
+
+def segments_table(segs: np.ndarray, grid: MapGrid, codes: np.ndarray, widest: float, pixels: tuple[int, int]) -> np.ndarray:
+    """Boundary segments as rows (x0, y0, x1, y1, width [px]): widest, but a third of the narrower band beside."""
+    widths = boundary_widths(segs, grid.xe, grid.ye, (float(pixels[0]), float(pixels[1])), widest, log=grid.log, codes=codes)
+    return np.column_stack([segs.reshape(-1, 4), widths]).astype(np.float32)
+
+
+def read_frame(label: xr.DataArray, bits: xr.DataArray | None, plan: PagePlan, at: dict[str, int], grid: MapGrid,
+               legend: Legend, pixels: tuple[int, int] = MAP_PIXELS) -> Frame:
+    """One frame: the map at slider setting ``at`` read once and reduced to ``grid``'s blocks, their states packed
+    (colours registered in ``legend``), and the boundaries between blocks."""
+    stable = legend.system.stable_label
+    blocks = reduce_blocks(frame_map(label, plan, at), None if bits is None else frame_map(bits, plan, at), stable, grid.factors)
+    near = touches_stability(blocks, stable) if stable is not None else np.zeros(blocks.low.shape, dtype=bool)
+    keys = pack(blocks, block_colours(blocks, legend, near))
+    codes, state = block_classes(blocks, stable)
+    stab, other = cell_edge_boundaries(codes, grid.xe, grid.ye, stable, state=state)
+    if len(stab):
+        legend.drawn.add("stability")
+    if len(other):
+        legend.drawn.add("classes")
+    return Frame(keys, dict(blocks.counts), segments_table(stab, grid, codes, WIDEST["stability"], pixels),
+                 segments_table(other, grid, codes, WIDEST["classes"], pixels))

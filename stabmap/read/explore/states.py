@@ -1,0 +1,130 @@
+"""The state of a block of grid points on a page: its lowest and highest label, whether it holds the stability
+boundary, how its points were decided and what their cells prove, and the colour it is drawn in. A page stores
+one small integer per block, an index into its table of distinct states, so that its size grows with the blocks
+and not with the text shown on hover.
+
+A state is packed into one int64 (:func:`pack`): the page gathers the distinct ones over every frame, then
+writes each state's colour once (the colour mapper's palette) and its text once (the hover's table).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ...store.variables import CELL, INFERRED
+from ..plot.palette import BOUNDARY, CLASS_EDGE, system_colour
+from .text import plain
+
+CELL_SHIFT = 16  # provenance meanings take bits 0..15 of a point's bits, the meanings of ``cell`` the bits above
+VEIL = 0.45  # share of white over the class colour of cells proved at their node only, or inferred: "lighter"
+CELL_TEXT = {
+    "whole_cell": "the label holds at every point of the cell",
+    "contains_change": "the cell is proved to hold a change of label",
+    "node_only": "proved at the grid node only, not over its cell",
+    "not_proved": "not proved: inferred from the cell's corners",
+}
+
+
+def point_bits(ds: xr.Dataset, system) -> xr.DataArray | None:
+    """Per grid point, lazily: bit p set for the p-th meaning of the system's provenance flag (``decided_by``), bit
+    CELL_SHIFT + q for the q-th meaning of ``cell``; None for an atlas with neither variable. ORed over a block,
+    the bits say every way its points were decided and every kind of cell it holds."""
+    bits = None
+    for name, var, shift in ((system.provenance, system.variable(system.provenance) if system.provenance else None, 0),
+                             (CELL.name, CELL, CELL_SHIFT)):
+        if var is None or name not in ds:
+            continue
+        for p, (value, _) in enumerate(var.flags):
+            term = (ds[name] == value).astype(np.int32) * np.int32(1 << (shift + p))
+            bits = term if bits is None else bits | term
+    return bits
+
+
+class Legend:
+    """The colours a page draws, each numbered once, and which legend entries they stand for."""
+
+    def __init__(self, system, has_provenance: bool) -> None:
+        self.system = system
+        self.colours: list[str] = []
+        self.drawn: set[str] = set()
+        flags = system.variable(system.provenance).meanings if has_provenance else ()
+        self.inferred_bit = (1 << flags.index(INFERRED)) if INFERRED in flags else 0
+
+    def id(self, colour: str) -> int:
+        if colour not in self.colours:
+            self.colours.append(colour)
+        return self.colours.index(colour)
+
+
+def lighter(colour: str) -> str:
+    """``colour`` under a white veil of VEIL."""
+    rgb = np.array([int(colour[i : i + 2], 16) for i in (1, 3, 5)], dtype=float)
+    return "#" + "".join(f"{int(round(c + VEIL * (255 - c))):02X}" for c in rgb)
+
+
+def cell_bit(meaning: str) -> int:
+    """The bit of a ``cell`` meaning in a point's bits."""
+    return 1 << (CELL_SHIFT + CELL.meanings.index(meaning))
+
+
+def block_colours(blocks, legend: Legend, near_stable: np.ndarray) -> np.ndarray:
+    """The colour id of every block, as the PNG maps colour it: a block of one class in that class's colour (lighter
+    where a cell is proved at its node only or inferred), a block of stable and unstable points and a cell proved
+    to hold a change next to stable ones black, other mixed blocks and changes dark grey."""
+    system = legend.system
+    low, mixed = blocks.low, blocks.low != blocks.high
+    bits = np.zeros(low.shape, dtype=np.int64) if blocks.any_flag is None else blocks.any_flag.astype(np.int64)
+    inferred = ((bits & legend.inferred_bit) > 0) | ((bits & cell_bit("not_proved")) > 0)
+    node_only = ((bits & cell_bit("node_only")) > 0) & ~inferred
+    change = (bits & cell_bit("contains_change")) > 0
+    out = np.empty(low.shape, dtype=np.int64)
+    for v in np.unique(low):
+        at = low == v
+        out[at] = legend.id(system_colour(int(v), system))
+        if (at & (inferred | node_only)).any():
+            out[at & (inferred | node_only)] = legend.id(lighter(system_colour(int(v), system)))
+    shown = ~mixed & ~change
+    for mask, entry in ((inferred & shown, "inferred"), (node_only & shown, "node-only")):
+        if mask.any():
+            legend.drawn.add(entry)
+    for mask, colour, entry in ((change & ~near_stable, CLASS_EDGE, "change"), (change & near_stable, BOUNDARY, "change"),
+                                (mixed & ~blocks.mixed_stability, CLASS_EDGE, "mixed-classes"),
+                                (blocks.mixed_stability, BOUNDARY, "mixed-stability")):
+        if mask.any():
+            out[mask] = legend.id(colour)
+            legend.drawn.add(entry)
+    return out
+
+
+def pack(blocks, colour_ids: np.ndarray) -> np.ndarray:
+    """Every block's state as one int64: low and high label (16 bits each), holds the stability boundary (1 bit),
+    colour id (6 bits), the ORed point bits (20 bits)."""
+    low = (blocks.low.astype(np.int64) + 2**15) & 0xFFFF
+    high = (blocks.high.astype(np.int64) + 2**15) & 0xFFFF
+    bits = np.zeros(low.shape, dtype=np.int64) if blocks.any_flag is None else blocks.any_flag.astype(np.int64) & 0xFFFFF
+    if colour_ids.max(initial=0) >= 64:
+        raise ValueError("more than 64 colours on one page")
+    return low | (high << 16) | (blocks.mixed_stability.astype(np.int64) << 32) | (colour_ids << 33) | (bits << 39)
+
+
+def unpack(key: int) -> tuple[int, int, bool, int, int]:
+    """low, high, holds the stability boundary, colour id, point bits of a packed state."""
+    return ((key & 0xFFFF) - 2**15, ((key >> 16) & 0xFFFF) - 2**15, bool((key >> 32) & 1), int((key >> 33) & 63), int(key >> 39))
+
+
+def state_text(key: int, system, has_provenance: bool, has_cell: bool) -> str:
+    """What a block's state says on hover, in lines: its label and class, what decided it, what its cell proves."""
+    low, high, boundary, _, bits = unpack(int(key))
+    symbol = plain(system.label_symbol)
+    if low == high:
+        lines = [f"{symbol} = {low}: {system.class_name(low)}"]
+    else:
+        lines = [f"{symbol} from {low} to {high}: " + ("holds the stability boundary" if boundary else "holds several classes")]
+    if has_provenance:
+        var = system.variable(system.provenance)
+        lines.append("decided by: " + ", ".join(m.replace("_", " ") for p, m in enumerate(var.meanings) if bits & (1 << p)))
+    if has_cell:
+        kinds = [m for q, m in enumerate(CELL.meanings) if bits & (1 << (CELL_SHIFT + q))]
+        lines.append(("cell: " if len(kinds) == 1 else "cells: ") + "; ".join(f"{k.replace('_', ' ')}, {CELL_TEXT.get(k, k)}" for k in kinds))
+    return "\n".join(lines)
