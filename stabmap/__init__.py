@@ -36,6 +36,7 @@ _API: dict[str, str | tuple[str, str]] = {
     "critical": "stabmap.run.critical",
     "example": "stabmap.examples",
     "example_names": "stabmap.examples",
+    "explore": "stabmap.read.explore",
     "label_at": "stabmap.read.query",
     "load_scene": "stabmap.systems",
     "loads_scene": "stabmap.systems",

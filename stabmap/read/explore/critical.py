@@ -10,7 +10,7 @@ import xarray as xr
 from ... import systems
 from ...errors import StabmapError, given
 from ..plot.captions import fixed_caption
-from ..plot.critical import critical_rows, critical_stretches, scanned_attrs
+from ..plot.critical import critical_rows, critical_stretches, scanned_attrs, undecided_gaps
 from ..plot.geometry import cell_edges
 from ..plot.palette import UNDECIDED_COLOUR, system_colour
 from . import widgets
@@ -47,8 +47,8 @@ def critical_page(ds: xr.Dataset, *, y: str | None = None, sel: dict[str, float]
     def read(at: dict[str, int]) -> tuple[dict, dict]:
         frame = picked.isel(at)
         rows, start = critical_rows(frame, system, along, [y] if y else [], {})
-        return stretch_columns(frame, system, along, y, edges, critical_stretches(rows, system, along, start, scan), names, at), \
-            dot_columns(rows, y, edges)
+        stretches = critical_stretches(rows, system, along, start, scan)
+        return stretch_columns(frame, system, along, y, edges, stretches, undecided_gaps(rows), names, at), dot_columns(rows, y, edges)
 
     first = read(plan.frames[0])
     plan = thin(plan, dict(ds.sizes), budget(max_mb) // max(1, columns_bytes(first)), f"the page's size bound, max_mb = {max_mb:g}")
@@ -68,8 +68,8 @@ def scanned_names(ds: xr.Dataset, system, along: str) -> xr.Dataset:
 
 
 def stretch_columns(frame: xr.Dataset, system, along: str, y: str | None, edges: np.ndarray, stretches: list[tuple],
-                    names: xr.Dataset, at: dict[str, int]) -> dict:
-    """The stretches of one frame as quads: their box, colour and hover text."""
+                    undecided: list[tuple], names: xr.Dataset, at: dict[str, int]) -> dict:
+    """The stretches and the undecided gaps of one frame as quads: their box, colour and hover text."""
     rows = [value_text(frame, y, float(v)) for v in np.asarray(frame[y])] if y else [""] * (len(edges) - 1)
     cols: dict[str, list] = {"left": [], "right": [], "bottom": [], "top": [], "colour": [], "text": []}
     unit = unit_plain(names, along).strip()
@@ -83,7 +83,6 @@ def stretch_columns(frame: xr.Dataset, system, along: str, y: str | None, edges:
         lines = [f"{plain(system.label_symbol)} = {c}: {system.class_name(int(c))}",
                  f"{plain(value_text(names, along, 0.0).split(' =')[0])} from {x0:.10g} to {x1:.10g} {unit}".rstrip()]
         cols["text"].append("\n".join(t for t in [*lines, rows[r], *where] if t))
-    undecided = [(r, lo, hi) for r in range(len(edges) - 1) for lo, hi in gaps(frame, y, r)]
     for r, lo, hi in undecided:
         cols["left"].append(lo)
         cols["right"].append(hi)
@@ -92,16 +91,6 @@ def stretch_columns(frame: xr.Dataset, system, along: str, y: str | None, edges:
         cols["colour"].append(UNDECIDED_COLOUR)
         cols["text"].append("\n".join(t for t in [f"undecided gap: {lo:.10g} to {hi:.10g} {unit}".rstrip(), rows[r], *where] if t))
     return {k: np.asarray(v, dtype=float) if k in ("left", "right", "bottom", "top") else v for k, v in cols.items()}
-
-
-def gaps(frame: xr.Dataset, y: str | None, r: int) -> list[tuple[float, float]]:
-    """The undecided gaps of row ``r`` (stretches no proof settled), if the file has them."""
-    if "undecided_lower" not in frame:
-        return []
-    lo, hi = frame["undecided_lower"], frame["undecided_upper"]
-    if y:
-        lo, hi = lo.isel({y: r}), hi.isel({y: r})
-    return [(float(a), float(b)) for a, b in zip(np.ravel(lo), np.ravel(hi), strict=True) if np.isfinite(a)]
 
 
 def dot_columns(rows: xr.Dataset, y: str | None, edges: np.ndarray) -> dict:

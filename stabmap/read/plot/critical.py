@@ -12,7 +12,7 @@ from .captions import captioned_figure, fill_title
 from .geometry import cell_edges
 from .labels import axis_label, log_ticks, mathtext, symbol, value_text
 from .layout import VALUE
-from .palette import HATCH_DEGENERATE, class_patch, system_colour
+from .palette import HATCH_DEGENERATE, UNDECIDED_COLOUR, class_patch, system_colour
 
 
 def scanned_attrs(ds: xr.Dataset, system, along: str, lower: xr.DataArray) -> dict:
@@ -46,6 +46,8 @@ def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
     else:
         edges = np.array([0.0, 1.0])
     present = draw_stretches(ax, stretches, edges, system)
+    gaps = undecided_gaps(rows)
+    draw_gaps(ax, gaps, edges)
     b_lo, b_hi = np.asarray(rows["boundary_lower"]), np.asarray(rows["boundary_upper"])
     ends = np.concatenate([b_lo.ravel(), b_hi.ravel()])
     ys = np.broadcast_to(((edges[:-1] + edges[1:]) / 2 if free else np.array([0.5]))[:, None], b_lo.shape).ravel()
@@ -61,7 +63,7 @@ def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
         ax.set_yticks([])
     lower = ds[f"{along}_stable_lower"]
     ax.set_xlabel(axis_label(xr.Dataset(coords={along: ((), 0.0, scanned_attrs(ds, system, along, lower))}, attrs=ds.attrs), along, width=60))
-    critical_legend(fig, system, present)
+    critical_legend(fig, system, present, bool(gaps))
     ax.set_title(critical_title(ds, along, start is None, chosen), fontsize=10)
     return fig
 
@@ -85,6 +87,7 @@ def critical_rows(ds: xr.Dataset, system, along: str, free: list[str], chosen: d
     lab = system.label
     names = ["boundary_lower", "boundary_upper", f"{lab}_below", f"{lab}_above", f"{along}_stable_lower", f"{along}_stable_upper"]
     start = f"{lab}_at_scan_start" if f"{lab}_at_scan_start" in ds else None
+    names += [g for g in ("undecided_lower", "undecided_upper") if g in ds]  # older files have no gaps
     picked = ds[names + ([start] if start else [])]
     if chosen:
         picked = picked.sel(chosen, method="nearest")
@@ -92,8 +95,35 @@ def critical_rows(ds: xr.Dataset, system, along: str, free: list[str], chosen: d
 
 
 def critical_stretches(rows: xr.Dataset, system, along: str, start: str | None, scan: list[float]) -> list[tuple]:
-    """(row, x0, x1, class) of every stretch the file proves; the few-ulp brackets between them are left out. An
-    older file (no ``start``) gives its stable intervals only."""
+    """(row, x0, x1, class) of every stretch the file proves; the few-ulp brackets between them and the undecided
+    gaps (:func:`undecided_gaps`) are left out. An older file (no ``start``) gives its stable intervals only."""
+    return without_gaps(class_stretches(rows, system, along, start, scan), undecided_gaps(rows))
+
+
+def undecided_gaps(rows: xr.Dataset) -> list[tuple[int, float, float]]:
+    """(row, x0, x1) of every undecided gap: a stretch whose ends are proved to carry the same label but whose inside
+    no proof settled; none in a file written before gaps were stored."""
+    if "undecided_lower" not in rows:
+        return []
+    lo, hi = np.asarray(rows["undecided_lower"], dtype=float), np.asarray(rows["undecided_upper"], dtype=float)
+    lo, hi = lo.reshape(lo.shape[0], -1), hi.reshape(hi.shape[0], -1)
+    return [(r, float(a), float(b)) for r in range(lo.shape[0]) for a, b in zip(lo[r], hi[r], strict=True) if np.isfinite(a)]
+
+
+def without_gaps(stretches: list[tuple], gaps: list[tuple[int, float, float]]) -> list[tuple]:
+    """``stretches`` (row, x0, x1, class) with every gap (row, x0, x1) cut out: a stretch is drawn only where proved."""
+    out = []
+    for r, x0, x1, c in stretches:
+        pieces = [(x0, x1)]
+        for g_r, g0, g1 in gaps:
+            if g_r == r:
+                pieces = [p for a, b in pieces for p in ((a, min(b, g0)), (max(a, g1), b)) if p[1] > p[0]]
+        out += [(r, a, b, c) for a, b in pieces]
+    return out
+
+
+def class_stretches(rows: xr.Dataset, system, along: str, start: str | None, scan: list[float]) -> list[tuple]:
+    """(row, x0, x1, class) between the file's located changes, gaps included."""
     b_lo, b_hi = np.asarray(rows["boundary_lower"]), np.asarray(rows["boundary_upper"])
     above = np.asarray(rows[f"{system.label}_above"])
     s_lo, s_hi = np.asarray(rows[f"{along}_stable_lower"]), np.asarray(rows[f"{along}_stable_upper"])
@@ -125,11 +155,23 @@ def draw_stretches(ax, stretches: list[tuple], edges: np.ndarray, system) -> lis
     return present
 
 
-def critical_legend(fig, system, present: list[int]) -> None:
-    """The classes drawn and the located changes (dots), beside the plot."""
+def draw_gaps(ax, gaps: list[tuple[int, float, float]], edges: np.ndarray) -> None:
+    """Fill each undecided gap (row, x0, x1) dark grey and cross-hatched, as the maps draw points not proved."""
+    from matplotlib.collections import PolyCollection
+
+    if gaps:
+        boxes = [[(x0, edges[r]), (x0, edges[r + 1]), (x1, edges[r + 1]), (x1, edges[r])] for r, x0, x1 in gaps]
+        ax.add_collection(PolyCollection(boxes, facecolors=UNDECIDED_COLOUR, edgecolors="none", hatch=HATCH_DEGENERATE))
+
+
+def critical_legend(fig, system, present: list[int], gaps: bool = False) -> None:
+    """The classes drawn, the undecided gaps (``gaps``: any drawn) and the located changes (dots), beside the plot."""
     from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
 
     handles = [class_patch(c, system) for c in present]
+    if gaps:
+        handles.append(Patch(facecolor=UNDECIDED_COLOUR, edgecolor="none", hatch=HATCH_DEGENERATE, label="undecided gap\n(no proof settled it)"))
     handles.append(Line2D([], [], color="k", marker=".", ls="none", label=f"a change of {mathtext(system.label_symbol)},\nlocated"))
     fig.legend(handles=handles, loc="outside right upper", alignment="left", frameon=False, title=system.label_title,
                fontsize=9, title_fontsize=9)
