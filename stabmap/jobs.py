@@ -357,10 +357,20 @@ def plot(
     if page:
         if is_critical(ds) and x is not None:
             raise StabmapError(f"{param('x')} applies to atlases; along x a critical-values page shows the scanned axis")
+        from .run.progress import ProgressLine, wanted
+
         bound = explore.MAX_MB if max_mb is None else max_mb
-        made = (explore.critical_page(ds, y=y, sel=chosen, max_mb=bound) if is_critical(ds)
-                else explore.atlas_page(ds, x=x, y=y, sel=chosen, max_mb=bound))
-        made.save(output)
+        line = ProgressLine(wanted(None))  # on a terminal, once a page has taken two seconds
+
+        def read(done: int, total: int) -> None:
+            line.show(f"page: {done} of {total} slider settings read")
+
+        try:
+            made = (explore.critical_page(ds, y=y, sel=chosen, max_mb=bound, progress=read) if is_critical(ds)
+                    else explore.atlas_page(ds, x=x, y=y, sel=chosen, max_mb=bound, progress=read))
+            made.save(output)
+        finally:
+            line.close()
         return Done([f"note: {note}" for note in made.notes] + [f"wrote {output} ({Path(output).stat().st_size / 1e6:.1f} MB)"])
     if is_critical(ds):
         extra = [name for name, v in (("x", x), ("y", y), ("facet", facet), ("max_panels", max_panels)) if v is not None]
