@@ -10,6 +10,9 @@ bound (``max_mb``): beyond it the sliders keep evenly spaced values, and the pag
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 import xarray as xr
 
@@ -25,17 +28,35 @@ from .plan import PagePlan, plan_page, thin
 from .states import Legend, lighter, point_bits, state_text
 from .text import axis_title, escape, plain, span_texts, value_text
 
-# The index of a block under the pointer -> its text: position along x and y, the sliders' values, its state.
+# The index of a block under the pointer -> its text: position along x and y, the other axes' values, its state.
 DESCRIBE_JS = """
 function describe(i) {
   const k = frame_index(sliders, radix);
   const row = Math.floor(i / nbx), col = i % nbx;
-  return [xtext[col], ytext[row], where[k], texts[quads.data.state[i]]].filter(t => t).join("\\n");
+  return [xtext[col], ytext[row], where[k], texts[STATE]].filter(t => t).join("\\n");
 }
 """
-# The geometry of block i (rows along y): edges of its column and row, pulled in by a millionth of the block, so
-# that two neighbours never touch and a pointer on their common edge hovers one block, not both.
-GEOMETRY_JS = {
+
+
+@dataclass(frozen=True)
+class BlockGlyph:
+    """How the blocks are drawn and read back: the glyph's ``field``, the JavaScript expressions of block i's
+    state, of the block under the pointer in a tooltip and in the hover callback's hits, and the frame swap."""
+
+    field: str
+    state: str
+    tooltip_index: str
+    hits: str
+    swap: str
+
+
+# One image when the blocks are equal in the axes' scales: drawn as one, no seams between blocks, light to pan.
+IMAGE = BlockGlyph("img", "blocks.data.img[0][i]", "special_vars.image_index.flat_index",
+                   "(cb_data.index.image_indices || []).map(h => h.flat_index)", "blocks.data = {img: [states[k]]};")
+# Else one quad per block (an irregular list of values), its edges computed in the browser from the grid's edges and
+# pulled in by a millionth of the block, so that a pointer on the common edge of two neighbours hovers one, not both.
+QUADS = BlockGlyph("state", "blocks.data.state[i]", "special_vars.index", "cb_data.index.indices", "blocks.data = {state: states[k]};")
+QUAD_EDGES_JS = {
     "left": "return Array.from(this.data.state, (_, i) => xe[i % nbx] + 1e-6 * (xe[i % nbx + 1] - xe[i % nbx]));",
     "right": "return Array.from(this.data.state, (_, i) => xe[i % nbx + 1] - 1e-6 * (xe[i % nbx + 1] - xe[i % nbx]));",
     "bottom": "return Array.from(this.data.state, (_, i) => { const r = Math.floor(i / nbx); return ye[r] + 1e-6 * (ye[r + 1] - ye[r]); });",
@@ -108,7 +129,7 @@ def frame_bytes(f: Frame, per_block: int) -> int:
 def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: list[Frame], states: np.ndarray, ids: list) -> object:
     """The bokeh layout of an atlas page: title, map, sliders, readout, legend and caption."""
     from bokeh.layouts import column, row
-    from bokeh.models import ColumnDataSource, CustomJSExpr, CustomJSHover, HoverTool, LinearColorMapper
+    from bokeh.models import ColumnDataSource, CustomJS, CustomJSHover, HoverTool, LinearColorMapper, Range1d
     from bokeh.plotting import figure
 
     has_prov, has_cell = system.provenance in ds, CELL.name in ds
@@ -119,7 +140,8 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: l
 
     p = figure(name="map", frame_width=MAP_PIXELS[1], frame_height=MAP_PIXELS[0] if plan.y else 60,
                x_axis_type="log" if grid.log[0] else "linear", y_axis_type="log" if grid.log[1] else "linear",
-               x_range=(float(grid.xe[0]), float(grid.xe[-1])), y_range=(float(grid.ye[0]), float(grid.ye[-1])),
+               x_range=Range1d(float(grid.xe[0]), float(grid.xe[-1]), bounds="auto"),  # not past the grid's ends
+               y_range=Range1d(float(grid.ye[0]), float(grid.ye[-1]), bounds="auto"),
                tools="pan,wheel_zoom,box_zoom,reset,save", toolbar_location="right", output_backend="canvas")
     p.xaxis.axis_label = axis_title(ds, plan.x)
     if plan.y:
@@ -127,10 +149,7 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: l
     else:
         p.yaxis.visible = False
     p.grid.visible = False
-    source = ColumnDataSource({"state": widgets.array(ids[0])})
-    geometry = {side: CustomJSExpr(args={"xe": grid.xe, "ye": grid.ye, "nbx": nx}, code=code) for side, code in GEOMETRY_JS.items()}
-    quads = p.quad(left={"expr": geometry["left"]}, right={"expr": geometry["right"]}, bottom={"expr": geometry["bottom"]},
-                   top={"expr": geometry["top"]}, source=source, fill_color={"field": "state", "transform": mapper}, line_color=None)
+    glyph, blocks = draw_blocks(p, grid, [widgets.array(i).reshape(grid.shape) for i in ids], mapper)
     lines = []
     for kind, colour in (("classes", CLASS_EDGE), ("stability", BOUNDARY)):
         seg = ColumnDataSource(segment_columns(getattr(chosen[0], kind)))
@@ -139,30 +158,44 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: l
 
     controls = widgets.sliders(ds, plan.sliders, plan.positions)
     radix = [len(plan.positions[s]) for s in plan.sliders]
-    where = [where_text(ds, plan, at) for at in plan.frames]
+    where = [where_text(ds, plan, {**at, **{k: i for k, (i, _) in plan.fixed.items()}}) for at in plan.frames]
     titles = [title_html(ds, system, plan, f, at, grid) for f, at in zip(chosen, plan.frames, strict=True)]
     readout = widgets.readout()
     title = widgets.title(titles)
-    describe = {"sliders": controls, "radix": radix, "nbx": nx, "quads": source, "texts": texts, "where": where,
+    describe = {"sliders": controls, "radix": radix, "nbx": nx, "blocks": blocks.data_source, "texts": texts, "where": where,
                 "xtext": span_texts(ds, plan.x, grid.factors[1]), "ytext": span_texts(ds, plan.y, grid.factors[0]) if plan.y else [""]}
-    tooltip = CustomJSHover(args=describe, code=widgets.FRAME_JS + DESCRIBE_JS + "return describe(special_vars.index);")
-    from bokeh.models import CustomJS
-
-    hover = HoverTool(renderers=[quads], tooltips='<div style="white-space: pre-line; max-width: 420px">@state{custom}</div>',
-                      formatters={"@state": tooltip},
-                      callback=CustomJS(args={**describe, "readout": readout}, code=widgets.FRAME_JS + DESCRIBE_JS + widgets.READOUT_JS
-                                        + "const i = cb_data.index.indices;\nif (i.length) show(readout, describe(i[0]));"))
+    js = widgets.FRAME_JS + DESCRIBE_JS.replace("STATE", glyph.state)
+    tooltip = CustomJSHover(args=describe, code=js + f"return describe({glyph.tooltip_index});")
+    hover = HoverTool(renderers=[blocks], tooltips=f'<div style="white-space: pre-line; max-width: 420px">@{glyph.field}{{custom}}</div>',
+                      formatters={f"@{glyph.field}": tooltip},
+                      callback=CustomJS(args={**describe, "readout": readout}, code=js + widgets.READOUT_JS
+                                        + f"const i = {glyph.hits};\nif (i.length) show(readout, describe(i[0]));"))
     p.add_tools(hover)
     if controls:
-        widgets.on_frame(controls, radix, """
-quads.data = {state: states[k]};
+        shape = grid.shape if glyph is IMAGE else (-1,)
+        widgets.on_frame(controls, radix, glyph.swap + """
 lines[0].data = segs[k][0];
 lines[1].data = segs[k][1];
 title.text = titles[k];
-""", quads=source, states=[widgets.array(i) for i in ids], lines=lines, title=title, titles=titles,
+""", blocks=blocks.data_source, states=[widgets.array(i).reshape(shape) for i in ids], lines=lines, title=title, titles=titles,
                          segs=[[segment_columns(f.classes), segment_columns(f.stability)] for f in chosen])
     side = widgets.legend(plain(system.label_title), legend_entries(system, legend, chosen))
     return column(title, row(p, side), *controls, readout, widgets.caption(caption_lines(ds, plan, grid)))
+
+
+def draw_blocks(p, grid, states: list[np.ndarray], mapper) -> tuple[BlockGlyph, Any]:
+    """Draw the first frame's blocks (``states``: each frame's state indices, rows along y) as one image, or as a quad
+    each where the blocks are not equal in the axes' scales; returns how they are read and the renderer."""
+    from bokeh.models import ColumnDataSource, CustomJSExpr
+
+    nx = grid.shape[1]
+    if grid.image is not None:
+        x, y, dw, dh = grid.image
+        return IMAGE, p.image(image="img", x=x, y=y, dw=dw, dh=dh, color_mapper=mapper, source=ColumnDataSource({"img": [states[0]]}))
+    edges = {side: CustomJSExpr(args={"xe": grid.xe, "ye": grid.ye, "nbx": nx}, code=code) for side, code in QUAD_EDGES_JS.items()}
+    return QUADS, p.quad(left={"expr": edges["left"]}, right={"expr": edges["right"]}, bottom={"expr": edges["bottom"]},
+                         top={"expr": edges["top"]}, source=ColumnDataSource({"state": states[0].ravel()}),
+                         fill_color={"field": "state", "transform": mapper}, line_color=None)
 
 
 def segment_columns(table: np.ndarray) -> dict[str, np.ndarray]:
@@ -171,7 +204,7 @@ def segment_columns(table: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def where_text(ds: xr.Dataset, plan: PagePlan, at: dict[str, int]) -> str:
-    """The sliders' values at setting ``at``, one line each."""
+    """The values of the axes off the map at ``at`` (the sliders' setting and the axes fixed by ``sel``), one line each."""
     return "\n".join(value_text(ds, d, float(ds[d][i])) for d, i in at.items())
 
 

@@ -44,6 +44,25 @@ class MapGrid:
     def shape(self) -> tuple[int, int]:
         return len(self.ye) - 1, len(self.xe) - 1
 
+    @property
+    def image(self) -> tuple[float, float, float, float] | None:
+        """(x, y, dw, dh) of one image of equal blocks that lays every block on its cells, or None when the blocks are
+        not equal in the axes' scales (an irregular list of values): then each block is drawn as its own quad.
+
+        A grid even in the scale of its axis (linear, or geometric on a log axis) has blocks of equal size there but
+        the last, which holds what is left; the image gives that one the common size too, beyond the grid's end,
+        where the map's range, which cannot be panned past, cuts it off."""
+        sizes = []
+        for e, log in ((self.xe, self.log[0]), (self.ye, self.log[1])):
+            s = np.log(e) if log else e
+            step = s[1] - s[0]
+            if not step > 0 or (len(s) > 2 and not np.allclose(np.diff(s[:-1]), step, rtol=1e-6, atol=0)):
+                return None
+            if not 0 < s[-1] - s[-2] <= step * (1 + 1e-6):
+                return None
+            sizes.append(np.exp(s[0] + step * (len(s) - 1)) - e[0] if log else step * (len(s) - 1))
+        return float(self.xe[0]), float(self.ye[0]), float(sizes[0]), float(sizes[1])
+
 
 def map_grid(ds: xr.Dataset, plan: PagePlan, pixels: tuple[int, int] = MAP_PIXELS) -> MapGrid:
     """Blocks of the drawn axes no smaller than a pixel of a map ``pixels`` (y, x) in size, and their edges."""
