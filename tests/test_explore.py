@@ -30,9 +30,10 @@ def models(page, kind: str) -> list:
 
 def shown_states(page) -> tuple[np.ndarray, list[str]]:
     """The first frame's state index per block and the text of every state, as the page stores them."""
-    (source,) = [s for s in models(page, "ColumnDataSource") if "state" in s.data]
+    (source,) = [s for s in models(page, "ColumnDataSource") if "state" in s.data or "img" in s.data]
     (hover,) = models(page, "CustomJSHover")
-    return np.asarray(source.data["state"]), list(hover.args["texts"])
+    state = source.data["state"] if "state" in source.data else source.data["img"][0]  # quads, or one image (rows along y)
+    return np.asarray(state).ravel(), list(hover.args["texts"])
 
 
 def test_plain_text_of_mathtext():
@@ -107,9 +108,31 @@ def test_a_slider_per_further_axis_and_its_frames(two_tops_atlas):
     _, texts = shown_states(page)
     for k, value in enumerate([0.0, 20.0]):
         want = np.asarray(ds.n_complex_pairs.sel(K_1=value).transpose("m_2", "omega")).ravel()
-        got = [int(texts[s].split(" = ")[1].split(":")[0]) for s in switch.args["states"][k]]
+        got = [int(texts[s].split(" = ")[1].split(":")[0]) for s in np.ravel(switch.args["states"][k])]
         assert got == want.tolist()
         assert value_text(ds, "K_1", value) in switch.args["titles"][k]
+
+
+def test_an_irregular_axis_is_drawn_in_quads_an_even_one_as_an_image(two_tops_atlas):
+    """One image lays its blocks on the grid's cells only when they are equal in the axis's scale (linear, or
+    geometric on a log axis); an irregular list of values gets a quad per block, each on its own cells."""
+    from stabmap.read.plot.geometry import cell_edges
+
+    ds = two_tops_atlas
+    grid = map_grid(ds, plan_page(ds, ["omega", "m_2"]))
+    x, y, dw, dh = grid.image
+    xe = cell_edges(ds.omega.values, None)
+    ye = cell_edges(ds.m_2.values, "log")
+    assert (x, x + dw) == pytest.approx((xe[0], xe[-1]), rel=1e-12)
+    assert (y, y + dh) == pytest.approx((ye[0], ye[-1]), rel=1e-12)  # geometric cells on the log axis
+    uneven = ds.assign_coords(m_2=("m_2", [0.1, 0.2, 0.5, 1.0, 3.0, 4.0, 5.0], {**ds.m_2.attrs, "scale": "values"}))
+    assert map_grid(uneven, plan_page(uneven, ["omega", "m_2"])).image is None
+    page = atlas_page(uneven)
+    assert models(page, "Quad") and not models(page, "Image")
+    state, texts = shown_states(page)
+    label = np.asarray(uneven.n_complex_pairs.transpose("m_2", "omega")).ravel()
+    assert [int(texts[s].split(" = ")[1].split(":")[0]) for s in state] == label.tolist()
+    assert models(atlas_page(ds), "Image")
 
 
 def test_thinning_keeps_evenly_spaced_values_and_says_so():

@@ -255,5 +255,5 @@ def caption_lines(ds: xr.Dataset, plan: PagePlan, grid) -> list[str]:
                      + (f" × {fy}" if plan.y else "") + " (no block smaller than a pixel): a block shows its class where all its points "
                      "agree, black if it holds stable and unstable points, dark grey if several other classes; hover names them.")
     lines += [f"note: {n}" for n in plan.notes]
-    lines.append("Drag to pan, scroll to zoom (the tools at the right), move the sliders to change the further axes.")
+    lines.append(widgets.how_to(bool(plan.sliders)))
     return lines

@@ -151,5 +151,5 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, edges: np.ndarray, scan: list[f
     entries.append('<div style="margin:3px 0">&#9679;&nbsp; a change of ' + escape(plain(system.label_symbol)) + ", located</div>")
     side = widgets.legend(plain(system.label_title), entries)
     lines = [plain(fixed_caption(ds, 10_000)).replace("\u00a0", " "), *(f"note: {n}" for n in plan.notes),
-             "Drag to pan, scroll to zoom (the tools at the right), move the sliders to change the further axes."]
+             widgets.how_to(bool(plan.sliders))]
     return column(title, row(p, side), *controls, readout, widgets.caption(lines))

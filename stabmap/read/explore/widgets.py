@@ -92,6 +92,11 @@ def title(texts: list[str]):
     return Div(name="title", width=880, styles={**STYLE, "font-size": "14px"}, text=texts[0])
 
 
+def how_to(sliders: bool) -> str:
+    """The caption's last line: how to move around the page."""
+    return "Drag to pan, scroll to zoom (the tools at the right of the map)" + (", move the sliders to change the further axes." if sliders else ".")
+
+
 def array(a) -> np.ndarray:
     """The smallest unsigned integer type that holds ``a`` (a page stores state indices, not labels)."""
     a = np.asarray(a)
