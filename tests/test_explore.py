@@ -30,10 +30,9 @@ def models(page, kind: str) -> list:
 
 def shown_states(page) -> tuple[np.ndarray, list[str]]:
     """The first frame's state index per block and the text of every state, as the page stores them."""
-    (source,) = [s for s in models(page, "ColumnDataSource") if "state" in s.data or "img" in s.data]
+    (source,) = [s for s in models(page, "ColumnDataSource") if "state" in s.data]
     (hover,) = models(page, "CustomJSHover")
-    state = source.data["state"] if "state" in source.data else source.data["img"][0]  # quads, or one image (rows along y)
-    return np.asarray(state).ravel(), list(hover.args["texts"])
+    return np.asarray(source.data["state"]), list(hover.args["tables"]["texts"].data["v"])
 
 
 def test_plain_text_of_mathtext():
@@ -108,31 +107,55 @@ def test_a_slider_per_further_axis_and_its_frames(two_tops_atlas):
     _, texts = shown_states(page)
     for k, value in enumerate([0.0, 20.0]):
         want = np.asarray(ds.n_complex_pairs.sel(K_1=value).transpose("m_2", "omega")).ravel()
-        got = [int(texts[s].split(" = ")[1].split(":")[0]) for s in np.ravel(switch.args["states"][k])]
+        got = [int(texts[s].split(" = ")[1].split(":")[0]) for s in switch.args["frames"][k][1]]
         assert got == want.tolist()
         assert value_text(ds, "K_1", value) in switch.args["titles"][k]
 
 
-def test_an_irregular_axis_is_drawn_in_quads_an_even_one_as_an_image(two_tops_atlas):
-    """One image lays its blocks on the grid's cells only when they are equal in the axis's scale (linear, or
-    geometric on a log axis); an irregular list of values gets a quad per block, each on its own cells."""
-    from stabmap.read.plot.geometry import cell_edges
+def test_the_map_colours_the_atlas_cells_and_nothing_beyond(two_tops_atlas):
+    """The blocks are drawn on the cells the atlas proves its labels on (its CF bounds; on the log axis too), the map
+    ends where the scan ends, and the rectangles of one colour cover every block once, in that block's colour."""
+    from stabmap.read.explore.frames import colour_rectangles
 
     ds = two_tops_atlas
     grid = map_grid(ds, plan_page(ds, ["omega", "m_2"]))
-    x, y, dw, dh = grid.image
-    xe = cell_edges(ds.omega.values, None)
-    ye = cell_edges(ds.m_2.values, "log")
-    assert (x, x + dw) == pytest.approx((xe[0], xe[-1]), rel=1e-12)
-    assert (y, y + dh) == pytest.approx((ye[0], ye[-1]), rel=1e-12)  # geometric cells on the log axis
-    uneven = ds.assign_coords(m_2=("m_2", [0.1, 0.2, 0.5, 1.0, 3.0, 4.0, 5.0], {**ds.m_2.attrs, "scale": "values"}))
-    assert map_grid(uneven, plan_page(uneven, ["omega", "m_2"])).image is None
-    page = atlas_page(uneven)
-    assert models(page, "Quad") and not models(page, "Image")
-    state, texts = shown_states(page)
-    label = np.asarray(uneven.n_complex_pairs.transpose("m_2", "omega")).ravel()
-    assert [int(texts[s].split(" = ")[1].split(":")[0]) for s in state] == label.tolist()
-    assert models(atlas_page(ds), "Image")
+    for edges, dim in ((grid.xe, "omega"), (grid.ye, "m_2")):
+        bounds = ds[f"{dim}_bounds"].values
+        assert edges.tolist() == [*bounds[:, 0], bounds[-1, 1]]
+        assert (edges[0], edges[-1]) == (ds[dim].values[0], ds[dim].values[-1])
+    page = atlas_page(ds)
+    (fig,) = [m for m in page.layout.references() if m.name == "map"]
+    assert (fig.x_range.start, fig.x_range.end) == (ds.omega.values[0], ds.omega.values[-1])
+    colours = np.random.default_rng(1).integers(0, 3, size=(40, 30))
+    colours[10:30, 5:25] = 7
+    rects = colour_rectangles(colours)
+    painted = np.full(colours.shape, -1)
+    for c0, c1, r0, r1, c in rects:
+        assert (painted[r0:r1, c0:c1] == -1).all()  # no block twice
+        painted[r0:r1, c0:c1] = c
+    assert (painted == colours).all()
+    assert len(rects) < colours.size / 2  # merged: the 20 x 20 square of one colour is few rectangles
+
+
+def test_a_page_is_fitted_under_its_bound_by_measuring_it():
+    """The bound holds on the page as written: a page too big with every setting is made again with fewer, evenly
+    spaced, and says so once."""
+    from stabmap.read.explore.page import Page, fitted
+
+    class Sized(Page):
+        @property
+        def size(self) -> int:  # a page whose every slider setting costs 50 kB
+            return int(1.7e6 + 50_000 * len(self.layout.frames))
+
+    full = PagePlan("x", "y", ("a",), {"a": tuple(range(40))})
+    made = []
+    page = fitted(full, {"a": 40}, 2.5, 40, lambda plan: made.append(plan) or Sized(plan, "t", plan.notes))
+    assert page.size <= 2.5e6 and len(page.layout.frames) >= 14
+    assert page.layout.positions["a"][0] == 0 and page.layout.positions["a"][-1] == 39
+    assert len(page.notes) == 1 and page.notes[0].startswith(f"a: {len(page.layout.frames)} of 40 values on its slider, evenly spaced")
+    assert len(made[0].frames) == 40
+    with pytest.raises(StabmapError, match="one map of this file makes a page of"):
+        fitted(full, {"a": 40}, 1.72, 40, lambda plan: Sized(plan, "t", plan.notes))
 
 
 def test_thinning_keeps_evenly_spaced_values_and_says_so():
@@ -146,19 +169,16 @@ def test_thinning_keeps_evenly_spaced_values_and_says_so():
 
 
 def test_a_page_over_its_bound_leaves_slider_values_out(two_tops_atlas, monkeypatch):
-    """With room for two frames, a slider of five values keeps three (its ends and middle) and the page says so."""
+    """With room for three frames, a slider of five values keeps three (its ends and middle) and the page says so."""
     import stabmap.read.explore.atlas as page_module
 
     ds = two_tops_atlas.expand_dims(K_1=[0.0, 10.0, 20.0, 30.0, 40.0]).transpose("omega", "m_2", "K_1", ...)
-    one = page_module.frame_bytes(page_module.read_frame(
-        ds.n_complex_pairs, None, plan_page(ds, ["omega", "m_2", "K_1"]), {"K_1": 0}, map_grid(ds, plan_page(ds, ["omega", "m_2", "K_1"])),
-        Legend(stabmap.systems.of_atlas(ds.attrs), False)), 1)
-    monkeypatch.setattr(page_module, "budget", lambda max_mb: 3 * one)
+    monkeypatch.setattr(page_module, "frame_bytes", lambda frame: 1)
+    monkeypatch.setattr(page_module, "budget", lambda max_mb: 3)  # room for three frames
     page = atlas_page(ds, max_mb=5)
-    assert page.notes and "K_1: 3 of 5 values on its slider, evenly spaced" in page.notes[0] and "max_mb = 5" in page.notes[0]
+    assert page.notes and "K_1: 3 of 5 values on its slider, evenly spaced" in page.notes[0] and "max_mb 5" in page.notes[0]
     (slider,) = models(page, "Slider")
     assert slider.end == 2
-    assert page.data_bytes <= 3 * one
 
 
 def test_page_file_is_written_atomically_and_within_its_bound(two_tops_atlas, tmp_path):

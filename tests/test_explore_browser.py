@@ -8,15 +8,11 @@ gyroscopes' atlas has a third axis: its slider is moved and the map hovered agai
 file is drawn the same way and each stretch hovered, its class and ends checked against the file's boundaries and
 stable intervals.  Every test saves a screenshot and checks that it shows a drawn page.
 
-One test is expected to fail (strict xfail) until a bug of the atlas page is fixed: a pointer on the edge between two
-blocks, where it lies on a whole pixel, hovers neither block.
-
 Without Chromium these tests skip, or fail when STABMAP_REQUIRE_BROWSER=1 (tests/browser.py).
 """
 
 from __future__ import annotations
 
-import math
 import re
 
 import numpy as np
@@ -151,13 +147,20 @@ def hover_every_point(page: Page, ds: xr.Dataset, name: str, sliders: dict[str, 
         for j in range(ds.sizes[y]):
             at = {x: i, y: j, **sliders}
             point = {d: float(ds[d][k]) for d, k in at.items()}
-            page.hover("map", point[x], point[y])
+            page.hover("map", *(inside(ds, d, at[d]) for d in (x, y)))
             readout = page.wait(f"the readout of {point}", lambda: page.text("readout"), lambda t, p=point: at_point(t, p))
             assert_point_text(readout, ds, system, name, at)
             tooltip = page.wait(f"the tooltip of {point}", page.tooltip_text, lambda t, p=point: at_point(t, p))
             assert tooltip == readout
             seen.add(int(ds[system.label].isel(at)))
     return seen
+
+
+def inside(ds: xr.Dataset, dim: str, i: int) -> float:
+    """The middle of grid point ``i``'s cell along ``dim`` (its CF bounds): at the ends of the scan the cell ends at
+    the point itself, which lies on the map's border, where a pointer may fall outside the map."""
+    lo, hi = (float(v) for v in ds[f"{dim}_bounds"][i])
+    return (lo + hi) / 2
 
 
 def assert_drawn_png(path) -> None:
@@ -228,11 +231,9 @@ def hover_pixel(page: Page, px: int, py: int) -> None:
             page.wait("the tooltip to go", page.tooltip_text, lambda t: t == "")
 
 
-@pytest.mark.xfail(strict=True, reason="stabmap/read/explore/atlas.py GEOMETRY_JS pulls every block in on all four sides, so a pointer on a "
-                   "block edge that falls on a whole pixel hovers no block: no tooltip, and the readout keeps the previous block")
 def test_a_pointer_on_the_edge_between_two_rows_hovers_one_of_them(new_page, atlas_page_of, tmp_path):
-    """The map's 450 px hold the 5 rows of m_2 (a log axis) in 90 px each, so every edge between two rows lies on a
-    whole pixel: the pointer there must show one of the two rows' points, as on either side of it.  (A real mouse
+    """A pointer on the edge between two rows (the atlas's cell bounds) must show one of the two rows' points, as on
+    either side of it, also where the edge lies on a whole pixel.  (A real mouse
     stops on whole pixels; on an axis of 300 values, every other pixel column is such an edge.)"""
     ds, html = atlas_page_of("gyroscopes")
     page = new_page().open(html)
@@ -240,7 +241,7 @@ def test_a_pointer_on_the_edge_between_two_rows_hovers_one_of_them(new_page, atl
     i = 3
     for j in range(ds.sizes["m_2"] - 1):
         below, above = ({"omega": float(ds["omega"][i]), "m_2": float(ds["m_2"][r]), "K_1": float(ds["K_1"][0])} for r in (j, j + 1))
-        edge = math.sqrt(below["m_2"] * above["m_2"])  # on a log axis the blocks meet half way in the logarithm
+        edge = float(ds["m_2_bounds"][j, 1])  # the cells the atlas proves its labels on: midpoints, on the log axis too
         px, py = page.point("map", below["omega"], edge)
         for dy in (1, 0, -1):  # the row below the edge, the edge, the row above (screen y grows downwards)
             hover_pixel(page, round(px), round(py) + dy)

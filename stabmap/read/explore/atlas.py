@@ -2,16 +2,15 @@
 each further axis, and on hover the point's parameters, label and class, what decided it and what its cell
 proves.
 
-The map is drawn in blocks no smaller than a pixel of the page's map (600 x 450), each block one byte (two past 256
-states) naming its state (:mod:`.states`); the blocks' geometry is computed in the browser from the grid's edges,
-so a frame costs one byte a block plus its boundary segments. A page holds every slider setting up to its size
-bound (``max_mb``): beyond it the sliders keep evenly spaced values, and the page and ``notes`` say which.
+The map is drawn in blocks no smaller than a pixel of the page's map (600 x 450) on the cells the atlas proves
+its labels on (its ``*_bounds``: nothing is coloured beyond the scan); blocks of one colour are merged into
+rectangles, one quad each, so that no seam shows inside a region. On hover, the block under the pointer is found
+from its coordinates, and its state (:mod:`.states`: one byte per block, two past 256 states) names its text.
+A page holds every slider setting that fits its size bound (``max_mb``), measured on the page itself: beyond it
+the sliders keep evenly spaced values, and the page and ``notes`` say which.
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -23,44 +22,36 @@ from ..plot.captions import fixed_caption
 from ..plot.palette import BOUNDARY, CLASS_EDGE, system_colour
 from . import widgets
 from .frames import MAP_PIXELS, Frame, map_grid, read_frame
-from .page import MAX_MB, Page, budget
-from .plan import PagePlan, plan_page, thin
+from .page import MAX_MB, Page, budget, fitted
+from .plan import PagePlan, plan_page
 from .states import Legend, lighter, point_bits, state_text
 from .text import axis_title, escape, plain, span_texts, value_text
 
-# The index of a block under the pointer -> its text: position along x and y, the other axes' values, its state.
+# The block under the pointer (data coordinates x, y) -> its text: its values along x and y, the other axes' values,
+# its state. Tables shared by the tooltip and the readout live in data sources, so the page holds them once.
 DESCRIBE_JS = """
-function describe(i) {
+function locate(e, v) {
+  const n = e.length - 1, up = e[n] >= e[0];
+  let lo = 0, hi = n;
+  while (hi - lo > 1) { const m = (lo + hi) >> 1; if ((v >= e[m]) === up) lo = m; else hi = m; }
+  return lo;
+}
+function describe(x, y) {
   const k = frame_index(sliders, radix);
-  const row = Math.floor(i / nbx), col = i % nbx;
-  return [xtext[col], ytext[row], where[k], texts[STATE]].filter(t => t).join("\\n");
+  const xe = tables.xe.data.v, ye = tables.ye.data.v, nbx = xe.length - 1;
+  const col = locate(xe, x), row = ye.length > 2 ? locate(ye, y) : 0;
+  const s = current.data.state[row * nbx + col];
+  return [tables.xtext.data.v[col], tables.ytext.data.v[row], tables.where.data.v[k], tables.texts.data.v[s]].filter(t => t).join("\\n");
 }
 """
-
-
-@dataclass(frozen=True)
-class BlockGlyph:
-    """How the blocks are drawn and read back: the glyph's ``field``, the JavaScript expressions of block i's
-    state, of the block under the pointer in a tooltip and in the hover callback's hits, and the frame swap."""
-
-    field: str
-    state: str
-    tooltip_index: str
-    hits: str
-    swap: str
-
-
-# One image when the blocks are equal in the axes' scales: drawn as one, no seams between blocks, light to pan.
-IMAGE = BlockGlyph("img", "blocks.data.img[0][i]", "special_vars.image_index.flat_index",
-                   "(cb_data.index.image_indices || []).map(h => h.flat_index)", "blocks.data = {img: [states[k]]};")
-# Else one quad per block (an irregular list of values), its edges computed in the browser from the grid's edges and
-# pulled in by a millionth of the block, so that a pointer on the common edge of two neighbours hovers one, not both.
-QUADS = BlockGlyph("state", "blocks.data.state[i]", "special_vars.index", "cb_data.index.indices", "blocks.data = {state: states[k]};")
-QUAD_EDGES_JS = {
-    "left": "return Array.from(this.data.state, (_, i) => xe[i % nbx] + 1e-6 * (xe[i % nbx + 1] - xe[i % nbx]));",
-    "right": "return Array.from(this.data.state, (_, i) => xe[i % nbx + 1] - 1e-6 * (xe[i % nbx + 1] - xe[i % nbx]));",
-    "bottom": "return Array.from(this.data.state, (_, i) => { const r = Math.floor(i / nbx); return ye[r] + 1e-6 * (ye[r + 1] - ye[r]); });",
-    "top": "return Array.from(this.data.state, (_, i) => { const r = Math.floor(i / nbx); return ye[r + 1] - 1e-6 * (ye[r + 1] - ye[r]); });",
+# A rectangle's edges from its block columns [c0, c1) and rows [r0, r1); the right and top edges inside the map are
+# pulled in by a millionth of a block, so that a pointer on the edge between two rectangles hovers the one it belongs to (edges are
+# inclusive in bokeh's hit test), and the same one that locate() names.
+RECT_EDGES_JS = {
+    "left": "const e = xe.data.v; return Array.from(this.data.c0, c => e[c]);",
+    "right": "const e = xe.data.v; return Array.from(this.data.c1, c => c == e.length - 1 ? e[c] : e[c] - 1e-6 * (e[c] - e[c - 1]));",
+    "bottom": "const e = ye.data.v; return Array.from(this.data.r0, r => e[r]);",
+    "top": "const e = ye.data.v; return Array.from(this.data.r1, r => r == e.length - 1 ? e[r] : e[r] - 1e-6 * (e[r] - e[r - 1]));",
 }
 
 
@@ -88,68 +79,72 @@ def atlas_page(ds: xr.Dataset, *, x: str | None = None, y: str | None = None, se
     if not dims:
         raise StabmapError("this atlas has no axis to draw (a single point); use 'stabmap info' or 'stabmap query'")
     room = budget(max_mb)
-    plan = plan_page(ds, dims, x=x, y=y, sel=sel)
-    fix = {k: i for k, (i, _) in plan.fixed.items()}
+    full = plan_page(ds, dims, x=x, y=y, sel=sel)
+    fix = {k: i for k, (i, _) in full.fixed.items()}
     label = ds[system.label].isel(fix)
     bits = point_bits(ds, system)
     bits = None if bits is None else bits.isel(fix)
-    grid = map_grid(ds, plan)
+    grid = map_grid(ds, full)
     legend = Legend(system, system.provenance in ds)
-
     frames: dict[tuple, Frame] = {}
 
-    def read(at: dict[str, int]) -> Frame:
+    def read(at: dict[str, int], total: int) -> Frame:
         key = tuple(sorted(at.items()))
         if key not in frames:
-            frames[key] = read_frame(label, bits, plan, at, grid, legend)
+            frames[key] = read_frame(label, bits, full, at, grid, legend)
             if progress is not None:
-                progress(len(frames), len(plan.frames))
+                progress(len(frames), total)
         return frames[key]
 
-    first = read(plan.frames[0])
-    plan = thin(plan, dict(ds.sizes), room // max(1, frame_bytes(first, 1)), f"the page's size bound, max_mb = {max_mb:g}; "
-                "a value left out can be chosen with sel / --sel")
-    chosen = [read(at) for at in plan.frames]
-    states, table = np.unique(np.concatenate([f.keys.ravel() for f in chosen]), return_inverse=True)
-    while sum(frame_bytes(f, 1 if len(states) <= 256 else 2) for f in chosen) > room and len(chosen) > 1:  # an estimate fell short
-        plan = thin(plan, dict(ds.sizes), len(chosen) // 2, f"the page's size bound, max_mb = {max_mb:g}")
-        chosen = [read(at) for at in plan.frames]
-        states, table = np.unique(np.concatenate([f.keys.ravel() for f in chosen]), return_inverse=True)
-    ids = np.split(table, np.cumsum([f.keys.size for f in chosen])[:-1])
-    layout = draw(ds, system, plan, grid, legend, chosen, states, ids)
-    data = sum(frame_bytes(f, 1 if len(states) <= 256 else 2) for f in chosen)
-    return Page(layout, plain(ds.attrs.get("title", "") or "stabmap atlas"), plan.notes, data)
+    first = read(full.frames[0], len(full.frames))  # a first guess of the frames that fit; the page is then measured
+
+    def make(plan: PagePlan) -> Page:
+        chosen = [read(at, len(plan.frames)) for at in plan.frames]
+        return Page(draw(ds, system, plan, grid, legend, chosen), plain(ds.attrs.get("title", "") or "stabmap atlas"), plan.notes)
+
+    return fitted(full, dict(ds.sizes), max_mb, room // max(1, frame_bytes(first)), make)
 
 
-def frame_bytes(f: Frame, per_block: int) -> int:
-    """Bytes a frame adds to a page: a state index per block, five float32 per boundary segment."""
-    return per_block * f.keys.size + 20 * (len(f.stability) + len(f.classes))
+def frame_bytes(f: Frame) -> int:
+    """A first guess of the bytes a frame adds to a page: a state per block, its rectangles and boundary segments."""
+    return f.keys.size + 10 * len(f.rects) + 20 * (len(f.stability) + len(f.classes))
 
 
-def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: list[Frame], states: np.ndarray, ids: list) -> object:
+def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: list[Frame]) -> object:
     """The bokeh layout of an atlas page: title, map, sliders, readout, legend and caption."""
     from bokeh.layouts import column, row
-    from bokeh.models import ColumnDataSource, CustomJS, CustomJSHover, HoverTool, LinearColorMapper, Range1d
+    from bokeh.models import ColumnDataSource, CustomJS, CustomJSExpr, CustomJSHover, HoverTool, LinearColorMapper, Range1d
     from bokeh.plotting import figure
 
     has_prov, has_cell = system.provenance in ds, CELL.name in ds
-    ny, nx = grid.shape
+    states, table = np.unique(np.concatenate([f.keys.ravel() for f in chosen]), return_inverse=True)
+    ids = np.split(table, np.cumsum([f.keys.size for f in chosen])[:-1])
     texts = [state_text(int(k), system, has_prov, has_cell) for k in states]
-    palette = [legend.colours[(int(k) >> 33) & 63] for k in states]
+    palette = list(legend.colours)
     mapper = LinearColorMapper(palette=palette * (2 if len(palette) == 1 else 1), low=-0.5, high=len(palette) - 0.5)
 
     p = figure(name="map", frame_width=MAP_PIXELS[1], frame_height=MAP_PIXELS[0] if plan.y else 60,
                x_axis_type="log" if grid.log[0] else "linear", y_axis_type="log" if grid.log[1] else "linear",
-               x_range=Range1d(float(grid.xe[0]), float(grid.xe[-1]), bounds="auto"),  # not past the grid's ends
+               x_range=Range1d(float(grid.xe[0]), float(grid.xe[-1]), bounds="auto"),  # not panned past the scan
                y_range=Range1d(float(grid.ye[0]), float(grid.ye[-1]), bounds="auto"),
-               tools="pan,wheel_zoom,box_zoom,reset,save", toolbar_location="right", output_backend="canvas")
+               tools="pan,wheel_zoom,box_zoom,reset,save", toolbar_location="right")
     p.xaxis.axis_label = axis_title(ds, plan.x)
     if plan.y:
         p.yaxis.axis_label = axis_title(ds, plan.y)
     else:
         p.yaxis.visible = False
     p.grid.visible = False
-    glyph, blocks = draw_blocks(p, grid, [widgets.array(i).reshape(grid.shape) for i in ids], mapper)
+
+    where = [where_text(ds, {**at, **{k: i for k, (i, _) in plan.fixed.items()}}) for at in plan.frames]
+    # The tables every callback reads, each in a model: bokeh writes a model once, however many callbacks name it.
+    tables = {name: ColumnDataSource({"v": values}) for name, values in (
+        ("xe", grid.xe), ("ye", grid.ye), ("texts", texts), ("where", where), ("xtext", span_texts(ds, plan.x, grid.factors[1])),
+        ("ytext", span_texts(ds, plan.y, grid.factors[0]) if plan.y else [""]))}
+    rects = ColumnDataSource(rect_columns(chosen[0]))
+    current = ColumnDataSource({"state": widgets.array(ids[0])})
+    edges = {side: CustomJSExpr(args={"xe": tables["xe"], "ye": tables["ye"]}, code=code) for side, code in RECT_EDGES_JS.items()}
+    blocks = p.quad(left={"expr": edges["left"]}, right={"expr": edges["right"]}, bottom={"expr": edges["bottom"]},
+                    top={"expr": edges["top"]}, source=rects, fill_color={"field": "colour", "transform": mapper}, line_color=None)
     lines = []
     for kind, colour in (("classes", CLASS_EDGE), ("stability", BOUNDARY)):
         seg = ColumnDataSource(segment_columns(getattr(chosen[0], kind)))
@@ -158,44 +153,36 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: l
 
     controls = widgets.sliders(ds, plan.sliders, plan.positions)
     radix = [len(plan.positions[s]) for s in plan.sliders]
-    where = [where_text(ds, plan, {**at, **{k: i for k, (i, _) in plan.fixed.items()}}) for at in plan.frames]
-    titles = [title_html(ds, system, plan, f, at, grid) for f, at in zip(chosen, plan.frames, strict=True)]
+    titles = [title_html(ds, system, plan, f, at) for f, at in zip(chosen, plan.frames, strict=True)]
     readout = widgets.readout()
     title = widgets.title(titles)
-    describe = {"sliders": controls, "radix": radix, "nbx": nx, "blocks": blocks.data_source, "texts": texts, "where": where,
-                "xtext": span_texts(ds, plan.x, grid.factors[1]), "ytext": span_texts(ds, plan.y, grid.factors[0]) if plan.y else [""]}
-    js = widgets.FRAME_JS + DESCRIBE_JS.replace("STATE", glyph.state)
-    tooltip = CustomJSHover(args=describe, code=js + f"return describe({glyph.tooltip_index});")
-    hover = HoverTool(renderers=[blocks], tooltips=f'<div style="white-space: pre-line; max-width: 420px">@{glyph.field}{{custom}}</div>',
-                      formatters={f"@{glyph.field}": tooltip},
+    describe = {"sliders": controls, "radix": radix, "tables": tables, "current": current}
+    js = widgets.FRAME_JS + DESCRIBE_JS
+    tooltip = CustomJSHover(args=describe, code=js + "return describe(special_vars.x, special_vars.y);")
+    hover = HoverTool(renderers=[blocks], tooltips='<div style="white-space: pre-line; max-width: 420px">@colour{custom}</div>',
+                      formatters={"@colour": tooltip},
                       callback=CustomJS(args={**describe, "readout": readout}, code=js + widgets.READOUT_JS
-                                        + f"const i = {glyph.hits};\nif (i.length) show(readout, describe(i[0]));"))
+                                        + "if (cb_data.index.indices.length) show(readout, describe(cb_data.geometry.x, cb_data.geometry.y));"))
     p.add_tools(hover)
     if controls:
-        shape = grid.shape if glyph is IMAGE else (-1,)
-        widgets.on_frame(controls, radix, glyph.swap + """
-lines[0].data = segs[k][0];
-lines[1].data = segs[k][1];
+        widgets.on_frame(controls, radix, """
+rects.data = frames[k][0];
+current.data = {state: frames[k][1]};
+lines[0].data = frames[k][2];
+lines[1].data = frames[k][3];
 title.text = titles[k];
-""", blocks=blocks.data_source, states=[widgets.array(i).reshape(shape) for i in ids], lines=lines, title=title, titles=titles,
-                         segs=[[segment_columns(f.classes), segment_columns(f.stability)] for f in chosen])
+""", rects=rects, current=current, lines=lines, title=title, titles=titles,
+                         frames=[[rect_columns(f), widgets.array(i), segment_columns(f.classes), segment_columns(f.stability)]
+                                 for f, i in zip(chosen, ids, strict=True)])
     side = widgets.legend(plain(system.label_title), legend_entries(system, legend, chosen))
     return column(title, row(p, side), *controls, readout, widgets.caption(caption_lines(ds, plan, grid)))
 
 
-def draw_blocks(p, grid, states: list[np.ndarray], mapper) -> tuple[BlockGlyph, Any]:
-    """Draw the first frame's blocks (``states``: each frame's state indices, rows along y) as one image, or as a quad
-    each where the blocks are not equal in the axes' scales; returns how they are read and the renderer."""
-    from bokeh.models import ColumnDataSource, CustomJSExpr
-
-    nx = grid.shape[1]
-    if grid.image is not None:
-        x, y, dw, dh = grid.image
-        return IMAGE, p.image(image="img", x=x, y=y, dw=dw, dh=dh, color_mapper=mapper, source=ColumnDataSource({"img": [states[0]]}))
-    edges = {side: CustomJSExpr(args={"xe": grid.xe, "ye": grid.ye, "nbx": nx}, code=code) for side, code in QUAD_EDGES_JS.items()}
-    return QUADS, p.quad(left={"expr": edges["left"]}, right={"expr": edges["right"]}, bottom={"expr": edges["bottom"]},
-                         top={"expr": edges["top"]}, source=ColumnDataSource({"state": states[0].ravel()}),
-                         fill_color={"field": "state", "transform": mapper}, line_color=None)
+def rect_columns(f: Frame) -> dict[str, np.ndarray]:
+    """A frame's rectangles of one colour as the columns of its quads: block columns c0..c1, rows r0..r1, colour."""
+    r = f.rects
+    return {"c0": r[:, 0].astype(np.uint16), "c1": r[:, 1].astype(np.uint16), "r0": r[:, 2].astype(np.uint16),
+            "r1": r[:, 3].astype(np.uint16), "colour": r[:, 4].astype(np.uint8)}
 
 
 def segment_columns(table: np.ndarray) -> dict[str, np.ndarray]:
@@ -203,12 +190,12 @@ def segment_columns(table: np.ndarray) -> dict[str, np.ndarray]:
     return {k: np.ascontiguousarray(table[:, j]) for j, k in enumerate(("x0", "y0", "x1", "y1", "w"))}
 
 
-def where_text(ds: xr.Dataset, plan: PagePlan, at: dict[str, int]) -> str:
+def where_text(ds: xr.Dataset, at: dict[str, int]) -> str:
     """The values of the axes off the map at ``at`` (the sliders' setting and the axes fixed by ``sel``), one line each."""
     return "\n".join(value_text(ds, d, float(ds[d][i])) for d, i in at.items())
 
 
-def title_html(ds: xr.Dataset, system, plan: PagePlan, f: Frame, at: dict[str, int], grid) -> str:
+def title_html(ds: xr.Dataset, system, plan: PagePlan, f: Frame, at: dict[str, int]) -> str:
     """The title of one frame: the atlas's title, the share of this map's grid points proved stable, the values of
     the sliders and of the axes fixed by ``sel``."""
     total = sum(f.counts.values())

@@ -14,8 +14,8 @@ from ..plot.critical import critical_rows, critical_stretches, scanned_attrs, un
 from ..plot.geometry import cell_edges
 from ..plot.palette import UNDECIDED_COLOUR, system_colour
 from . import widgets
-from .page import MAX_MB, Page, budget
-from .plan import PagePlan, thin
+from .page import MAX_MB, Page, budget, fitted
+from .plan import PagePlan
 from .text import axis_title, escape, plain, unit_plain, value_text
 
 SHOW_JS = widgets.READOUT_JS + "const i = cb_data.index.indices;\nif (i.length) show(readout, quads.data.text[i[0]]);"
@@ -50,15 +50,23 @@ def critical_page(ds: xr.Dataset, *, y: str | None = None, sel: dict[str, float]
         stretches = critical_stretches(rows, system, along, start, scan)
         return stretch_columns(frame, system, along, y, edges, stretches, undecided_gaps(rows), names, at), dot_columns(rows, y, edges)
 
-    first = read(plan.frames[0])
-    plan = thin(plan, dict(ds.sizes), budget(max_mb) // max(1, columns_bytes(first)), f"the page's size bound, max_mb = {max_mb:g}")
-    frames = []
-    for n, at in enumerate(plan.frames):
-        frames.append(first if n == 0 and at == plan.frames[0] else read(at))
-        if progress is not None:
-            progress(n + 1, len(plan.frames))
-    layout = draw(ds, system, plan, edges, scan, names, frames)
-    return Page(layout, plain(ds.attrs.get("title", "") or "stabmap critical values"), plan.notes, sum(columns_bytes(f) for f in frames))
+    done: dict[tuple, tuple[dict, dict]] = {}
+
+    def frame(at: dict[str, int], total: int) -> tuple[dict, dict]:
+        key = tuple(sorted(at.items()))
+        if key not in done:
+            done[key] = read(at)
+            if progress is not None:
+                progress(len(done), total)
+        return done[key]
+
+    def make(plan: PagePlan) -> Page:
+        frames = [frame(at, len(plan.frames)) for at in plan.frames]
+        return Page(draw(ds, system, plan, edges, scan, names, frames), plain(ds.attrs.get("title", "") or "stabmap critical values"),
+                    plan.notes)
+
+    guess = budget(max_mb) // max(1, columns_bytes(frame(plan.frames[0], len(plan.frames))))
+    return fitted(plan, dict(ds.sizes), max_mb, guess, make)
 
 
 def scanned_names(ds: xr.Dataset, system, along: str) -> xr.Dataset:

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
+from ...store.dataset import edges
 from ..blocks import block_factors, reduce_blocks
 from ..plot.geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, cell_edges, touches_stability
 from ..plot.labels import log_axis
@@ -21,11 +22,13 @@ WIDEST = {"stability": 2.5, "classes": 1.0}  # [px] boundary widths between wide
 
 @dataclass(frozen=True)
 class Frame:
-    """One slider setting: every block's packed state (rows along y), the label's counts, and the boundary
-    segments as columns x0, y0, x1, y1, width [px] (float32), thick (stability) and thin (other classes)."""
+    """One slider setting: every block's packed state (rows along y), the label's counts, the rectangles of one
+    colour that draw the blocks (rows c0, c1, r0, r1, colour: block columns [c0, c1) and rows [r0, r1)), and the
+    boundary segments as columns x0, y0, x1, y1, width [px] (float32), thick (stability) and thin (other classes)."""
 
     keys: np.ndarray
     counts: dict[int, int]
+    rects: np.ndarray
     stability: np.ndarray
     classes: np.ndarray
 
@@ -44,24 +47,13 @@ class MapGrid:
     def shape(self) -> tuple[int, int]:
         return len(self.ye) - 1, len(self.xe) - 1
 
-    @property
-    def image(self) -> tuple[float, float, float, float] | None:
-        """(x, y, dw, dh) of one image of equal blocks that lays every block on its cells, or None when the blocks are
-        not equal in the axes' scales (an irregular list of values): then each block is drawn as its own quad.
 
-        A grid even in the scale of its axis (linear, or geometric on a log axis) has blocks of equal size there but
-        the last, which holds what is left; the image gives that one the common size too, beyond the grid's end,
-        where the map's range, which cannot be panned past, cuts it off."""
-        sizes = []
-        for e, log in ((self.xe, self.log[0]), (self.ye, self.log[1])):
-            s = np.log(e) if log else e
-            step = s[1] - s[0]
-            if not step > 0 or (len(s) > 2 and not np.allclose(np.diff(s[:-1]), step, rtol=1e-6, atol=0)):
-                return None
-            if not 0 < s[-1] - s[-2] <= step * (1 + 1e-6):
-                return None
-            sizes.append(np.exp(s[0] + step * (len(s) - 1)) - e[0] if log else step * (len(s) - 1))
-        return float(self.xe[0]), float(self.ye[0]), float(sizes[0]), float(sizes[1])
+def axis_edges(ds: xr.Dataset, dim: str) -> np.ndarray:
+    """The edges of the cells of axis ``dim`` as the atlas proves them (:func:`stabmap.store.dataset.edges`: midpoints,
+    the first and last grid values at the ends), so that a page colours exactly the cells its labels are proved on
+    and nothing beyond the scan. A one-value axis has a cell of width 0, drawn as a thin strip around its value."""
+    values = np.asarray(ds[dim], dtype=float)
+    return edges(values) if len(values) > 1 else cell_edges(values, "log" if log_axis(ds, dim) else None)
 
 
 def map_grid(ds: xr.Dataset, plan: PagePlan, pixels: tuple[int, int] = MAP_PIXELS) -> MapGrid:
@@ -69,10 +61,29 @@ def map_grid(ds: xr.Dataset, plan: PagePlan, pixels: tuple[int, int] = MAP_PIXEL
     shape = (ds.sizes[plan.y] if plan.y else 1, ds.sizes[plan.x])
     factors = block_factors(shape, pixels if plan.y else (1, pixels[1]))
     log = (log_axis(ds, plan.x), plan.y is not None and log_axis(ds, plan.y))
-    xe = block_edges(cell_edges(np.asarray(ds[plan.x], dtype=float), "log" if log[0] else None), factors[1])
-    ye = (block_edges(cell_edges(np.asarray(ds[plan.y], dtype=float), "log" if log[1] else None), factors[0]) if plan.y
-          else np.array([0.0, 1.0]))
+    xe = block_edges(axis_edges(ds, plan.x), factors[1])
+    ye = block_edges(axis_edges(ds, plan.y), factors[0]) if plan.y else np.array([0.0, 1.0])
     return MapGrid(factors, xe, ye, log)
+
+
+def colour_rectangles(colours: np.ndarray) -> np.ndarray:
+    """The blocks of a map (``colours``: colour id per block, rows along y) as few rectangles of one colour, rows
+    (c0, c1, r0, r1, colour): the runs of one colour along each row, merged with identical runs of the rows above.
+    Drawn as one quad each, neighbouring blocks of one colour show no seam between them."""
+    ny, nx = colours.shape
+    done: list[tuple[int, int, int, int, int]] = []
+    open_: dict[tuple[int, int, int], int] = {}  # (c0, c1, colour) of a run open since row r0
+    for r in range(ny):
+        row = colours[r]
+        cuts = np.flatnonzero(row[1:] != row[:-1]) + 1
+        now = {}
+        for a, b in zip(np.r_[0, cuts], np.r_[cuts, nx], strict=True):
+            key = (int(a), int(b), int(row[a]))
+            now[key] = open_.pop(key, r)
+        done.extend((a, b, r0, r, c) for (a, b, c), r0 in open_.items())
+        open_ = now
+    done.extend((a, b, r0, ny, c) for (a, b, c), r0 in open_.items())
+    return np.array(done, dtype=np.int32).reshape(-1, 5)
 
 
 def frame_map(da: xr.DataArray, plan: PagePlan, at: dict[str, int]):
@@ -94,12 +105,13 @@ def read_frame(label: xr.DataArray, bits: xr.DataArray | None, plan: PagePlan, a
     stable = legend.system.stable_label
     blocks = reduce_blocks(frame_map(label, plan, at), None if bits is None else frame_map(bits, plan, at), stable, grid.factors)
     near = touches_stability(blocks, stable) if stable is not None else np.zeros(blocks.low.shape, dtype=bool)
-    keys = pack(blocks, block_colours(blocks, legend, near))
+    colours = block_colours(blocks, legend, near)
+    keys = pack(blocks, colours)
     codes, state = block_classes(blocks, stable)
     stab, other = cell_edge_boundaries(codes, grid.xe, grid.ye, stable, state=state)
     if len(stab):
         legend.drawn.add("stability")
     if len(other):
         legend.drawn.add("classes")
-    return Frame(keys, dict(blocks.counts), segments_table(stab, grid, codes, WIDEST["stability"], pixels),
+    return Frame(keys, dict(blocks.counts), colour_rectangles(colours), segments_table(stab, grid, codes, WIDEST["stability"], pixels),
                  segments_table(other, grid, codes, WIDEST["classes"], pixels))

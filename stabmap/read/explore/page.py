@@ -4,11 +4,13 @@ inline in Jupyter, and what its making left out (``notes``)."""
 from __future__ import annotations
 
 import html
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...errors import StabmapError, param
 from ...store.files import check_writable
+from .plan import PagePlan, thin
 
 BASE_BYTES = 1_700_000  # BokehJS inlined (bokeh 3.x: about 1.7 MB), the layout and its texts: every page's floor
 MAX_MB = 20.0  # the default bound of a page's size
@@ -16,20 +18,26 @@ MAX_MB = 20.0  # the default bound of a page's size
 
 @dataclass
 class Page:
-    """An interactive page: the bokeh ``layout``, its ``title``, the ``notes`` on what was left out, and the bytes
-    its frames' data take (``data_bytes``, before base64)."""
+    """An interactive page: the bokeh ``layout``, its ``title`` and the ``notes`` on what was left out."""
 
     layout: object
     title: str
     notes: tuple[str, ...] = ()
-    data_bytes: int = 0
+    _html: str | None = field(default=None, repr=False)
 
     def html(self) -> str:
-        """The page as one HTML document, scripts inlined."""
+        """The page as one HTML document, scripts inlined (made once)."""
         from bokeh.embed import file_html
         from bokeh.resources import INLINE
 
-        return file_html(self.layout, resources=INLINE, title=self.title)
+        if self._html is None:
+            self._html = file_html(self.layout, resources=INLINE, title=self.title)
+        return self._html
+
+    @property
+    def size(self) -> int:
+        """The page's bytes as a file (UTF-8)."""
+        return len(self.html().encode())
 
     def save(self, path: str | Path) -> Path:
         """Write the page atomically (a temporary file renamed into place); returns the path."""
@@ -46,6 +54,24 @@ class Page:
         # An iframe of the whole page: it runs its own BokehJS, so nothing has to be loaded into the notebook first.
         return (f'<iframe srcdoc="{html.escape(self.html(), quote=True)}" style="width: 100%; height: 900px; border: none" '
                 f'title="{html.escape(self.title, quote=True)}"></iframe>')
+
+
+def fitted(full: PagePlan, sizes: dict, max_mb: float, guess: int, make: Callable[[PagePlan], Page]) -> Page:
+    """The page ``make`` draws of ``full`` with as many slider settings as keep it under ``max_mb`` MB, measured on the
+    page itself: first ``guess`` settings, then fewer in proportion while it is too big (evenly spaced values kept;
+    the note says so, once). A page that is too big with one setting is an error."""
+    why = f"the page's size bound, {param('max_mb')} {max_mb:g}; a value left out can be chosen with {param('sel')}"
+    allowed = max(1, guess)
+    while True:
+        plan = thin(full, sizes, allowed, why)
+        page = make(plan)
+        if page.size <= max_mb * 1e6:
+            return page
+        if len(plan.frames) == 1:
+            raise StabmapError(f"one map of this file makes a page of {page.size / 1e6:.1f} MB, over {param('max_mb')} {max_mb:g}; "
+                               "give a larger one")
+        n = len(plan.frames)
+        allowed = max(1, min(n - 1, int(n * (max_mb * 1e6 - BASE_BYTES) / max(1.0, page.size - BASE_BYTES) * 0.95)))
 
 
 def check_page_path(path: str | Path) -> Path:

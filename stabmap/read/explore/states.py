@@ -29,16 +29,29 @@ CELL_TEXT = {
 def point_bits(ds: xr.Dataset, system) -> xr.DataArray | None:
     """Per grid point, lazily: bit p set for the p-th meaning of the system's provenance flag (``decided_by``), bit
     CELL_SHIFT + q for the q-th meaning of ``cell``; None for an atlas with neither variable. ORed over a block,
-    the bits say every way its points were decided and every kind of cell it holds."""
+    the bits say every way its points were decided and every kind of cell it holds.
+
+    One table look-up a variable (a value outside its flags gets no bit), so a lazy atlas's graph stays two
+    operations deep however many meanings the flags have."""
     bits = None
     for name, var, shift in ((system.provenance, system.variable(system.provenance) if system.provenance else None, 0),
                              (CELL.name, CELL, CELL_SHIFT)):
         if var is None or name not in ds:
             continue
-        for p, (value, _) in enumerate(var.flags):
-            term = (ds[name] == value).astype(np.int32) * np.int32(1 << (shift + p))
-            bits = term if bits is None else bits | term
+        values = np.array([v for v, _ in var.flags], dtype=np.int64)
+        order = np.argsort(values)
+        table = (np.int32(1) << (shift + np.arange(len(values), dtype=np.int32)))[order]
+        term = xr.apply_ufunc(_look_up, ds[name], kwargs={"values": values[order], "table": table}, dask="parallelized",
+                              output_dtypes=[np.int32])
+        bits = term if bits is None else bits | term
     return bits
+
+
+def _look_up(a: np.ndarray, *, values: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """``table[i]`` where ``a == values[i]`` (``values`` sorted), 0 elsewhere."""
+    a = np.asarray(a, dtype=np.int64)
+    i = np.clip(np.searchsorted(values, a), 0, len(values) - 1)
+    return np.where(values[i] == a, table[i], np.int32(0)).astype(np.int32)
 
 
 class Legend:
