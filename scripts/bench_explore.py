@@ -31,6 +31,7 @@ import argparse
 import math
 import os
 import platform
+import resource
 import shutil
 import statistics
 import subprocess
@@ -220,20 +221,24 @@ def model_bytes(counts: dict) -> float:
     return BASE_MB * 1e6 + sum(b + 20 * s for b, s in zip(counts["blocks"], counts["segments"], strict=True)) * 4 / 3
 
 
-def cli_runs(atlas: Path, out: Path, runs: int, max_mb: float | None) -> tuple[list[float], list[str]]:
-    """Seconds of ``python -m stabmap plot atlas -o out`` in fresh processes, and the notes the last run printed."""
+def cli_runs(atlas: Path, out: Path, runs: int, max_mb: float | None) -> tuple[list[float], list[float], list[str]]:
+    """Wall-clock and CPU seconds of ``python -m stabmap plot atlas -o out`` in fresh processes, and the notes the
+    last run printed."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
     command = [sys.executable, "-m", "stabmap", "plot", str(atlas), "-o", str(out), "--overwrite"]
     command += [] if max_mb is None else ["--max-mb", f"{max_mb:g}"]
-    seconds, text = [], ""
+    seconds, cpu, text = [], [], ""
     for _ in range(runs):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
         res = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
         seconds.append(time.perf_counter() - t0)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
         if res.returncode:
             raise RuntimeError(f"{' '.join(command)} failed: {res.stdout}{res.stderr}")
         text = res.stdout + res.stderr
-    return seconds, [line for line in text.splitlines() if line.startswith("note:")]
+    return seconds, cpu, [line for line in text.splitlines() if line.startswith("note:")]
 
 
 def in_process(atlas: Path, out: Path, runs: int, max_mb: float | None, lazy: bool = True) -> dict:
@@ -242,20 +247,21 @@ def in_process(atlas: Path, out: Path, runs: int, max_mb: float | None, lazy: bo
     from stabmap import open_atlas
     from stabmap.read.explore import MAX_MB, atlas_page
 
-    make, save = [], []
+    make, save, cpu = [], [], []
     for _ in range(runs):
         ds = open_atlas(atlas, lazy=lazy)
         try:
-            t0 = time.perf_counter()
+            c0, t0 = time.process_time(), time.perf_counter()
             page = atlas_page(ds, max_mb=MAX_MB if max_mb is None else max_mb)
             t1 = time.perf_counter()
             page.save(out)
-            t2 = time.perf_counter()
+            c2, t2 = time.process_time(), time.perf_counter()
         finally:
             ds.close()
         make.append(t1 - t0)
         save.append(t2 - t1)
-    return {"make_s": statistics.median(make), "save_s": statistics.median(save), "page": page}
+        cpu.append(c2 - c0)
+    return {"make_s": statistics.median(make), "save_s": statistics.median(save), "cpu_s": statistics.median(cpu), "page": page}
 
 
 def open_times(paths: list[Path], runs: int) -> list[float | None]:
@@ -288,6 +294,15 @@ def open_times(paths: list[Path], runs: int) -> list[float | None]:
         return [None] * len(paths)
 
 
+def empty_page_bytes() -> int:
+    """Bytes of a bokeh page of one empty Div, scripts inlined as stabmap's pages inline them: every page's floor."""
+    from bokeh.embed import file_html
+    from bokeh.models import Div
+    from bokeh.resources import INLINE
+
+    return len(file_html(Div(text=""), resources=INLINE, title="").encode("utf-8"))
+
+
 def machine() -> dict:
     """What the numbers were measured on."""
     import bokeh
@@ -295,7 +310,9 @@ def machine() -> dict:
     cpu = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines() if line.startswith("model name")),
                platform.processor() or platform.machine()) if Path("/proc/cpuinfo").exists() else platform.machine()
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    return {"cores": cores, "cpu": cpu, "python": platform.python_version(), "bokeh": bokeh.__version__, "date": time.strftime("%Y-%m-%d")}
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")  # other work on the machine moves the times
+    return {"cores": cores, "cpu": cpu, "python": platform.python_version(), "bokeh": bokeh.__version__, "date": time.strftime("%Y-%m-%d"),
+            "load": load}
 
 
 # ---------------------------------------------------------------------------------------------------- the run
@@ -315,6 +332,8 @@ def main(argv: list[str] | None = None) -> dict:
     work = Path(args.dir) if args.dir else Path(tempfile.mkdtemp(prefix="stabmap-explore-"))
     work.mkdir(parents=True, exist_ok=True)
     rows, templates, atlases = [], {}, {}
+    floor = empty_page_bytes()
+    load_start = machine()["load"]
     try:
         for name, points, max_mb in cases:
             dims = tuple(points)
@@ -333,16 +352,17 @@ def main(argv: list[str] | None = None) -> dict:
             timed = in_process(atlas, py_page, runs, max_mb)
             loaded = in_process(atlas, py_page, runs, max_mb, lazy=False)  # the same page, the atlas read into memory first
             counts = page_counts(timed["page"])
-            seconds, cli_notes = cli_runs(atlas, cli_page, runs, max_mb)
+            seconds, cpu, cli_notes = cli_runs(atlas, cli_page, runs, max_mb)
             size = cli_page.stat().st_size
             frames_all = math.prod(n for d, n in points.items() if d not in ("omega", "c_1"))
             row = {"atlas": name, "points": math.prod(points.values()), "max_mb": max_mb, "nc_mb": atlas.stat().st_size / 1e6,
                    "frames": counts["frames"], "frames_all": frames_all, "blocks": statistics.mean(counts["blocks"]),
                    "segments": statistics.mean(counts["segments"]), "page_mb": size / 1e6, "py_page_mb": py_page.stat().st_size / 1e6,
                    "model_mb": model_bytes(counts) / 1e6, "data_mb": timed["page"].data_bytes / 1e6,
-                   "plot_s": statistics.median(seconds), "plot_runs": seconds, "make_s": timed["make_s"], "save_s": timed["save_s"],
-                   "make_memory_s": loaded["make_s"],
+                   "plot_s": statistics.median(seconds), "plot_runs": seconds, "plot_cpu_s": statistics.median(cpu),
+                   "make_s": timed["make_s"], "save_s": timed["save_s"], "inproc_cpu_s": timed["cpu_s"], "make_memory_s": loaded["make_s"],
                    "notes": list(timed["page"].notes), "cli_notes": cli_notes, "page": str(cli_page), "open_s": None}
+            row["beyond_kb"] = (size - floor) / 1e3
             row["model_err_pct"] = 100 * (row["page_mb"] - row["model_mb"]) / row["model_mb"]
             rows.append(row)
             print(f"{name:>16} max_mb {max_mb or 'default':>7}: {row['page_mb']:6.2f} MB (model {row['model_mb']:6.2f}), {row['frames']} frames "
@@ -353,31 +373,35 @@ def main(argv: list[str] | None = None) -> dict:
             for row, seconds in zip(rows, open_times([Path(r["page"]) for r in rows], runs), strict=True):
                 row["open_s"] = seconds
         info = machine()
+        info["load"] = f"{load_start:.1f} at the start, {info['load']:.1f} at the end"
         command = "python scripts/bench_explore.py" + (" --quick" if args.quick else "") + (f" --runs {args.runs}" if args.runs else "")
-        print(table(rows, info, command, runs))
-        return {"rows": rows, "machine": info, "command": command, "dir": str(work)}
+        print(table(rows, info, command, runs, floor))
+        return {"rows": rows, "machine": info, "command": command, "dir": str(work), "empty_page_mb": floor / 1e6}
     finally:
         if args.dir is None:
             shutil.rmtree(work, ignore_errors=True)
 
 
-def table(rows: list[dict], info: dict, command: str, runs: int) -> str:
-    """The markdown table of ``rows``, the command and the machine."""
+def table(rows: list[dict], info: dict, command: str, runs: int, floor: int) -> str:
+    """The markdown table of ``rows``, the command and the machine; ``floor``: bytes of an empty bokeh page."""
     lines = [f"\nCommand: `{command}`. Machine: {info['cores']} cores ({info['cpu']}), Python {info['python']}, bokeh {info['bokeh']}, "
-             f"{info['date']}; median of {runs} run{'s' if runs > 1 else ''}.", "",
+             f"{info['date']}; load average (1 min) {info['load']}; median of {runs} run{'s' if runs > 1 else ''}.", "",
              "| atlas | grid points | max_mb | frames (kept of all) | blocks a frame | boundary segments a frame | .nc MB | page MB "
-             "| model MB (page − model) | `stabmap plot` s | make + save s (in process) "
+             "| beyond an empty page, kB | model MB (page − model) | `stabmap plot` s (CPU s) | make + save s (CPU s), in process "
              "| make s, atlas in memory | open in Chromium s |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         opened = "–" if r["open_s"] is None else f"{r['open_s']:.2f}"
         bound = "20 (default)" if r["max_mb"] is None else f"{r['max_mb']:g}"
         lines.append(f"| {r['atlas']} | {r['points']:,} | {bound} | "
-                     f"{r['frames']} of {r['frames_all']} | {r['blocks']:,.0f} | {r['segments']:,.0f} | {r['nc_mb']:.2f} | {r['page_mb']:.2f} | "
-                     f"{r['model_mb']:.2f} ({r['model_err_pct']:+.1f} %) | {r['plot_s']:.2f} | {r['make_s']:.2f} + {r['save_s']:.2f} | "
+                     f"{r['frames']} of {r['frames_all']} | {r['blocks']:,.0f} | {r['segments']:,.0f} | {r['nc_mb']:.2f} | "
+                     f"{r['page_mb']:.2f} | {r['beyond_kb']:,.0f} | "
+                     f"{r['model_mb']:.2f} ({r['model_err_pct']:+.1f} %) | {r['plot_s']:.2f} ({r['plot_cpu_s']:.2f}) | "
+                     f"{r['make_s']:.2f} + {r['save_s']:.2f} ({r['inproc_cpu_s']:.2f}) | "
                      f"{r['make_memory_s']:.2f} | {opened} |")
-    notes = sorted({n for r in rows for n in r["cli_notes"]})
-    lines += ["", *(f"`stabmap plot` printed: {n}" for n in notes)]
+    notes = list(dict.fromkeys(n for r in rows for n in r["cli_notes"]))
+    lines += ["", f"An empty bokeh page (one Div, BokehJS inlined) is {floor / 1e6:.3f} MB.",
+              *(f"`stabmap plot` printed: {n}" for n in notes)]
     return "\n".join(lines)
 
 
