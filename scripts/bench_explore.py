@@ -1,7 +1,7 @@
 """Interactive pages: the size of ``stabmap plot atlas.nc -o atlas.html`` and the time to write and to open it, for
 100², 1000² and 100² × 10 × 10 atlases, and a page thinned by a small ``--max-mb``.
 
-    python scripts/bench_explore.py                 # the three atlases, a thinned page, a page of many small frames (~10 min)
+    python scripts/bench_explore.py                 # the three atlases, a thinned page, a page of many small frames (3 minutes)
     python scripts/bench_explore.py --quick         # tiny shapes, seconds; run once by the test suite
     python scripts/bench_explore.py --no-browser    # without the time to open the pages in headless Chromium
 
