@@ -198,27 +198,32 @@ def synthetic_atlas(points: dict[str, int], real: xr.Dataset) -> xr.Dataset:
 
 # ---------------------------------------------------------------------------------------------------- measuring
 def page_counts(page) -> dict:
-    """Frames, blocks per frame and boundary segments per frame, counted in the page's own bokeh models."""
+    """Frames, and per frame the blocks, the rectangles that draw them and the boundary segments, counted in the
+    page's own bokeh models."""
     from bokeh.models import ColumnDataSource, CustomJS, Slider
 
     refs = page.layout.references()
     frames = math.prod(1 if s.disabled else int(s.end - s.start) + 1 for s in refs if isinstance(s, Slider))
-    swaps = [m for m in refs if isinstance(m, CustomJS) and "segs" in m.args]
-    if swaps:
-        blocks = [len(a) for a in swaps[0].args["states"]]
-        segments = [sum(len(cols["x0"]) for cols in pair) for pair in swaps[0].args["segs"]]
+    swaps = [m for m in refs if isinstance(m, CustomJS) and "frames" in m.args]
+    if swaps:  # each frame: its rectangles, its blocks' states, its two tables of boundary segments
+        table = swaps[0].args["frames"]
+        blocks = [len(f[1]) for f in table]
+        rects = [len(f[0]["c0"]) for f in table]
+        segments = [len(f[2]["x0"]) + len(f[3]["x0"]) for f in table]
     else:
         sources = [m for m in refs if isinstance(m, ColumnDataSource)]
         blocks = [len(s.data["state"]) for s in sources if "state" in s.data]
+        rects = [len(s.data["c0"]) for s in sources if "c0" in s.data]
         segments = [sum(len(s.data["x0"]) for s in sources if "x0" in s.data)]
-    if not (len(blocks) == len(segments) == frames):
+    if not (len(blocks) == len(rects) == len(segments) == frames):
         raise AssertionError(f"the page holds {len(blocks)} block arrays and {len(segments)} segment tables for {frames} frames")
-    return {"frames": frames, "blocks": blocks, "segments": segments}
+    return {"frames": frames, "blocks": blocks, "rects": rects, "segments": segments}
 
 
 def model_bytes(counts: dict) -> float:
-    """The size model: 1.7 MB + every frame's blocks (a byte each) and segments (20 B each), base64 (4/3)."""
-    return BASE_MB * 1e6 + sum(b + 20 * s for b, s in zip(counts["blocks"], counts["segments"], strict=True)) * 4 / 3
+    """The size model of docs/explore.md, before bokeh's compression: 1.7 MB + every frame's blocks (a byte each),
+    rectangles (9 B each) and segments (20 B each), base64 (4/3)."""
+    return BASE_MB * 1e6 + sum(b + 9 * r + 20 * s for b, r, s in zip(counts["blocks"], counts["rects"], counts["segments"], strict=True)) * 4 / 3
 
 
 def cli_runs(atlas: Path, out: Path, runs: int, max_mb: float | None) -> tuple[list[float], list[float], list[str]]:
@@ -358,7 +363,7 @@ def main(argv: list[str] | None = None) -> dict:
             row = {"atlas": name, "points": math.prod(points.values()), "max_mb": max_mb, "nc_mb": atlas.stat().st_size / 1e6,
                    "frames": counts["frames"], "frames_all": frames_all, "blocks": statistics.mean(counts["blocks"]),
                    "segments": statistics.mean(counts["segments"]), "page_mb": size / 1e6, "py_page_mb": py_page.stat().st_size / 1e6,
-                   "model_mb": model_bytes(counts) / 1e6, "data_mb": timed["page"].data_bytes / 1e6,
+                   "model_mb": model_bytes(counts) / 1e6,
                    "plot_s": statistics.median(seconds), "plot_runs": seconds, "plot_cpu_s": statistics.median(cpu),
                    "make_s": timed["make_s"], "save_s": timed["save_s"], "inproc_cpu_s": timed["cpu_s"], "make_memory_s": loaded["make_s"],
                    "notes": list(timed["page"].notes), "cli_notes": cli_notes, "page": str(cli_page), "open_s": None}

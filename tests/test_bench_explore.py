@@ -95,15 +95,14 @@ def test_bench_explore_quick(bench, tmp_path, capsys):
         assert page.is_file() and page.stat().st_size / 1e6 == pytest.approx(r["page_mb"])
         assert pathlib.Path(r["page"].replace(".html", "-py.html")).is_file()
         assert 1.6 < r["page_mb"] <= (20 if r["max_mb"] is None else r["max_mb"])  # BokehJS inlined, within the bound
-        # the model counted in the page's models agrees with what the page says its frames take
-        assert r["model_mb"] == pytest.approx(1.7 + r["data_mb"] * 4 / 3, abs=1e-9)
+        assert r["page_mb"] <= r["model_mb"] * 1.05  # bokeh compresses its arrays: the model is an upper estimate
         assert r["segments"] > 0  # Maievskii's boundary crosses every map
     # omega's 1300 values in blocks of 3 (no block under a pixel of the 600 px wide map), c's 20 one each
     assert rows[0]["blocks"] == math.ceil(1300 / 3) * 20 and rows[0]["frames"] == 1
     assert rows[1]["blocks"] == 60 * 40 and rows[1]["frames"] == rows[1]["frames_all"] == 64 and not rows[1]["notes"]
     thinned = rows[2]
     assert thinned["frames"] < thinned["frames_all"] == 64
-    assert thinned["notes"] and all("max_mb = 1.8" in n for n in thinned["notes"])
-    assert thinned["cli_notes"] == [f"note: {n}" for n in thinned["notes"]]
+    assert thinned["notes"] and all("max_mb=1.8" in n for n in thinned["notes"])  # in Python's spelling; the CLI's:
+    assert thinned["cli_notes"] == [f"note: {n.replace('max_mb=1.8', '--max-mb 1.8').replace('with sel', 'with --sel')}" for n in thinned["notes"]]
     printed = capsys.readouterr().out
     assert "| atlas | grid points |" in printed and "note: m_1:" in printed

@@ -176,7 +176,7 @@ def test_a_page_over_its_bound_leaves_slider_values_out(two_tops_atlas, monkeypa
     monkeypatch.setattr(page_module, "frame_bytes", lambda frame: 1)
     monkeypatch.setattr(page_module, "budget", lambda max_mb: 3)  # room for three frames
     page = atlas_page(ds, max_mb=5)
-    assert page.notes and "K_1: 3 of 5 values on its slider, evenly spaced" in page.notes[0] and "max_mb 5" in page.notes[0]
+    assert page.notes and "K_1: 3 of 5 values on its slider, evenly spaced" in page.notes[0] and "max_mb=5" in page.notes[0]
     (slider,) = models(page, "Slider")
     assert slider.end == 2
 

@@ -9,9 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from ...store.dataset import edges
 from ..blocks import block_factors, reduce_blocks
-from ..plot.geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, cell_edges, touches_stability
+from ..plot.geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges, touches_stability
 from ..plot.labels import log_axis
 from .plan import PagePlan
 from .states import Legend, block_colours, pack
@@ -48,21 +47,13 @@ class MapGrid:
         return len(self.ye) - 1, len(self.xe) - 1
 
 
-def axis_edges(ds: xr.Dataset, dim: str) -> np.ndarray:
-    """The edges of the cells of axis ``dim`` as the atlas proves them (:func:`stabmap.store.dataset.edges`: midpoints,
-    the first and last grid values at the ends), so that a page colours exactly the cells its labels are proved on
-    and nothing beyond the scan. A one-value axis has a cell of width 0, drawn as a thin strip around its value."""
-    values = np.asarray(ds[dim], dtype=float)
-    return edges(values) if len(values) > 1 else cell_edges(values, "log" if log_axis(ds, dim) else None)
-
-
 def map_grid(ds: xr.Dataset, plan: PagePlan, pixels: tuple[int, int] = MAP_PIXELS) -> MapGrid:
     """Blocks of the drawn axes no smaller than a pixel of a map ``pixels`` (y, x) in size, and their edges."""
     shape = (ds.sizes[plan.y] if plan.y else 1, ds.sizes[plan.x])
     factors = block_factors(shape, pixels if plan.y else (1, pixels[1]))
     log = (log_axis(ds, plan.x), plan.y is not None and log_axis(ds, plan.y))
-    xe = block_edges(axis_edges(ds, plan.x), factors[1])
-    ye = block_edges(axis_edges(ds, plan.y), factors[0]) if plan.y else np.array([0.0, 1.0])
+    xe = block_edges(proved_cell_edges(np.asarray(ds[plan.x], dtype=float), log[0]), factors[1])
+    ye = block_edges(proved_cell_edges(np.asarray(ds[plan.y], dtype=float), log[1]), factors[0]) if plan.y else np.array([0.0, 1.0])
     return MapGrid(factors, xe, ye, log)
 
 

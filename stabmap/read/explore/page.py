@@ -8,7 +8,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ...errors import StabmapError, param
+from ...errors import StabmapError, given, param
 from ...store.files import check_writable
 from .plan import PagePlan, thin
 
@@ -60,7 +60,7 @@ def fitted(full: PagePlan, sizes: dict, max_mb: float, guess: int, make: Callabl
     """The page ``make`` draws of ``full`` with as many slider settings as keep it under ``max_mb`` MB, measured on the
     page itself: first ``guess`` settings, then fewer in proportion while it is too big (evenly spaced values kept;
     the note says so, once). A page that is too big with one setting is an error."""
-    why = f"the page's size bound, {param('max_mb')} {max_mb:g}; a value left out can be chosen with {param('sel')}"
+    why = f"the page's size bound, {given('max_mb', max_mb)}; a value left out can be chosen with {param('sel')}"
     allowed = max(1, guess)
     while True:
         plan = thin(full, sizes, allowed, why)

@@ -13,7 +13,7 @@ import xarray as xr
 from ... import systems
 from ..areas import AreaShares
 from .captions import atlas_title, captioned_figure
-from .geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, cell_edges, touches_stability
+from .geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges, touches_stability
 from .labels import axis_label, display_ticks, log_axis, log_ticks, value_text
 from .layout import LEGEND_WIDTH, MAX_PANELS, FigurePlan, figure_size, panel_grid, panel_points, plan_figure
 from .paint import fill_classes, hatch_cells, paint_cells
@@ -111,10 +111,10 @@ def atlas_figure(
 
 
 def map_edges(ds: xr.Dataset, plan: FigurePlan, factors: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
-    """The edges of the drawn cells along x and y: grid cells (geometric on a log axis), merged into blocks of
+    """The edges of the drawn cells along x and y: the cells the atlas proves its labels on, merged into blocks of
     ``factors`` (y, x); a strip's y runs from 0 to 1."""
-    xe = cell_edges(np.asarray(ds[plan.x], dtype=float), "log" if log_axis(ds, plan.x) else None)
-    ye = cell_edges(np.asarray(ds[plan.y], dtype=float), "log" if log_axis(ds, plan.y) else None) if plan.y else np.array([0.0, 1.0])
+    xe = proved_cell_edges(np.asarray(ds[plan.x], dtype=float), log_axis(ds, plan.x))
+    ye = proved_cell_edges(np.asarray(ds[plan.y], dtype=float), log_axis(ds, plan.y)) if plan.y else np.array([0.0, 1.0])
     return block_edges(xe, factors[1]), block_edges(ye, factors[0]) if plan.y else ye
 
 

@@ -1,8 +1,8 @@
 """Cell geometry of a map: the edges of grid cells, runs and rectangles of marked cells, the boundary segments on
 cell edges between differing neighbours and their widths, and the same for blocks of cells of a reduced map.
 
-Cell edges are the midpoints between grid values (geometric midpoints on a log axis), so everything here follows
-log and irregular (``values``) grids. Nothing here draws.
+Maps draw the cells an atlas proves its labels on (:func:`proved_cell_edges`: midpoints, the scan's ends); everything
+here follows log and irregular (``values``) grids. Nothing here draws.
 """
 
 from __future__ import annotations
@@ -25,6 +25,16 @@ def cell_edges(centres: np.ndarray, scale: str | None) -> np.ndarray:
         return np.exp(np.concatenate([[2 * lc[0] - mid[0]], mid, [2 * lc[-1] - mid[-1]]]))
     mid = (centres[1:] + centres[:-1]) / 2
     return np.concatenate([[2 * centres[0] - mid[0]], mid, [2 * centres[-1] - mid[-1]]])
+
+
+def proved_cell_edges(centres: np.ndarray, log: bool) -> np.ndarray:
+    """The edges of the cells an atlas proves its labels on (:func:`stabmap.store.dataset.edges`, its CF bounds):
+    midpoints, on a log axis too, and the first and last grid values at the ends, so that a map colours nothing
+    beyond the scan. A one-value axis has a cell of width 0: it is drawn as :func:`cell_edges` draws it, a strip."""
+    from ...store.dataset import edges
+
+    centres = np.asarray(centres, dtype=float)
+    return edges(centres) if len(centres) > 1 else cell_edges(centres, "log" if log else None)
 
 
 def runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
