@@ -25,30 +25,8 @@ import stabmap
 from stabmap.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
-# The two tops of tests/scenes.py, on a grid fine enough for a picture (2,400 points; about ten seconds on 2 cores).
-SCENE = """
-title = "two tops on a fixed point, elastic joint"
-support = "fixed"
-g = 9.81
-omega = 50.0
-joints = [20.0]
-
-[[bodies]]
-m = 1.0
-A = 0.02
-C = 0.03
-c = 0.10
-s = 0.25
-fluid = { E = [1e-3], kappa = [1.31] }
-
-[[bodies]]
-m = 0.5
-A = 0.01
-C = 0.015
-c = 0.08
-omega = 45.0
-
-[grid]
+# The two tops of tests/scenes.py on a grid fine enough for a picture (2,400 points; about ten seconds on 2 cores).
+GRID = """[grid]
 omega = { start = 1.0, stop = 150.0, num = 40 }
 m_2 = { start = 0.1, stop = 5.0, num = 20, scale = "log" }
 K_1 = { values = [5.0, 20.0, 60.0] }
@@ -58,12 +36,24 @@ MARGIN = 12  # [px] of white kept around the page's content
 MAX_BYTES = 250_000
 
 
-def load_browser():
-    """tests/browser.py, imported by its path (it is a library of the tests, not a package module)."""
-    spec = importlib.util.spec_from_file_location("browser", ROOT / "tests" / "browser.py")
+def load_test_module(name: str):
+    """tests/NAME.py, imported by its path (a library of the tests, not a package module)."""
+    spec = importlib.util.spec_from_file_location(name, ROOT / "tests" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def load_browser():
+    """tests/browser.py: headless Chromium."""
+    return load_test_module("browser")
+
+
+def scene_text() -> str:
+    """The two tops (tests/scenes.py, TWO_TOPS) with this script's grid and a title for the docs."""
+    tops = load_test_module("scenes").TWO_TOPS
+    tops = tops.replace('title = "two tops, small grid"', 'title = "two tops on a fixed point, elastic joint"')
+    return tops[: tops.index("[grid]")] + GRID
 
 
 def save_cropped(page, path: Path) -> Path:
@@ -94,7 +84,7 @@ def node(ds, dim: str, value: float) -> float:
 
 
 def atlas_figure(new_page, work: Path, out: Path) -> None:
-    ds = stabmap.compute_atlas(stabmap.loads_scene(SCENE), progress=False)
+    ds = stabmap.compute_atlas(stabmap.loads_scene(scene_text()), progress=False)
     stabmap.write_atlas(ds, work / "atlas.nc")
     main(["plot", str(work / "atlas.nc"), "-o", str(work / "atlas.html")])
     page = new_page().open(work / "atlas.html")
@@ -113,7 +103,7 @@ def scene_grid(scene) -> dict[str, np.ndarray]:
 
 
 def critical_figure(new_page, work: Path, out: Path) -> None:
-    scene = stabmap.loads_scene(SCENE.replace("num = 20", f"num = {CRITICAL_ROWS}"))
+    scene = stabmap.loads_scene(scene_text().replace("num = 20", f"num = {CRITICAL_ROWS}"))
     (work / "scene.toml").write_text(scene.to_toml(), encoding="utf-8")
     main(["critical", str(work / "scene.toml"), "-o", str(work / "critical.nc"), "-q"])
     main(["plot", str(work / "critical.nc"), "-o", str(work / "critical.html")])

@@ -12,16 +12,19 @@ the sliders keep evenly spaced values, and the page and ``notes`` say which.
 
 from __future__ import annotations
 
+import zlib
+
 import numpy as np
 import xarray as xr
 
 from ... import systems
 from ...errors import StabmapError
 from ...store.variables import CELL
+from ..blocks import compute
 from ..plot.captions import fixed_caption
 from ..plot.palette import BOUNDARY, CLASS_EDGE, system_colour
 from . import widgets
-from .frames import MAP_PIXELS, Frame, map_grid, read_frame
+from .frames import EAGER_POINTS, MAP_PIXELS, Frame, map_grid, read_frame
 from .page import MAX_MB, Page, budget, fitted
 from .plan import PagePlan, plan_page
 from .states import Legend, lighter, point_bits, state_text
@@ -84,6 +87,8 @@ def atlas_page(ds: xr.Dataset, *, x: str | None = None, y: str | None = None, se
     label = ds[system.label].isel(fix)
     bits = point_bits(ds, system)
     bits = None if bits is None else bits.isel(fix)
+    if label.size <= EAGER_POINTS:  # every frame at once: a few MB, each chunk of the file read once, not once a frame
+        label, bits = compute(label, bits)
     grid = map_grid(ds, full)
     legend = Legend(system, system.provenance in ds)
     frames: dict[tuple, Frame] = {}
@@ -106,8 +111,10 @@ def atlas_page(ds: xr.Dataset, *, x: str | None = None, y: str | None = None, se
 
 
 def frame_bytes(f: Frame) -> int:
-    """A first guess of the bytes a frame adds to a page: a state per block, its rectangles and boundary segments."""
-    return f.keys.size + 10 * len(f.rects) + 20 * (len(f.stability) + len(f.classes))
+    """A first guess of the bytes a frame adds to a page, as bokeh writes it: its block states, rectangles and
+    boundary segments compressed, in base64, and about 1.5 kB of wrapping and title."""
+    arrays = (f.keys.astype(np.uint16), f.rects.astype(np.uint16), f.stability, f.classes)
+    return 1500 + sum(len(zlib.compress(np.ascontiguousarray(a).tobytes())) for a in arrays) * 4 // 3
 
 
 def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: list[Frame]) -> object:

@@ -9,13 +9,14 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from ..blocks import block_factors, reduce_blocks
+from ..blocks import block_factors, compute, reduce_blocks
 from ..plot.geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges, touches_stability
 from ..plot.labels import log_axis
 from .plan import PagePlan
 from .states import Legend, block_colours, pack
 
 MAP_PIXELS = (450, 600)  # (y, x) pixels of the page's map: blocks are no smaller than one
+EAGER_POINTS = 4_000_000  # a frame's map of at most this many points is read at once (a few MB), a larger one chunk by chunk
 WIDEST = {"stability": 2.5, "classes": 1.0}  # [px] boundary widths between wide regions (narrower beside thin bands)
 
 
@@ -94,7 +95,10 @@ def read_frame(label: xr.DataArray, bits: xr.DataArray | None, plan: PagePlan, a
     """One frame: the map at slider setting ``at`` read once and reduced to ``grid``'s blocks, their states packed
     (colours registered in ``legend``), and the boundaries between blocks."""
     stable = legend.system.stable_label
-    blocks = reduce_blocks(frame_map(label, plan, at), None if bits is None else frame_map(bits, plan, at), stable, grid.factors)
+    values, flags = frame_map(label, plan, at), None if bits is None else frame_map(bits, plan, at)
+    if values.size <= EAGER_POINTS:  # one read of a small map, rather than a task graph for each of many small frames
+        values, flags = compute(values, flags)
+    blocks = reduce_blocks(values, flags, stable, grid.factors)
     near = touches_stability(blocks, stable) if stable is not None else np.zeros(blocks.low.shape, dtype=bool)
     colours = block_colours(blocks, legend, near)
     keys = pack(blocks, colours)

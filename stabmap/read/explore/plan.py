@@ -10,7 +10,7 @@ import numpy as np
 import xarray as xr
 
 from ...errors import StabmapError, param
-from ..plot.layout import check_roles, check_sel, evenly
+from ..plot.layout import check_roles, check_sel, evenly, nearest
 
 
 @dataclass(frozen=True)
@@ -49,13 +49,7 @@ def plan_page(ds: xr.Dataset, dims: list[str], *, x: str | None = None, y: str |
     x = x or rest.pop(0)
     if len(free) >= 2:
         y = y or rest.pop(0)
-    fixed, notes = {}, []
-    for k, v in sel.items():
-        values = np.asarray(ds[k], dtype=float)
-        fixed[k] = (int(np.argmin(np.abs(values - v))), float(v))
-        if not values.min() <= v <= values.max():
-            notes.append(f"{k} = {v:g} lies outside the grid ({values.min():g} .. {values.max():g}): shown at its nearest end, "
-                         f"{k} = {values[fixed[k][0]]:g}")
+    fixed, notes = nearest(ds, sel)
     return PagePlan(x, y, tuple(rest), {d: tuple(range(ds.sizes[d])) for d in rest}, fixed, tuple(notes))
 
 

@@ -101,6 +101,19 @@ def check_roles(dims: list[str], sel: dict, roles: list[tuple[str, str]]) -> Non
             raise StabmapError(f"{param(opt)} and {param(opt2)} both name {name}; give each axis one place in the figure")
 
 
+def nearest(ds: xr.Dataset, sel: dict) -> tuple[dict[str, tuple[int, float]], list[str]]:
+    """Each axis of ``sel`` at its grid value nearest to the one asked, as ``{name: (index, asked)}``, and a note for
+    each value asked outside the grid."""
+    fixed, notes = {}, []
+    for k, v in sel.items():
+        values = np.asarray(ds[k], dtype=float)
+        fixed[k] = (int(np.argmin(np.abs(values - v))), float(v))
+        if not values.min() <= v <= values.max():
+            notes.append(f"{k} = {v:g} lies outside the grid ({values.min():g} .. {values.max():g}{unit_suffix(ds[k].attrs.get('units'))}): "
+                         f"drawn at its nearest end, {k} = {values[fixed[k][0]]:g}")
+    return fixed, notes
+
+
 def plan_figure(
     ds: xr.Dataset,
     *,
@@ -140,14 +153,8 @@ def plan_figure(
         facet = facet or rest.pop(0)
     row = rest.pop(0) if len(free) >= 4 else None
 
-    fixed: dict[str, tuple[int, float | None]] = {}
-    notes = []
-    for k, v in sel.items():
-        values = np.asarray(ds[k], dtype=float)
-        fixed[k] = (int(np.argmin(np.abs(values - v))), float(v))
-        if not values.min() <= v <= values.max():
-            notes.append(f"{k} = {v:g} lies outside the grid ({values.min():g} .. {values.max():g}{unit_suffix(ds[k].attrs.get('units'))}): "
-                         f"drawn at its nearest end, {k} = {values[fixed[k][0]]:g}")
+    chosen, notes = nearest(ds, sel)
+    fixed: dict[str, tuple[int, float | None]] = dict(chosen)
     for d in rest:  # a figure shows at most four axes
         fixed[d] = (0, None)
         notes.append(f"{d} fixed at its first value (choose with {given('sel', VALUE, d)})")
