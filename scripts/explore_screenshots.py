@@ -37,7 +37,7 @@ MAX_BYTES = 250_000
 
 
 def load_test_module(name: str):
-    """tests/NAME.py, imported by its path (a library of the tests, not a package module)."""
+    """The module ``name`` of the tests folder, imported by its path (a library of the tests, not a package module)."""
     spec = importlib.util.spec_from_file_location(name, ROOT / "tests" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
