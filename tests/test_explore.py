@@ -6,7 +6,6 @@ tests/test_explore_browser.py opens the pages in Chromium and checks what a read
 from __future__ import annotations
 
 import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -201,7 +200,22 @@ def test_bad_options_are_errors_naming_the_parameter(two_tops_atlas, kw, message
 
 
 def run(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "stabmap", *args], cwd=cwd, capture_output=True, text=True)
+    """``stabmap ARGS`` in ``cwd``, in this process (``stabmap.cli.main``: the exit status and the messages a shell
+    sees, without starting Python again for each command)."""
+    import contextlib
+    import io
+    import os
+
+    from stabmap.cli import main
+
+    here, out, err = os.getcwd(), io.StringIO(), io.StringIO()
+    os.chdir(cwd)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            status = main(list(args))
+    finally:
+        os.chdir(here)
+    return subprocess.CompletedProcess(args, status, out.getvalue(), err.getvalue())
 
 
 def test_cli_writes_a_page_and_refuses_bad_options_without_a_file(two_tops_atlas, tmp_path):

@@ -10,12 +10,13 @@ import xarray as xr
 from ... import systems
 from ...errors import StabmapError, given
 from ..plot.captions import fixed_caption
-from ..plot.critical import critical_rows, critical_stretches, scanned_attrs, undecided_gaps
+from ..plot.critical import critical_rows, critical_stretches, gap_stretches, scanned_attrs
 from ..plot.geometry import cell_edges
-from ..plot.palette import UNDECIDED_COLOUR, system_colour
+from ..plot.palette import system_colour
 from . import widgets
 from .page import MAX_MB, Page, budget, fitted
 from .plan import PagePlan
+from .states import lighter
 from .text import axis_title, escape, plain, unit_plain, value_text
 
 SHOW_JS = widgets.READOUT_JS + "const i = cb_data.index.indices;\nif (i.length) show(readout, quads.data.text[i[0]]);"
@@ -48,7 +49,8 @@ def critical_page(ds: xr.Dataset, *, y: str | None = None, sel: dict[str, float]
         frame = picked.isel(at)
         rows, start = critical_rows(frame, system, along, [y] if y else [], {})
         stretches = critical_stretches(rows, system, along, start, scan)
-        return stretch_columns(frame, system, along, y, edges, stretches, undecided_gaps(rows), names, at), dot_columns(rows, y, edges)
+        gaps = gap_stretches(rows, system, along, start, scan)
+        return stretch_columns(frame, system, along, y, edges, stretches, gaps, names, at), dot_columns(rows, y, edges)
 
     done: dict[tuple, tuple[dict, dict]] = {}
 
@@ -77,28 +79,35 @@ def scanned_names(ds: xr.Dataset, system, along: str) -> xr.Dataset:
 
 def stretch_columns(frame: xr.Dataset, system, along: str, y: str | None, edges: np.ndarray, stretches: list[tuple],
                     undecided: list[tuple], names: xr.Dataset, at: dict[str, int]) -> dict:
-    """The stretches and the undecided gaps of one frame as quads: their box, colour and hover text."""
+    """The stretches and the undecided gaps (``undecided``: row, x0, x1, the class at both ends) of one frame as quads:
+    their box, colour (a gap's lighter) and hover text."""
     rows = [value_text(frame, y, float(v)) for v in np.asarray(frame[y])] if y else [""] * (len(edges) - 1)
-    cols: dict[str, list] = {"left": [], "right": [], "bottom": [], "top": [], "colour": [], "text": []}
+    cols: dict[str, list] = {"left": [], "right": [], "bottom": [], "top": [], "cls": [], "colour": [], "text": []}
     unit = unit_plain(names, along).strip()
+    symbol = plain(value_text(names, along, 0.0).split(" =")[0])
     where = [value_text(frame, d, float(frame[d])) for d in at]
     for r, x0, x1, c in stretches:
         cols["left"].append(x0)
         cols["right"].append(x1)
         cols["bottom"].append(edges[r])
         cols["top"].append(edges[r + 1])
+        cols["cls"].append(int(c))
         cols["colour"].append(system_colour(int(c), system))
         lines = [f"{plain(system.label_symbol)} = {c}: {system.class_name(int(c))}",
-                 f"{plain(value_text(names, along, 0.0).split(' =')[0])} from {x0:.10g} to {x1:.10g} {unit}".rstrip()]
+                 f"{symbol} from {x0:.10g} to {x1:.10g} {unit}".rstrip()]
         cols["text"].append("\n".join(t for t in [*lines, rows[r], *where] if t))
-    for r, lo, hi in undecided:
+    for r, lo, hi, c in undecided:
         cols["left"].append(lo)
         cols["right"].append(hi)
         cols["bottom"].append(edges[r])
         cols["top"].append(edges[r + 1])
-        cols["colour"].append(UNDECIDED_COLOUR)
-        cols["text"].append("\n".join(t for t in [f"undecided gap: {lo:.10g} to {hi:.10g} {unit}".rstrip(), rows[r], *where] if t))
-    return {k: np.asarray(v, dtype=float) if k in ("left", "right", "bottom", "top") else v for k, v in cols.items()}
+        cols["cls"].append(int(c))
+        cols["colour"].append(lighter(system_colour(int(c), system)))
+        lines = [f"undecided gap: {plain(system.label_symbol)} = {c} ({system.class_name(int(c))}) at both ends, not proved inside",
+                 f"{symbol} from {lo:.10g} to {hi:.10g} {unit}".rstrip()]
+        cols["text"].append("\n".join(t for t in [*lines, rows[r], *where] if t))
+    return {k: np.asarray(v, dtype=float) if k in ("left", "right", "bottom", "top") else np.asarray(v, dtype=np.int16) if k == "cls" else v
+            for k, v in cols.items()}
 
 
 def dot_columns(rows: xr.Dataset, y: str | None, edges: np.ndarray) -> dict:
@@ -151,11 +160,10 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, edges: np.ndarray, scan: list[f
     if controls:
         widgets.on_frame(controls, radix, "quads.data = frames[k][0];\ndots.data = frames[k][1];\ntitle.text = titles[k];",
                          quads=quads, dots=dots, frames=[list(f) for f in frames], title=title, titles=titles)
-    present = sorted({c for f in frames for c in f[0]["colour"]}, key=str)
-    classes = sorted({int(t.split(" = ")[1].split(":")[0]) for f in frames for t in f[0]["text"] if not t.startswith("undecided")})
+    classes = sorted({int(c) for f in frames for c in f[0]["cls"]})
     entries = [widgets.swatch(system_colour(c, system), system.class_name(c)) for c in classes]
-    if UNDECIDED_COLOUR in present:
-        entries.append(widgets.swatch(UNDECIDED_COLOUR, "undecided gap (no proof settled it)"))
+    if any(t.startswith("undecided gap") for f in frames for t in f[0]["text"]):
+        entries.append(widgets.swatch(lighter("#888888"), "lighter: an undecided gap, its class proved at its ends, not inside"))
     entries.append('<div style="margin:3px 0">&#9679;&nbsp; a change of ' + escape(plain(system.label_symbol)) + ", located</div>")
     side = widgets.legend(plain(system.label_title), entries)
     lines = [plain(fixed_caption(ds, 10_000)).replace("\u00a0", " "), *(f"note: {n}" for n in plan.notes),

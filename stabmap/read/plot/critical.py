@@ -12,7 +12,7 @@ from .captions import captioned_figure, fill_title
 from .geometry import cell_edges
 from .labels import axis_label, log_ticks, mathtext, symbol, value_text
 from .layout import VALUE
-from .palette import HATCH_DEGENERATE, UNDECIDED_COLOUR, class_patch, system_colour
+from .palette import HATCH_DEGENERATE, HATCH_NODE_ONLY, class_patch, system_colour
 
 
 def scanned_attrs(ds: xr.Dataset, system, along: str, lower: xr.DataArray) -> dict:
@@ -45,8 +45,8 @@ def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
         edges = cell_edges(y, ds[free[0]].attrs.get("scale"))
     else:
         edges = np.array([0.0, 1.0])
-    present = draw_stretches(ax, stretches, edges, system)
-    gaps = undecided_gaps(rows)
+    gaps = gap_stretches(rows, system, along, start, scan)
+    present = sorted(set(draw_stretches(ax, stretches, edges, system)) | set(draw_stretches(ax, gaps, edges, system)))
     draw_gaps(ax, gaps, edges)
     b_lo, b_hi = np.asarray(rows["boundary_lower"]), np.asarray(rows["boundary_upper"])
     ends = np.concatenate([b_lo.ravel(), b_hi.ravel()])
@@ -95,9 +95,15 @@ def critical_rows(ds: xr.Dataset, system, along: str, free: list[str], chosen: d
 
 
 def critical_stretches(rows: xr.Dataset, system, along: str, start: str | None, scan: list[float]) -> list[tuple]:
-    """(row, x0, x1, class) of every stretch the file proves; the few-ulp brackets between them and the undecided
-    gaps (:func:`undecided_gaps`) are left out. An older file (no ``start``) gives its stable intervals only."""
-    return without_gaps(class_stretches(rows, system, along, start, scan), undecided_gaps(rows))
+    """(row, x0, x1, class) of every stretch the file proves throughout; the few-ulp brackets between them and the
+    undecided gaps (:func:`gap_stretches`) are left out. An older file (no ``start``) gives its stable intervals only."""
+    return split_gaps(class_stretches(rows, system, along, start, scan), undecided_gaps(rows))[0]
+
+
+def gap_stretches(rows: xr.Dataset, system, along: str, start: str | None, scan: list[float]) -> list[tuple]:
+    """(row, x0, x1, class) of every undecided gap: its class is proved at both its ends (and is the same there), not
+    inside."""
+    return split_gaps(class_stretches(rows, system, along, start, scan), undecided_gaps(rows))[1]
 
 
 def undecided_gaps(rows: xr.Dataset) -> list[tuple[int, float, float]]:
@@ -110,16 +116,18 @@ def undecided_gaps(rows: xr.Dataset) -> list[tuple[int, float, float]]:
     return [(r, float(a), float(b)) for r in range(lo.shape[0]) for a, b in zip(lo[r], hi[r], strict=True) if np.isfinite(a)]
 
 
-def without_gaps(stretches: list[tuple], gaps: list[tuple[int, float, float]]) -> list[tuple]:
-    """``stretches`` (row, x0, x1, class) with every gap (row, x0, x1) cut out: a stretch is drawn only where proved."""
-    out = []
+def split_gaps(stretches: list[tuple], gaps: list[tuple[int, float, float]]) -> tuple[list[tuple], list[tuple]]:
+    """``stretches`` (row, x0, x1, class) cut by the ``gaps`` (row, x0, x1): the pieces proved throughout, and the
+    pieces inside a gap, with the class of the stretch they lie in."""
+    proved, inside = [], []
     for r, x0, x1, c in stretches:
         pieces = [(x0, x1)]
         for g_r, g0, g1 in gaps:
             if g_r == r:
+                inside += [(r, max(a, g0), min(b, g1), c) for a, b in pieces if min(b, g1) > max(a, g0)]
                 pieces = [p for a, b in pieces for p in ((a, min(b, g0)), (max(a, g1), b)) if p[1] > p[0]]
-        out += [(r, a, b, c) for a, b in pieces]
-    return out
+        proved += [(r, a, b, c) for a, b in pieces]
+    return proved, inside
 
 
 def class_stretches(rows: xr.Dataset, system, along: str, start: str | None, scan: list[float]) -> list[tuple]:
@@ -155,13 +163,18 @@ def draw_stretches(ax, stretches: list[tuple], edges: np.ndarray, system) -> lis
     return present
 
 
-def draw_gaps(ax, gaps: list[tuple[int, float, float]], edges: np.ndarray) -> None:
-    """Fill each undecided gap (row, x0, x1) dark grey and cross-hatched, as the maps draw points not proved."""
-    from matplotlib.collections import PolyCollection
+def draw_gaps(ax, gaps: list[tuple], edges: np.ndarray) -> None:
+    """Dot the undecided gaps (row, x0, x1, class), drawn in their class's colour, as maps dot the cells proved at their
+    node only: the class holds at the gap's ends, not proved inside."""
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path as MplPath
 
     if gaps:
-        boxes = [[(x0, edges[r]), (x0, edges[r + 1]), (x1, edges[r + 1]), (x1, edges[r])] for r, x0, x1 in gaps]
-        ax.add_collection(PolyCollection(boxes, facecolors=UNDECIDED_COLOUR, edgecolors="none", hatch=HATCH_DEGENERATE))
+        boxes = np.array([[(x0, edges[r]), (x0, edges[r + 1]), (x1, edges[r + 1]), (x1, edges[r])] for r, x0, x1, _ in gaps])
+        patch = PathPatch(MplPath.make_compound_path_from_polys(boxes), facecolor="none", edgecolor="#00000066", linewidth=0,
+                          hatch=HATCH_NODE_ONLY, zorder=2)
+        patch.set_gid("undecided-gaps")
+        ax.add_patch(patch)
 
 
 def critical_legend(fig, system, present: list[int], gaps: bool = False) -> None:
@@ -171,7 +184,8 @@ def critical_legend(fig, system, present: list[int], gaps: bool = False) -> None
 
     handles = [class_patch(c, system) for c in present]
     if gaps:
-        handles.append(Patch(facecolor=UNDECIDED_COLOUR, edgecolor="none", hatch=HATCH_DEGENERATE, label="undecided gap\n(no proof settled it)"))
+        handles.append(Patch(facecolor="white", edgecolor="#00000066", lw=0, hatch=HATCH_NODE_ONLY,
+                             label="undecided gap: proved at\nits ends, not inside"))
     handles.append(Line2D([], [], color="k", marker=".", ls="none", label=f"a change of {mathtext(system.label_symbol)},\nlocated"))
     fig.legend(handles=handles, loc="outside right upper", alignment="left", frameon=False, title=system.label_title,
                fontsize=9, title_fontsize=9)
