@@ -157,6 +157,20 @@ def test_a_page_is_fitted_under_its_bound_by_measuring_it():
         fitted(full, {"a": 40}, 1.72, 40, lambda plan: Sized(plan, "t", plan.notes))
 
 
+def test_a_strip_of_one_free_axis(two_tops_atlas):
+    """With every axis but one fixed, the page is a strip along it: one block per grid value, the atlas's label at
+    the nearest value of the fixed axis, which the hover names."""
+    ds = two_tops_atlas
+    page = atlas_page(ds, sel={"m_2": 1.0})
+    state, texts = shown_states(page)
+    m2 = float(ds.m_2.sel(m_2=1.0, method="nearest"))
+    want = ds.n_complex_pairs.sel(m_2=m2).transpose("omega").values
+    assert [int(texts[s].split(" = ")[1].split(":")[0]) for s in state] == want.tolist()
+    (hover,) = models(page, "CustomJSHover")
+    assert hover.args["tables"]["where"].data["v"] == [value_text(ds, "m_2", m2)]
+    assert not models(page, "Slider")
+
+
 def test_thinning_keeps_evenly_spaced_values_and_says_so():
     plan = PagePlan("x", "y", ("a", "b"), {"a": tuple(range(40)), "b": tuple(range(5))})
     small = thin(plan, {"a": 40, "b": 5}, 60, "the bound")
