@@ -12,6 +12,7 @@ from ...errors import StabmapError, given
 from ..plot.captions import fixed_caption
 from ..plot.critical import critical_rows, critical_stretches, gap_stretches, scanned_attrs
 from ..plot.geometry import cell_edges
+from ..plot.layout import nearest
 from ..plot.palette import system_colour
 from . import widgets
 from .page import MAX_MB, Page, budget, fitted
@@ -38,8 +39,8 @@ def critical_page(ds: xr.Dataset, *, y: str | None = None, sel: dict[str, float]
         raise StabmapError(f"{given('y', y)}: not a free axis of this file; choose from {', '.join(free) or '(none)'}")
     y = y or (free[0] if free else None)
     rest = tuple(d for d in free if d != y)
-    fixed = {k: (int(np.argmin(np.abs(np.asarray(ds[k], dtype=float) - v))), float(v)) for k, v in sel.items()}
-    plan = PagePlan(along, y, rest, {d: tuple(range(ds.sizes[d])) for d in rest}, fixed)
+    fixed, notes = nearest(ds, sel)
+    plan = PagePlan(along, y, rest, {d: tuple(range(ds.sizes[d])) for d in rest}, fixed, tuple(notes))
     picked = ds.isel({k: i for k, (i, _) in fixed.items()})
     scan = [float(v) for v in ds.attrs["critical_scan_range"]]
     edges = cell_edges(np.asarray(ds[y], dtype=float), ds[y].attrs.get("scale")) if y else np.array([0.0, 1.0])
