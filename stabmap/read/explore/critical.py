@@ -10,7 +10,7 @@ import xarray as xr
 from ... import systems
 from ...errors import StabmapError, given
 from ..plot.captions import fixed_caption
-from ..plot.critical import critical_rows, critical_stretches, gap_stretches, scanned_attrs
+from ..plot.critical import critical_rows, critical_stretches, scanned_attrs
 from ..plot.geometry import cell_edges
 from ..plot.layout import nearest
 from ..plot.palette import system_colour
@@ -49,8 +49,7 @@ def critical_page(ds: xr.Dataset, *, y: str | None = None, sel: dict[str, float]
     def read(at: dict[str, int]) -> tuple[dict, dict]:
         frame = picked.isel(at)
         rows, start = critical_rows(frame, system, along, [y] if y else [], {})
-        stretches = critical_stretches(rows, system, along, start, scan)
-        gaps = gap_stretches(rows, system, along, start, scan)
+        stretches, gaps = critical_stretches(rows, system, along, start, scan)
         return stretch_columns(frame, system, along, y, edges, stretches, gaps, names, at), dot_columns(rows, y, edges)
 
     done: dict[tuple, tuple[dict, dict]] = {}
@@ -87,26 +86,18 @@ def stretch_columns(frame: xr.Dataset, system, along: str, y: str | None, edges:
     unit = unit_plain(names, along).strip()
     symbol = plain(value_text(names, along, 0.0).split(" =")[0])
     where = [value_text(frame, d, float(frame[d])) for d in at]
-    for r, x0, x1, c in stretches:
+    label = plain(system.label_symbol)
+    for (r, x0, x1, c), gap in [*((piece, False) for piece in stretches), *((piece, True) for piece in undecided)]:
         cols["left"].append(x0)
         cols["right"].append(x1)
         cols["bottom"].append(edges[r])
         cols["top"].append(edges[r + 1])
         cols["cls"].append(int(c))
-        cols["colour"].append(system_colour(int(c), system))
-        lines = [f"{plain(system.label_symbol)} = {c}: {system.class_name(int(c))}",
-                 f"{symbol} from {x0:.10g} to {x1:.10g} {unit}".rstrip()]
-        cols["text"].append("\n".join(t for t in [*lines, rows[r], *where] if t))
-    for r, lo, hi, c in undecided:
-        cols["left"].append(lo)
-        cols["right"].append(hi)
-        cols["bottom"].append(edges[r])
-        cols["top"].append(edges[r + 1])
-        cols["cls"].append(int(c))
-        cols["colour"].append(lighter(system_colour(int(c), system)))
-        lines = [f"undecided gap: {plain(system.label_symbol)} = {c} ({system.class_name(int(c))}) at both ends, not proved inside",
-                 f"{symbol} from {lo:.10g} to {hi:.10g} {unit}".rstrip()]
-        cols["text"].append("\n".join(t for t in [*lines, rows[r], *where] if t))
+        colour = system_colour(int(c), system)
+        cols["colour"].append(lighter(colour) if gap else colour)
+        head = (f"undecided gap: {label} = {c} ({system.class_name(int(c))}) at both ends, not proved inside" if gap
+                else f"{label} = {c}: {system.class_name(int(c))}")
+        cols["text"].append("\n".join(t for t in [head, f"{symbol} from {x0:.10g} to {x1:.10g} {unit}".rstrip(), rows[r], *where] if t))
     return {k: np.asarray(v, dtype=float) if k in ("left", "right", "bottom", "top") else np.asarray(v, dtype=np.int16) if k == "cls" else v
             for k, v in cols.items()}
 

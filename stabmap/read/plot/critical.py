@@ -36,7 +36,7 @@ def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
     free, chosen = free_axes(ds, along, sel)
     rows, start = critical_rows(ds, system, along, free, chosen)
     scan = [float(v) for v in ds.attrs["critical_scan_range"]]
-    stretches = critical_stretches(rows, system, along, start, scan)
+    stretches, gaps = critical_stretches(rows, system, along, start, scan)
 
     fig = captioned_figure(ds, (7.5, 5.5 if free else 2.4))
     ax = fig.subplots()
@@ -45,7 +45,6 @@ def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
         edges = cell_edges(y, ds[free[0]].attrs.get("scale"))
     else:
         edges = np.array([0.0, 1.0])
-    gaps = gap_stretches(rows, system, along, start, scan)
     present = sorted(set(draw_stretches(ax, stretches, edges, system)) | set(draw_stretches(ax, gaps, edges, system)))
     draw_gaps(ax, gaps, edges)
     b_lo, b_hi = np.asarray(rows["boundary_lower"]), np.asarray(rows["boundary_upper"])
@@ -94,16 +93,11 @@ def critical_rows(ds: xr.Dataset, system, along: str, free: list[str], chosen: d
     return (picked.transpose(*free, ...) if free else picked.expand_dims(row=[0])), start
 
 
-def critical_stretches(rows: xr.Dataset, system, along: str, start: str | None, scan: list[float]) -> list[tuple]:
-    """(row, x0, x1, class) of every stretch the file proves throughout; the few-ulp brackets between them and the
-    undecided gaps (:func:`gap_stretches`) are left out. An older file (no ``start``) gives its stable intervals only."""
-    return split_gaps(class_stretches(rows, system, along, start, scan), undecided_gaps(rows))[0]
-
-
-def gap_stretches(rows: xr.Dataset, system, along: str, start: str | None, scan: list[float]) -> list[tuple]:
-    """(row, x0, x1, class) of every undecided gap: its class is proved at both its ends (and is the same there), not
-    inside."""
-    return split_gaps(class_stretches(rows, system, along, start, scan), undecided_gaps(rows))[1]
+def critical_stretches(rows: xr.Dataset, system, along: str, start: str | None, scan: list[float]) -> tuple[list[tuple], list[tuple]]:
+    """(row, x0, x1, class) of every stretch the file proves throughout, and of every undecided gap (its class proved
+    at both its ends, the same there, not inside); the few-ulp brackets between stretches are left out. An older file
+    (no ``start``) gives its stable intervals only."""
+    return split_gaps(class_stretches(rows, system, along, start, scan), undecided_gaps(rows))
 
 
 def undecided_gaps(rows: xr.Dataset) -> list[tuple[int, float, float]]:
