@@ -181,7 +181,7 @@ title.text = titles[k];
 """, rects=rects, current=current, lines=lines, title=title, titles=titles,
                          frames=[[rect_columns(f), widgets.array(i), segment_columns(f.classes), segment_columns(f.stability)]
                                  for f, i in zip(chosen, ids, strict=True)])
-    side = widgets.legend(plain(system.label_title), legend_entries(system, legend, chosen))
+    side = widgets.legend(plain(system.label_title), legend_entries(system, chosen))
     return column(title, row(p, side), *controls, readout, widgets.caption(caption_lines(ds, plan, grid)))
 
 
@@ -218,11 +218,12 @@ def title_html(ds: xr.Dataset, system, plan: PagePlan, f: Frame, at: dict[str, i
     return "<br>".join(lines)
 
 
-def legend_entries(system, legend: Legend, chosen: list[Frame]) -> list[str]:
-    """The legend: the classes drawn, then the lines and marks drawn, as the PNG legend names them."""
+def legend_entries(system, chosen: list[Frame]) -> list[str]:
+    """The legend: the classes drawn, then the lines and marks drawn, as the PNG legend names them (of the frames on
+    the page only, not of those left out)."""
     present = sorted({v for f in chosen for v in f.counts})
     entries = [widgets.swatch(system_colour(v, system), system.class_name(v)) for v in present]
-    drawn = legend.drawn
+    drawn = frozenset().union(*(f.drawn for f in chosen))
     if "stability" in drawn:
         entries.append(widgets.swatch(BOUNDARY, "stability boundary", "line"))
     if "classes" in drawn:

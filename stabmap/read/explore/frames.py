@@ -23,14 +23,22 @@ WIDEST = {"stability": 2.5, "classes": 1.0}  # [px] boundary widths between wide
 @dataclass(frozen=True)
 class Frame:
     """One slider setting: every block's packed state (rows along y), the label's counts, the rectangles of one
-    colour that draw the blocks (rows c0, c1, r0, r1, colour: block columns [c0, c1) and rows [r0, r1)), and the
-    boundary segments as columns x0, y0, x1, y1, width [px] (float32), thick (stability) and thin (other classes)."""
+    colour that draw the blocks (rows c0, c1, r0, r1, colour: block columns [c0, c1) and rows [r0, r1)), the
+    boundary segments as columns x0, y0, x1, y1, width [px] (float32), thick (stability) and thin (other classes),
+    and the marks drawn beside the classes (:func:`.states.block_colours`), for the legend."""
 
     keys: np.ndarray
     counts: dict[int, int]
     rects: np.ndarray
     stability: np.ndarray
     classes: np.ndarray
+    marks: frozenset[str] = frozenset()
+
+    @property
+    def drawn(self) -> frozenset[str]:
+        """Every legend entry this frame needs beyond its classes: its marks and its kinds of boundary."""
+        lines = {name for name, segs in (("stability", self.stability), ("classes", self.classes)) if len(segs)}
+        return self.marks | lines
 
 
 @dataclass(frozen=True)
@@ -100,13 +108,9 @@ def read_frame(label: xr.DataArray, bits: xr.DataArray | None, plan: PagePlan, a
         values, flags = compute(values, flags)
     blocks = reduce_blocks(values, flags, stable, grid.factors)
     near = touches_stability(blocks, stable) if stable is not None else np.zeros(blocks.low.shape, dtype=bool)
-    colours = block_colours(blocks, legend, near)
-    keys = pack(blocks, colours)
+    colours, marks = block_colours(blocks, legend, near)
     codes, state = block_classes(blocks, stable)
     stab, other = cell_edge_boundaries(codes, grid.xe, grid.ye, stable, state=state)
-    if len(stab):
-        legend.drawn.add("stability")
-    if len(other):
-        legend.drawn.add("classes")
-    return Frame(keys, dict(blocks.counts), colour_rectangles(colours), segments_table(stab, grid, codes, WIDEST["stability"], pixels),
-                 segments_table(other, grid, codes, WIDEST["classes"], pixels))
+    return Frame(pack(blocks, colours), dict(blocks.counts), colour_rectangles(colours),
+                 segments_table(stab, grid, codes, WIDEST["stability"], pixels), segments_table(other, grid, codes, WIDEST["classes"], pixels),
+                 frozenset(marks))

@@ -55,12 +55,11 @@ def _look_up(a: np.ndarray, *, values: np.ndarray, table: np.ndarray) -> np.ndar
 
 
 class Legend:
-    """The colours a page draws, each numbered once, and which legend entries they stand for."""
+    """The colours a page draws, each numbered once."""
 
     def __init__(self, system, has_provenance: bool) -> None:
         self.system = system
         self.colours: list[str] = []
-        self.drawn: set[str] = set()
         flags = system.variable(system.provenance).meanings if has_provenance else ()
         self.inferred_bit = (1 << flags.index(INFERRED)) if INFERRED in flags else 0
 
@@ -81,10 +80,11 @@ def cell_bit(meaning: str) -> int:
     return 1 << (CELL_SHIFT + CELL.meanings.index(meaning))
 
 
-def block_colours(blocks, legend: Legend, near_stable: np.ndarray) -> np.ndarray:
+def block_colours(blocks, legend: Legend, near_stable: np.ndarray) -> tuple[np.ndarray, set[str]]:
     """The colour id of every block, as the PNG maps colour it: a block of one class in that class's colour (lighter
     where a cell is proved at its node only or inferred), a block of stable and unstable points and a cell proved
-    to hold a change next to stable ones black, other mixed blocks and changes dark grey."""
+    to hold a change next to stable ones black, other mixed blocks and changes dark grey; and the marks drawn, for
+    the legend ("inferred", "node-only", "change", "mixed-classes", "mixed-stability")."""
     system = legend.system
     low, mixed = blocks.low, blocks.low != blocks.high
     bits = np.zeros(low.shape, dtype=np.int64) if blocks.any_flag is None else blocks.any_flag.astype(np.int64)
@@ -98,16 +98,14 @@ def block_colours(blocks, legend: Legend, near_stable: np.ndarray) -> np.ndarray
         if (at & (inferred | node_only)).any():
             out[at & (inferred | node_only)] = legend.id(lighter(system_colour(int(v), system)))
     shown = ~mixed & ~change
-    for mask, entry in ((inferred & shown, "inferred"), (node_only & shown, "node-only")):
-        if mask.any():
-            legend.drawn.add(entry)
+    marks = {entry for mask, entry in ((inferred & shown, "inferred"), (node_only & shown, "node-only")) if mask.any()}
     for mask, colour, entry in ((change & ~near_stable, CLASS_EDGE, "change"), (change & near_stable, BOUNDARY, "change"),
                                 (mixed & ~blocks.mixed_stability, CLASS_EDGE, "mixed-classes"),
                                 (blocks.mixed_stability, BOUNDARY, "mixed-stability")):
         if mask.any():
             out[mask] = legend.id(colour)
-            legend.drawn.add(entry)
-    return out
+            marks.add(entry)
+    return out, marks
 
 
 def pack(blocks, colour_ids: np.ndarray) -> np.ndarray:
