@@ -18,7 +18,7 @@ from . import widgets
 from .page import MAX_MB, Page, budget, fitted
 from .plan import PagePlan
 from .states import lighter
-from .text import axis_title, escape, plain, unit_plain, value_text
+from .text import axis_title, escape, name, plain, unit_plain, value_text
 
 SHOW_JS = widgets.READOUT_JS + "const i = cb_data.index.indices;\nif (i.length) show(readout, quads.data.text[i[0]]);"
 
@@ -84,7 +84,7 @@ def stretch_columns(frame: xr.Dataset, system, along: str, y: str | None, edges:
     rows = [value_text(frame, y, float(v)) for v in np.asarray(frame[y])] if y else [""] * (len(edges) - 1)
     cols: dict[str, list] = {"left": [], "right": [], "bottom": [], "top": [], "cls": [], "colour": [], "text": []}
     unit = unit_plain(names, along).strip()
-    symbol = plain(value_text(names, along, 0.0).split(" =")[0])
+    symbol = name(names, along)
     where = [value_text(frame, d, float(frame[d])) for d in at]
     label = plain(system.label_symbol)
     for (r, x0, x1, c), gap in [*((piece, False) for piece in stretches), *((piece, True) for piece in undecided)]:
@@ -144,7 +144,7 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, edges: np.ndarray, scan: list[f
     controls = widgets.sliders(ds, plan.sliders, plan.positions)
     radix = [len(plan.positions[s]) for s in plan.sliders]
     head = f"<b>{escape(plain(ds.attrs.get('title', '') or 'stabmap critical values'))}</b><br>" \
-           f"{escape(plain(value_text(names, plan.x, 0.0).split(' =')[0]))} scanned, every change located to rtol {ds.attrs['critical_rtol']:g}"
+           f"{escape(name(names, plan.x))} scanned, every change located to rtol {ds.attrs['critical_rtol']:g}"
     fixed = {k: i for k, (i, _) in plan.fixed.items()}
     titles = [head + ("<br>" + escape(", ".join(value_text(ds, d, float(ds[d][i])) for d, i in {**at, **fixed}.items())) if at or fixed else "")
               for at in plan.frames]

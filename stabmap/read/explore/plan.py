@@ -9,8 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
-from ...errors import StabmapError, param
-from ..plot.layout import check_roles, check_sel, evenly, nearest
+from ..plot.layout import evenly, free_to_draw, nearest
 
 
 @dataclass(frozen=True)
@@ -38,13 +37,7 @@ def plan_page(ds: xr.Dataset, dims: list[str], *, x: str | None = None, y: str |
     """Check ``x``, ``y`` and ``sel`` against the axes ``dims`` of ``ds`` and decide the page's layout: the map's
     axes (default: the first two free axes), a slider for every other free axis, every value on it."""
     sel = dict(sel or {})
-    check_sel(ds, dims, sel)
-    check_roles(dims, sel, [(opt, v) for opt, v in (("x", x), ("y", y)) if v is not None])
-    free = [d for d in dims if d not in sel]
-    if not free:
-        raise StabmapError(f"{param('sel')} fixes every axis ({', '.join(dims)}); leave one or two free to draw, or use 'stabmap query'")
-    if len(free) == 1 and y is not None:
-        raise StabmapError(f"{param('y')} {y}: only one axis is left to draw ({free[0]}), along x; drop {param('y')}")
+    free = free_to_draw(ds, dims, sel, {"x": x, "y": y})
     rest = [d for d in free if d not in (x, y)]
     x = x or rest.pop(0)
     if len(free) >= 2:

@@ -77,7 +77,7 @@ def rows_cols(n_rows: int, n_cols: int, max_panels: int) -> tuple[int, int]:
     return best
 
 
-def check_sel(ds: xr.Dataset, dims: list[str], sel: dict) -> None:
+def _check_sel(ds: xr.Dataset, dims: list[str], sel: dict) -> None:
     """Each axis fixed by ``sel`` is a grid axis of ``dims`` and its value a finite number."""
     for k, v in sel.items():
         if k in ds.coords and ds[k].ndim == 0 and k not in dims:
@@ -89,7 +89,7 @@ def check_sel(ds: xr.Dataset, dims: list[str], sel: dict) -> None:
             raise StabmapError(f"{given('sel', v, k)}: give a finite number, e.g. {given('sel', float(ds[k][0]), k)}")
 
 
-def check_roles(dims: list[str], sel: dict, roles: list[tuple[str, str]]) -> None:
+def _check_roles(dims: list[str], sel: dict, roles: list[tuple[str, str]]) -> None:
     """Each of x, y and facet (``roles``: parameter, axis) names an axis of ``dims`` not fixed by ``sel``, once."""
     for opt, name in roles:
         if name not in dims:
@@ -99,6 +99,19 @@ def check_roles(dims: list[str], sel: dict, roles: list[tuple[str, str]]) -> Non
     for i, (opt, name) in enumerate(roles):
         for opt2, _ in (r for r in roles[i + 1 :] if r[1] == name):
             raise StabmapError(f"{param(opt)} and {param(opt2)} both name {name}; give each axis one place in the figure")
+
+
+def free_to_draw(ds: xr.Dataset, dims: list[str], sel: dict, roles: dict[str, str | None]) -> list[str]:
+    """The axes of ``dims`` that ``sel`` leaves free, after checking ``sel`` and the ``roles`` (option -> axis or None:
+    x, y, facet) against them: at least one is left, and two where ``y`` is given."""
+    _check_sel(ds, dims, sel)
+    _check_roles(dims, sel, [(opt, name) for opt, name in roles.items() if name is not None])
+    free = [d for d in dims if d not in sel]
+    if not free:
+        raise StabmapError(f"{param('sel')} fixes every axis ({', '.join(dims)}); leave one or two free to draw, or use 'stabmap query'")
+    if len(free) == 1 and roles.get("y") is not None:
+        raise StabmapError(f"{given('y', roles['y'])}: only one axis is left to draw ({free[0]}), along x; drop {param('y')}")
+    return free
 
 
 def nearest(ds: xr.Dataset, sel: dict) -> tuple[dict[str, tuple[int, float]], list[str]]:
@@ -133,13 +146,7 @@ def plan_figure(
     if not dims:
         raise StabmapError("this atlas has no axis to plot (a single point); use 'stabmap info' or 'stabmap query'")
     sel = dict(sel or {})
-    check_sel(ds, dims, sel)
-    check_roles(dims, sel, [(opt, name) for opt, name in (("x", x), ("y", y), ("facet", facet)) if name is not None])
-    free = [d for d in dims if d not in sel]
-    if not free:
-        raise StabmapError(f"{param('sel')} fixes every axis ({', '.join(dims)}); leave one or two free to draw, or use 'stabmap query'")
-    if len(free) == 1 and y is not None:
-        raise StabmapError(f"{given('y', y)}: only one axis is left to draw ({free[0]}), along x; drop {param('y')}")
+    free = free_to_draw(ds, dims, sel, {"x": x, "y": y, "facet": facet})
     if len(free) <= 2 and facet is not None:
         raise StabmapError(
             f"{given('facet', facet)}: only {len(free)} ax{'is' if len(free) == 1 else 'es'} left to draw ({', '.join(free)}), "
@@ -169,9 +176,9 @@ def plan_figure(
         else:
             r, c = rows_cols(ds.sizes[row], n_f, max_panels)
             facet_index, row_index = evenly(n_f, c), evenly(ds.sizes[row], r)
-        for d, index in ((facet, facet_index), (row, row_index)):
-            if d is not None and len(index) < ds.sizes[d]:
-                panel_notes.append(f"{d}: {len(index)} of {ds.sizes[d]} values drawn, evenly spaced")
+        for axis, index in ((facet, facet_index), (row, row_index)):
+            if axis is not None and len(index) < ds.sizes[axis]:
+                panel_notes.append(f"{axis}: {len(index)} of {ds.sizes[axis]} values drawn, evenly spaced")
         if panel_notes:
             panel_notes[-1] += f" (more with {param('max_panels')}, now {max_panels}; one with {param('sel')})"
     notes = panel_notes + notes
