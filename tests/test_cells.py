@@ -14,6 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import stabmap
+from stabmap.run import cells
 from stabmap.run.critical import critical
 from stabmap.scene.grid import Axis, resample
 from stabmap.store.dataset import edges
@@ -33,8 +34,16 @@ def _exact(scene, values: dict[str, np.ndarray]) -> np.ndarray:
     return exact.decide_points(*pts.kernel_args(), np.arange(pts.body.shape[0]))
 
 
-def _atlas(scene, **kwargs):
-    return stabmap.compute_atlas(scene, threads=1, progress=False, **kwargs)
+def _atlas(scene, spare: float | None = None, **kwargs):
+    """The atlas of ``scene``; ``spare``: the tiles' spare for proofs (cells.SPARE) for this atlas, so that a test of what
+    cells claim sees boxes tried on a coarse grid, where the default spare tries few."""
+    if spare is None:
+        return stabmap.compute_atlas(scene, threads=1, progress=False, **kwargs)
+    saved, cells.SPARE = cells.SPARE, spare
+    try:
+        return stabmap.compute_atlas(scene, threads=1, progress=False, **kwargs)
+    finally:
+        cells.SPARE = saved
 
 
 def _cell_points(scene, index: tuple[int, ...], rng, k: int) -> dict[str, np.ndarray]:
@@ -73,7 +82,7 @@ def test_cells_tile_the_scan_and_are_written_as_cf_bounds(tmp_path):
 # ---------------------------------------------------------------------------------- narrow windows and bands
 def test_the_narrow_window_never_lies_in_a_whole_cell():
     scene = from_dict(WINDOW)
-    ds = _atlas(scene)
+    ds = _atlas(scene, spare=1.0)
     cell = ds["cell"].values
     # the window lies between two nodes that agree (N_c = 1 at omega = 11.5 and 12.5): their label is not claimed
     # for the window's cell, which is node_only (its sub-boxes straddle the window), and the boundary at 13.84
@@ -83,7 +92,7 @@ def test_the_narrow_window_never_lies_in_a_whole_cell():
         for i in _cells_containing(scene, x):
             assert cell[i] != WHOLE, (x, i)
     assert [CELL.meaning(int(cell[i])) for i in _cells_containing(scene, EXACT_BOUNDARIES[2])] == ["contains_change"]
-    assert (cell == WHOLE).sum() >= 75  # the rest mostly proved (a 100-cell tile affords 19 box proofs)
+    assert (cell == WHOLE).sum() >= 75  # the rest mostly proved (a spare of one node proof a cell affords 19 box proofs)
 
 
 @pytest.mark.parametrize("E", [1e-4, 1e-6, 1e-8])
@@ -92,7 +101,7 @@ def test_narrow_liquid_bands_never_hide_in_a_whole_cell(E):
     # values (checked against the exact discriminant in tests/test_boxes.py), each located to 1e-10.
     system = dict(WINDOW, bodies=[dict(b, fluid=dict(b["fluid"], E=[E])) for b in WINDOW["bodies"]])
     scene = from_dict(system)
-    ds = _atlas(scene)
+    ds = _atlas(scene, spare=1.0)
     crit = critical(scene, "omega", rtol=1e-10, progress=False, threads=1)
     keep = np.isfinite(crit["boundary_lower"].values)
     cell = ds["cell"].values
@@ -125,19 +134,23 @@ def _random_scene(seed: int):
 @given(seed=st.integers(0, 2**31 - 1))
 def test_a_whole_cell_has_its_label_at_random_interior_points_in_exact_arithmetic(seed):
     scene = _random_scene(seed)
-    ds = _atlas(scene)
+    ds = _atlas(scene, spare=1.0)
     cell, label = ds["cell"].values, ds["n_complex_pairs"].values
     rng = np.random.default_rng(seed)
     whole = np.argwhere(cell == WHOLE)
     for index in whole[rng.permutation(len(whole))[:6]]:
         pts = _cell_points(scene, tuple(index), rng, 4)
         assert np.all(_exact(scene, pts) == label[tuple(index)]), (seed, tuple(index))
-    # a claimed change: two labels inside the cell (node or corner labels, else random points find the other)
+    # a claimed change: two labels inside the cell (node, face-centre or corner labels, else random points find the other)
     change = np.argwhere(cell == CHANGE)
     for index in change[rng.permutation(len(change))[:2]]:
         corners = {a.name: edges(a.array)[[i, i + 1]] for a, i in zip(scene.grid, index)}
         grid = np.meshgrid(*corners.values(), indexing="ij")
+        faces = {a.name: np.array([a.array[i]] * (2 * len(scene.grid))) for a, i in zip(scene.grid, index)}
+        for d, a in enumerate(scene.grid):
+            faces[a.name][2 * d : 2 * d + 2] = corners[a.name]
         seen = set(_exact(scene, {k: g.ravel() for k, g in zip(corners, grid)}).tolist()) | {int(label[tuple(index)])}
+        seen |= set(_exact(scene, faces).tolist())
         if len(seen) == 1:
             seen |= set(_exact(scene, _cell_points(scene, tuple(index), rng, 300)).tolist())
         assert len(seen) > 1, (seed, tuple(index))
@@ -174,7 +187,7 @@ def test_a_cavity_axis_leaves_cells_node_only():
 
 def test_query_says_whether_the_cell_is_proved(tmp_path):
     scene = dataclasses.replace(from_dict(WINDOW), grid=(Axis("omega", tuple(np.linspace(0.5, 99.5, 100))),))
-    ds = _atlas(scene)
+    ds = _atlas(scene, spare=1.0)
     from stabmap.read.query import label_at
 
     assert label_at(ds, omega=12.0).cell == "node_only"  # the window's cell: N_c = 1 at its node, not claimed in it
@@ -259,3 +272,67 @@ def test_the_probe_of_an_atlas_decided_cell_by_cell_times_whole_tiles():
             assert a % t == 0 and b == min(n, a + t)
     points, seconds = probe_tiles(scene, where)
     assert points > 0 and seconds > 0
+
+
+# ------------------------------------------------------------------------ discrete axes and the proofs' spare
+def test_a_listed_axis_is_discrete_and_each_slice_has_the_cells_of_its_own_2d_atlas(tmp_path):
+    # K_1 = [0, 10, 120] are three cases, not a continuum: no cell spans two of them, so the slice at each listed
+    # value holds the labels and cell flags of the 2-D atlas with that value fixed, and its bounds are the value.
+    base = resample(stabmap.example("paper-n3-fixed"), omega=48, m_2=40)  # coarse: whole cells only with a larger spare
+    values = (0.0, 10.0, 120.0)
+    listed = dataclasses.replace(base, grid=(*base.grid, Axis("K_1", values, "values")))
+    assert listed.grid[-1].discrete and cells.tile_shape(listed)[-1] == 1
+    ds = _atlas(listed, spare=1.0)
+    assert np.array_equal(ds["K_1_bounds"].values, np.column_stack([values, values]))
+    for k, v in enumerate(values):
+        fixed = dataclasses.replace(base, joints=(v, *base.joints[1:]))
+        flat = _atlas(fixed, spare=1.0)
+        assert np.array_equal(ds["n_complex_pairs"].values[..., k], flat["n_complex_pairs"].values), v
+        assert np.array_equal(ds["cell"].values[..., k], flat["cell"].values), v
+        assert (flat["cell"].values == WHOLE).any() and (flat["cell"].values == CHANGE).any(), v  # the test means something
+    path = tmp_path / "listed.nc"
+    stabmap.write_atlas(ds, path)
+    assert np.array_equal(xr.load_dataset(path)["K_1_bounds"].values[:, 0], values)
+
+
+def test_a_scanned_axis_marked_discrete_and_a_list_marked_continuous():
+    from stabmap.errors import StabmapError
+    from stabmap.scene.grid import parse_axes
+    from stabmap.scene.values import Parameter
+
+    any_number = lambda name: Parameter("", "", "")  # noqa: E731
+    axes = parse_axes({"a": {"values": [1.0, 2.0]}, "b": {"start": 0.0, "stop": 1.0, "num": 5, "discrete": True},
+                       "c": {"values": [1.0, 2.0, 4.0], "discrete": False}, "d": {"start": 0.0, "stop": 1.0, "num": 5}}, any_number)
+    assert [a.discrete for a in axes] == [True, True, False, False]
+    assert [a.continuous for a in axes] == [False, False, True, True]
+    back = parse_axes({a.name: a.to_dict() for a in axes}, any_number)  # the scene stored in a file says the same
+    assert back == axes
+    with pytest.raises(StabmapError, match=r"grid\.a\.discrete must be true or false"):
+        parse_axes({"a": {"values": [1.0, 2.0], "discrete": "yes"}}, any_number)
+
+
+def test_proofs_beyond_the_nodes_cost_at_most_the_spare_and_what_boxes_saved(monkeypatch):
+    # Counted from the calls the system gets, not from the tiles' own accounts: box proofs priced by box_cost, and
+    # every label computed at a point that is not a node (the faces of cells beside a change), one node proof each.
+    system = stabmap.systems.of(stabmap.example("paper-n3-fixed"))
+    made = {"boxes": 0, "points": 0}
+    prove, evaluate = type(system).prove_and_cut_boxes, type(system).evaluate
+
+    def counted_prove(self, scene, lower, upper):
+        made["boxes"] += len(next(iter(lower.values())))
+        return prove(self, scene, lower, upper)
+
+    def counted_evaluate(self, scene, values):
+        made["points"] += len(next(iter(values.values())))
+        return evaluate(self, scene, values)
+
+    monkeypatch.setattr(type(system), "prove_and_cut_boxes", counted_prove)
+    monkeypatch.setattr(type(system), "evaluate", counted_evaluate)
+    for num in (20, 64):  # a coarse grid, where boxes fail for their size, and a finer one, where they prove
+        scene = resample(stabmap.example("paper-n3-fixed"), omega=num, m_2=num)
+        made.update(boxes=0, points=0)
+        ds = _atlas(scene, chunk_points=num * num)  # one chunk, no probe
+        by_box = int((ds["decided_by"].values == BY_BOX).sum())
+        nodes = ds["cell"].size - by_box
+        extra = made["boxes"] * system.box_cost(scene) + (made["points"] - nodes)
+        assert made["boxes"] > 0 and extra <= cells.SPARE * ds["cell"].size + by_box, (num, made, by_box)

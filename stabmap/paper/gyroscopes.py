@@ -152,7 +152,8 @@ def _by_scan_step(boundaries, scan: np.ndarray):
 
 def _one_step(row_scene, along: str, other: str, row: float, lo: float, hi: float):
     """``row_scene`` at ``other = row`` alone, with ``along`` scanned finely over [lo, hi]."""
-    axes = {along: Axis(along, tuple(float(v) for v in np.linspace(lo, hi, FINE)), "values"), other: Axis(other, (float(row),), "values")}
+    axes = {along: Axis(along, tuple(float(v) for v in np.linspace(lo, hi, FINE)), "values", discrete=False),
+            other: Axis(other, (float(row),), "values")}
     return dataclasses.replace(row_scene, grid=tuple(axes.get(a.name, a) for a in row_scene.grid))
 
 

@@ -33,7 +33,8 @@ def _critical(ds: xr.Dataset, along: str, sel: dict, progress: bool | None, thre
     grid = []
     for axis in scene.grid:
         values = np.atleast_1d(np.asarray(sub[axis.name].values, dtype=np.float64))
-        grid.append(Axis(axis.name, tuple(float(v) for v in values), "values" if values.size != len(axis.values) else axis.scale))
+        grid.append(Axis(axis.name, tuple(float(v) for v in values), "values" if values.size != len(axis.values) else axis.scale,
+                         discrete=axis.discrete))
     line = dataclasses.replace(scene, grid=tuple(grid))
     crit = critical(line, along, rtol=RTOL, progress=progress, threads=threads)
     fixed = [d for d in grid_axes(ds) if d != along and axes[d].fixed]

@@ -59,7 +59,7 @@ def scene_attrs(ds: xr.Dataset) -> dict:
             grid.append(axis)
             continue
         try:
-            grid.append(Axis(axis.name, tuple(float(v) for v in values), axis.scale, axis.display_units))
+            grid.append(Axis(axis.name, tuple(float(v) for v in values), axis.scale, axis.display_units, axis.discrete))
         except StabmapError as exc:
             raise StabmapError(f"cannot write this part of an atlas: {exc}; select values in grid order, each once") from None
         cut.append(axis.name)

@@ -24,6 +24,8 @@ from ..store.files import check_writable, write_streamed
 from ..systems.base import SceneBase
 from . import cells, runner
 from .chunks import (
+    BLOCK_SECONDS,
+    CELL_BLOCK_SECONDS,
     MIN_CHUNK_POINTS,
     check_chunk_points,
     chunk_locations,
@@ -281,7 +283,7 @@ class _Layout:
     progress line (closed on leaving the ``with``).
 
     Without a checkpoint or ``chunk_points``, a probe task first times a few hundred points spread over the grid
-    (``stabmap.run.tasks.probe``): the chunks hold about BLOCK_SECONDS of work at that pace, and tasks of several
+    (``stabmap.run.tasks.probe``): the chunks hold about BLOCK_SECONDS of work at that pace (CELL_BLOCK_SECONDS decided cell by cell), and tasks of several
     chunks about TASK_SECONDS, resized as tasks finish.
     """
 
@@ -309,7 +311,8 @@ class _Layout:
             chunks = chunk_shape(scene.shape, chunk_points_for(scene, 0.0, run.slots()), order, tile)
         else:
             try:
-                chunks = chunk_shape(scene.shape, chunk_points_for(scene, self._probe(tile), run.slots()), order, tile)
+                seconds = BLOCK_SECONDS if tile is None else CELL_BLOCK_SECONDS
+                chunks = chunk_shape(scene.shape, chunk_points_for(scene, self._probe(tile), run.slots(), seconds=seconds), order, tile)
             except BaseException:
                 self.progress.close()
                 raise

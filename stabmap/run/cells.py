@@ -37,7 +37,7 @@ import math
 import numpy as np
 
 from .. import systems
-from ..store.dataset import edges
+from ..store.dataset import bounds
 from ..store.variables import CELL
 from ..systems.base import SceneBase
 
@@ -46,28 +46,37 @@ SUB_ROUNDS = 2  # rounds of halving inside one cell before it is left node_only
 # PAYS_CELLS cells each, of which under PAYS prove, is the last; its boxes' nodes are then computed, and its cells
 # left node_only.  Larger boxes fail for their size alone (roots move past the separators), so they never stop it.
 PAYS, PAYS_MIN, PAYS_CELLS = 0.25, 32, 4
-# Box proofs of a tile cost at most BOX_BUDGET node proofs a cell (``System.box_cost`` prices one box): a tile
-# costs at most 1 + BOX_BUDGET times its nodes computed one by one (and the corners of cells beside a change of
-# label), however few of its boxes prove.  A coarse grid, whose cells are too wide to prove, stays cheap.
-BOX_BUDGET = 1.0
+# What a tile may spend beyond its nodes, in node proofs (``System.box_cost`` prices a box; a label at a point
+# between nodes costs one): SPARE a cell, plus one for every cell its boxes proved whole (a node it need not
+# compute).  So a tile never costs more than 1 + SPARE times its nodes computed one by one, whether its boxes
+# prove or not, and where they prove it goes on trying them.  Boxes leave RESERVE a cell of it to the labels that
+# prove a change in the cells beside one (``_Chunk.classify``), which need the nodes' labels and so come last.
+SPARE, RESERVE = 0.2, 0.1
 TILE_CELLS = 1024  # cells of a tile: 1024 along one axis, 32 x 32, 8 x 8 x 8 (a power of two along every axis)
 
 NODE_ONLY, WHOLE_CELL, CONTAINS_CHANGE = (CELL.value(m) for m in ("node_only", "whole_cell", "contains_change"))
 
 
 def provable(scene: SceneBase) -> bool:
-    """Whether the cells of ``scene``'s grid can be proved: its system proves boxes along every scanned axis."""
+    """Whether the cells of ``scene``'s grid can be proved: its system proves boxes along every axis the cells span
+    (``Axis.continuous``; a discrete axis is a set of separate cases, each a point of every cell)."""
     system = systems.of(scene)
-    moving = {a.name for a in scene.grid if len(a.values) > 1}
+    moving = {a.name for a in scene.grid if a.continuous}
     return bool(moving) and moving <= set(system.box_axes(scene))
 
 
 def tile_shape(scene: SceneBase) -> tuple[int, ...]:
-    """Cells of a tile along each grid axis: the same power of two along every scanned axis (TILE_CELLS in all),
-    1 along an axis of one value."""
-    moving = [len(a.values) > 1 for a in scene.grid]
+    """Cells of a tile along each grid axis: the same power of two along every axis the cells span (TILE_CELLS in
+    all), 1 along a discrete axis or one of one value, so that no box spans two cases."""
+    moving = [a.continuous for a in scene.grid]
     side = 2 ** int(math.log2(TILE_CELLS) // max(1, sum(moving)))
     return tuple(side if m else 1 for m in moving)
+
+
+def cell_edges(axis) -> tuple[np.ndarray, np.ndarray]:
+    """The lower and upper edge of each grid cell along ``axis`` (its CF bounds, in the axis's order)."""
+    b = bounds(axis.array, bool(axis.discrete))
+    return b[:, 0].copy(), b[:, 1].copy()
 
 
 def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evaluate, order: tuple[int, ...]) -> dict[str, np.ndarray]:
@@ -90,6 +99,7 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
     while lo.shape[0] and chunk.provable:
         tile = chunk.tile_of(lo)
         got, proved, tried, along = chunk.prove(lo, hi, tile)
+        chunk.credit += np.bincount(tile[proved], weights=np.prod(hi - lo, axis=1)[proved], minlength=chunk.credit.size)
         for b in np.flatnonzero(proved):
             where = tuple(slice(a, z) for a, z in zip(lo[b], hi[b], strict=True))
             label[where], cell[where], known[where] = got[b], WHOLE_CELL, True
@@ -123,18 +133,27 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
     return out
 
 
-def _beside_change(label: np.ndarray, nodes: np.ndarray, tile: np.ndarray) -> np.ndarray:
-    """Which of ``nodes`` (rows of indices into ``label``) have a neighbour in their own tile (``tile``: each
-    index's tile along its axis, same shape as ``label`` per axis) with another label."""
-    out = np.zeros(nodes.shape[0], dtype=bool)
+def _pairs_beside_change(label: np.ndarray, nodes: np.ndarray, tile: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pairs of neighbouring nodes in one tile (``tile``: each index's tile along its axis) with other labels, one
+    of them among ``nodes`` (rows of indices into ``label``), each pair once: (lower node, upper node, axis)."""
+    lows, axes = [], []
     for d in range(label.ndim):
         for step in (-1, 1):
             other = nodes.copy()
             other[:, d] += step
             inside = (other[:, d] >= 0) & (other[:, d] < label.shape[d])
             inside[inside] &= tile[d][other[inside, d]] == tile[d][nodes[inside, d]]
-            out[inside] |= label[tuple(other[inside].T)] != label[tuple(nodes[inside].T)]
-    return out
+            differ = np.zeros(nodes.shape[0], dtype=bool)
+            differ[inside] = label[tuple(other[inside].T)] != label[tuple(nodes[inside].T)]
+            lows.append(np.minimum(nodes[differ], other[differ]))
+            axes.append(np.full(int(differ.sum()), d, dtype=np.int64))
+    low, axis = np.concatenate(lows), np.concatenate(axes)
+    if low.shape[0]:
+        key = np.unique(np.column_stack([low, axis]), axis=0)
+        low, axis = key[:, :-1], key[:, -1]
+    high = low.copy()
+    high[np.arange(low.shape[0]), axis] += 1
+    return low, high, axis
 
 
 def _halves(lo: np.ndarray, hi: np.ndarray, along: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -168,7 +187,11 @@ class _Chunk:
         self.scene, self.system = scene, systems.of(scene)
         self.names = [a.name for a in scene.grid]
         self.nodes = [a.array[s:e] for a, (s, e) in zip(scene.grid, location, strict=True)]
-        self.edges = [edges(a.array)[s : e + 1] for a, (s, e) in zip(scene.grid, location, strict=True)]
+        # each cell's two edges per axis (equal along a discrete axis): a box of cells [lo, hi) spans lower[lo] to upper[hi - 1]
+        cut = [cell_edges(a) for a in scene.grid]
+        self.lower = [lo[s:e] for (lo, _), (s, e) in zip(cut, location, strict=True)]
+        self.upper = [hi[s:e] for (_, hi), (s, e) in zip(cut, location, strict=True)]
+        self.spans = np.array([a.continuous for a in scene.grid], dtype=bool)
         self.provable = provable(scene)
         self.cost = self.system.box_cost(scene) if self.provable else 1.0
         # tiles: index along each axis of the chunk's cells; tiles numbered in C order of the chunk's tile grid
@@ -180,7 +203,8 @@ class _Chunk:
         self._tiles = (np.array(list(itertools.product(*starts)), dtype=np.int64).reshape(-1, len(location)),
                        np.array(list(itertools.product(*stops)), dtype=np.int64).reshape(-1, len(location)))
         cells = np.prod(self._tiles[1] - self._tiles[0], axis=1)
-        self.budget = BOX_BUDGET * cells.astype(np.float64)  # per tile, in node proofs: no box dearer than its tile
+        self.credit = SPARE * cells.astype(np.float64)  # per tile, in node proofs (SPARE)
+        self.reserve = RESERVE * cells.astype(np.float64)  # credit that only the labels beside a change may spend
         self.stopped = np.zeros(cells.size, dtype=bool)
 
     def tiles(self) -> tuple[np.ndarray, np.ndarray]:
@@ -201,6 +225,17 @@ class _Chunk:
         wins = np.bincount(tile[tried & small & proved], minlength=n)
         self.stopped |= (attempts >= PAYS_MIN) & (wins < PAYS * attempts)
 
+    def afford(self, tile: np.ndarray, cost: float, keep: np.ndarray | None = None) -> np.ndarray:
+        """Which of several proofs, each of ``cost`` node proofs in the tiles ``tile``, their tiles' credit (less
+        ``keep``, per tile) pays for (the k-th of a tile, in the given order, if it pays for k), charged to it."""
+        order = np.argsort(tile, kind="stable")
+        first = np.searchsorted(tile[order], tile[order], side="left")
+        rank = np.empty(tile.size, dtype=np.int64)
+        rank[order] = np.arange(tile.size) - first
+        paid = (rank + 1) * cost <= self.credit[tile] - (0.0 if keep is None else keep[tile])
+        self.credit -= cost * np.bincount(tile[paid], minlength=self.credit.size)
+        return paid
+
     def values(self, index: np.ndarray) -> dict[str, np.ndarray]:
         """Grid-axis values of the nodes ``index`` (rows of chunk indices)."""
         return {name: v[index[:, d]] for d, (name, v) in enumerate(zip(self.names, self.nodes, strict=True))}
@@ -209,8 +244,8 @@ class _Chunk:
         """(label, proved, tried, along) of the boxes of cells [lo, hi) (chunk indices per axis) in the tiles ``tile``
         (``tile_of(lo)``), each tried while its tile's budget lasts (in the given order within a tile); along (boxes,
         axes): the axes a box not proved is worth cutting along (``System.prove_and_cut_boxes``)."""
-        return self._prove({n: e[lo[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges, strict=True))},
-                           {n: e[hi[:, d]] for d, (n, e) in enumerate(zip(self.names, self.edges, strict=True))}, tile)
+        return self._prove({n: e[lo[:, d]] for d, (n, e) in enumerate(zip(self.names, self.lower, strict=True))},
+                           {n: e[hi[:, d] - 1] for d, (n, e) in enumerate(zip(self.names, self.upper, strict=True))}, tile)
 
     def _prove(self, lower: dict, upper: dict, tile: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         npts = tile.size
@@ -219,13 +254,7 @@ class _Chunk:
         along = np.ones((npts, len(self.names)), dtype=bool)
         if not self.provable or npts == 0:
             return label, proved, tried, along
-        # the k-th box of a tile (in order) is tried if the tile can still pay for k boxes
-        order = np.argsort(tile, kind="stable")
-        first = np.searchsorted(tile[order], tile[order], side="left")
-        rank = np.empty(npts, dtype=np.int64)
-        rank[order] = np.arange(npts) - first
-        tried = (rank + 1) * self.cost <= self.budget[tile]
-        self.budget -= self.cost * np.bincount(tile[tried], minlength=self.budget.size)
+        tried = self.afford(tile, self.cost, self.reserve)
         rows = np.flatnonzero(tried)
         if rows.size:
             got, ok, cut = self.system.prove_and_cut_boxes(self.scene, {k: v[rows] for k, v in lower.items()},
@@ -245,23 +274,30 @@ class _Chunk:
         if not self.provable:
             return cell
         node_label = label[tuple(nodes.T)]
-        d = nodes.shape[1]
-        near = np.flatnonzero(_beside_change(label, nodes, self.axis_tile))
-        if near.size:
-            # the labels at those cells' 2^d corners, each corner computed once however many cells share it
-            sides = [np.array(s) for s in itertools.product((0, 1), repeat=d)]
-            corners = np.concatenate([nodes[near] + s for s in sides])
-            unique, back = np.unique(corners, axis=0, return_inverse=True)
-            at = {n: e[unique[:, k]] for k, (n, e) in enumerate(zip(self.names, self.edges, strict=True))}
-            corner_label = self.system.evaluate(self.system.labels_only(self.scene), at)[self.system.label].reshape(-1)[back.reshape(-1)]
-            changed = np.any(corner_label.reshape(len(sides), -1) != node_label[near][None, :], axis=0)
-            cell[near[changed]] = CONTAINS_CHANGE
+        tile = self.tile_of(nodes)
+        # A change between two neighbouring nodes lies on the segment joining them, which crosses their shared face
+        # at one point: its label differs from one node's at least, and proves a change in that node's cell.  One
+        # label a pair of neighbours (a cell's corners would take 2^d, each shared by fewer cells).
+        a, b, axis = _pairs_beside_change(label, nodes, self.axis_tile)
+        paid = self.afford(self.tile_of(a), 1.0)
+        self.reserve[:] = 0.0  # spent or not, what is left now pays for sub-boxes
+        a, b, axis = a[paid], b[paid], axis[paid]
+        if a.size:
+            face = np.column_stack([self.nodes[k][a[:, k]] for k in range(len(self.names))])
+            rows = np.arange(a.shape[0])
+            face[rows, axis] = np.array([self.upper[k][a[r, k]] for r, k in zip(rows, axis, strict=True)])
+            at = {n: face[:, k] for k, n in enumerate(self.names)}
+            mid = self.system.evaluate(self.system.labels_only(self.scene), at)[self.system.label].reshape(-1)
+            changed = np.zeros(label.shape, dtype=bool)
+            for side in (a, b):
+                other = mid != label[tuple(side.T)]
+                changed[tuple(side[other].T)] = True
+            cell[changed[tuple(nodes.T)]] = CONTAINS_CHANGE
         # Sub-boxes between the node and the cell's edges, halved while they fail and pay.
         todo = np.flatnonzero(sub_boxes & (cell == NODE_ONLY))
         lower, upper, owner = self._sub_boxes(nodes[todo], todo)
         whole = np.zeros(nodes.shape[0], dtype=bool)
         whole[todo] = True
-        tile = self.tile_of(nodes)
         for _ in range(SUB_ROUNDS):
             if owner.size == 0:
                 break
@@ -278,18 +314,25 @@ class _Chunk:
         cell[(cell == NODE_ONLY) & whole] = WHOLE_CELL
         return cell
 
+    def _sides(self) -> list[np.ndarray]:
+        """The corners of a cell as sides (0: lower edge, 1: upper) per axis, both only along the axes it spans."""
+        return [np.array(s) for s in itertools.product(*[(0, 1) if spans else (0,) for spans in self.spans])]
+
+    def _corner(self, nodes: np.ndarray, side: np.ndarray) -> np.ndarray:
+        """The corner ``side`` of the cells of ``nodes``: grid-axis values, one column per axis."""
+        return np.column_stack([(self.upper[k] if side[k] else self.lower[k])[nodes[:, k]] for k in range(len(self.names))])
+
     def _sub_boxes(self, nodes: np.ndarray, owner: np.ndarray):
-        """The 2^d boxes between each node and its cell's corners (one per corner), with the cell that owns them."""
+        """The boxes between each node and its cell's corners (one per corner), with the cell that owns them."""
         lower: dict[str, list[np.ndarray]] = {n: [] for n in self.names}
         upper: dict[str, list[np.ndarray]] = {n: [] for n in self.names}
         owners = []
-        d = nodes.shape[1] if nodes.size else len(self.names)
-        for side in itertools.product((0, 1), repeat=d):
+        for side in self._sides():
+            corner = self._corner(nodes, side)
             for k, name in enumerate(self.names):
                 node = self.nodes[k][nodes[:, k]]
-                edge = self.edges[k][nodes[:, k] + side[k]]
-                lower[name].append(np.minimum(node, edge))
-                upper[name].append(np.maximum(node, edge))
+                lower[name].append(np.minimum(node, corner[:, k]))
+                upper[name].append(np.maximum(node, corner[:, k]))
             owners.append(owner)
         return ({k: np.concatenate(v) for k, v in lower.items()}, {k: np.concatenate(v) for k, v in upper.items()},
                 np.concatenate(owners) if owners else owner)

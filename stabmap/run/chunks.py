@@ -23,20 +23,25 @@ from ..systems.base import SceneBase
 
 TASK_SECONDS = 0.5  # aimed-for run time of one task on one core
 BLOCK_SECONDS = TASK_SECONDS / 2  # aimed-for run time of one chunk of the grid (a task holds one or several)
+# A chunk decided cell by cell proves its boxes round by round, one call of the kernels per round for all its tiles,
+# and a call costs a few milliseconds of Python besides its boxes: chunks of several tiles make fewer, fuller calls.
+CELL_BLOCK_SECONDS = 4 * BLOCK_SECONDS
 MAX_CHUNK_POINTS = 1 << 18
 MAX_CHUNK_BYTES = 64 << 20  # the points' input arrays of one task
 MIN_CHUNK_POINTS = 16  # the time rule never cuts chunks smaller than this (balance may, on tiny grids)
 PROBE_RUNS, PROBE_RUN = 8, 64  # the probe: 8 runs of 64 neighbouring points along the fastest axis
 
 
-def chunk_points_for(scene: SceneBase, seconds_per_point: float, threads: int, npoints: int | None = None) -> int:
-    """Points per chunk: about BLOCK_SECONDS of work at the measured ``seconds_per_point``, at most
-    MAX_CHUNK_BYTES of inputs and MAX_CHUNK_POINTS points, and at least eight chunks per thread.
+def chunk_points_for(scene: SceneBase, seconds_per_point: float, threads: int, npoints: int | None = None,
+                     seconds: float = BLOCK_SECONDS) -> int:
+    """Points per chunk: about ``seconds`` of work (BLOCK_SECONDS; CELL_BLOCK_SECONDS for an atlas decided cell by
+    cell) at the measured ``seconds_per_point``, at most MAX_CHUNK_BYTES of inputs and MAX_CHUNK_POINTS points, and
+    at least eight chunks per thread.
 
     ``npoints`` is the number of points to cut (default: the whole grid).
     """
     total = math.prod(scene.shape) if npoints is None else npoints
-    by_time = max(MIN_CHUNK_POINTS, BLOCK_SECONDS / max(seconds_per_point, 1e-9))
+    by_time = max(MIN_CHUNK_POINTS, seconds / max(seconds_per_point, 1e-9))
     by_memory = MAX_CHUNK_BYTES // max(1, systems.of(scene).input_bytes(scene))
     balance = max(1, total // (8 * max(1, threads)))
     return int(max(1, min(by_time, by_memory, MAX_CHUNK_POINTS, balance)))

@@ -26,6 +26,7 @@ from ..version import __version__
 from . import cells
 
 PROBE_SECONDS = 0.2  # a probe stops once it has timed this much work
+PROBE_PART = 4  # a probe of cells times the first quarter of a tile along each axis (a sixteenth of a 2-D tile)
 
 _warm: set[str] = set()  # the systems whose kernels this process has loaded
 _warm_lock = threading.Lock()
@@ -117,18 +118,27 @@ def probe(scene: SceneBase, values: dict[str, np.ndarray]) -> tuple[int, float]:
 
 
 def probe_tiles(scene: SceneBase, locations: list) -> tuple[int, float]:
-    """Time whole tiles decided cell by cell (``evaluate_block``; ``stabmap.run.chunks.tile_locations``) for up to
-    PROBE_SECONDS, after one untimed tile that loads what the kernels load lazily.  Returns (points, seconds)."""
-    evaluate_block(scene, locations[0])
+    """Time parts of tiles decided cell by cell (``evaluate_block``; ``stabmap.run.chunks.tile_locations``) for up to
+    PROBE_SECONDS, after a few untimed cells that load what the kernels load lazily.  Returns (points, seconds).
+
+    Each part is the tile's first PROBE_PART along every axis it spans: the probe's work is thrown away, and a whole
+    tile of a long chain takes seconds."""
+    evaluate_block(scene, _part(locations[0], 2))
     done, spent = 0, 0.0
-    for location in locations[1:]:
+    for location in locations:
         if spent >= PROBE_SECONDS:
             break
+        part = _part(location, PROBE_PART)
         t0 = time.perf_counter()
-        evaluate_block(scene, location)
+        evaluate_block(scene, part)
         spent += time.perf_counter() - t0
-        done += math.prod(b - a for a, b in location)
+        done += math.prod(b - a for a, b in part)
     return done, spent
+
+
+def _part(location: tuple[tuple[int, int], ...], share: float) -> tuple[tuple[int, int], ...]:
+    """The first 1/share of ``location`` along each axis (at least one point, and at least two where it has two)."""
+    return tuple((a, a + max(min(b - a, 2), int((b - a) / share))) for a, b in location)
 
 
 def evaluate_points(scene: SceneBase, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

@@ -3,7 +3,10 @@
 An axis is named exactly like the parameter it scans (the name becomes the
 Dataset dimension) and holds its values, sorted and distinct.  In TOML it is
 ``name = { start = .., stop = .., num = .., scale = "linear" | "log" }`` or
-``name = { values = [...] }``.  Which names exist and what values they may take
+``name = { values = [...] }``.  An axis given as a list of values is **discrete**: a set of separate cases, so a
+grid cell does not span it (its CF bounds are the value itself) and cells are proved in the other axes only;
+``discrete = true`` makes a start/stop/num axis discrete too, ``discrete = false`` makes a list continuous.
+Which names exist and what values they may take
 is the system's (``parameter``, a function of the name).  A spin-rate axis may be
 given in rpm or Hz (``start = "5000 rpm"``, one unit for the whole axis): its
 values are stored in rad/s and the unit is kept as the axis's ``display_units``.
@@ -21,7 +24,7 @@ from . import units
 from .values import Parameter, check_value, no_unknown
 
 SCALES = ("linear", "log", "values")
-_AXIS_KEYS = {"start", "stop", "num", "scale", "values", "display_units"}
+_AXIS_KEYS = {"start", "stop", "num", "scale", "values", "display_units", "discrete"}
 _NUMBER = Parameter("", "", "")  # any finite number: the limits are the system's (check_axes)
 
 
@@ -33,6 +36,8 @@ class Axis:
     values: tuple[float, ...]
     scale: str = "linear"  # "linear" | "log" | "values" (listed explicitly)
     display_units: str = ""  # a spin rate's unit for display, "rpm" or "Hz"; "": the stored unit (values are SI)
+    # separate cases rather than samples of a continuum: cells do not span the axis (None: scale == "values")
+    discrete: bool | None = None
 
     def __post_init__(self):
         where = f"grid.{self.name}"
@@ -47,6 +52,15 @@ class Axis:
         if self.scale == "log" and min(self.values) <= 0:
             raise StabmapError(f'{where}: scale = "log" needs values > 0, got {min(self.values)}')
         object.__setattr__(self, "display_units", units.check_display(f"{where}.display_units", self.display_units))
+        if self.discrete is None:
+            object.__setattr__(self, "discrete", self.scale == "values")
+        elif not isinstance(self.discrete, bool):
+            raise StabmapError(f"{where}.discrete must be true or false, got {self.discrete!r}")
+
+    @property
+    def continuous(self) -> bool:
+        """Whether grid cells span the axis: a scanned (not discrete) axis of more than one value."""
+        return len(self.values) > 1 and not self.discrete
 
     @property
     def array(self) -> np.ndarray:
@@ -58,8 +72,9 @@ class Axis:
         if self.scale in ("linear", "log") and n > 2:
             spaced = np.geomspace if self.scale == "log" else np.linspace
             if np.array_equal(spaced(self.values[0], self.values[-1], n), self.array):
-                return {"start": self.values[0], "stop": self.values[-1], "num": n, "scale": self.scale, **self._display()}
-        return {"values": list(self.values), "scale": self.scale, **self._display()}
+                return {"start": self.values[0], "stop": self.values[-1], "num": n, "scale": self.scale, **self._display(),
+                        **({"discrete": True} if self.discrete else {})}
+        return {"values": list(self.values), "scale": self.scale, **self._display(), **({} if self.discrete else {"discrete": False})}
 
     def _display(self) -> dict:
         return {"display_units": self.display_units} if self.display_units else {}
@@ -89,7 +104,7 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
         where = f"grid.{name}"
         no_unknown(spec, _AXIS_KEYS, where)
         if "values" in spec:
-            extra = set(spec) - {"values", "scale", "display_units"}
+            extra = set(spec) - {"values", "scale", "display_units", "discrete"}
             if extra:
                 raise StabmapError(f"{where}: give either values or start/stop/num, not both (remove {sorted(extra)[0]!r})")
             values = spec["values"]
@@ -98,7 +113,7 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
             converted = [units.in_si(f"{where}.values[{i + 1}]", v, info.units) for i, v in enumerate(values)]
             unit = units.common_unit(f"{where}.values", values)
             values = converted
-            axes.append(Axis(name, tuple(values), spec.get("scale", "values"), _display(spec, unit)))
+            axes.append(Axis(name, tuple(values), spec.get("scale", "values"), _display(spec, unit), spec.get("discrete", True)))
             continue
         for key in ("start", "stop", "num"):
             if key not in spec:
@@ -121,7 +136,7 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
             values = np.geomspace(start, stop, num)
         else:
             raise StabmapError(f'{where}.scale must be "linear" or "log", got {scale!r}')
-        axes.append(Axis(name, tuple(float(v) for v in values), scale, _display(spec, unit)))
+        axes.append(Axis(name, tuple(float(v) for v in values), scale, _display(spec, unit), spec.get("discrete", False)))
     return tuple(axes)
 
 

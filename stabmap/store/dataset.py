@@ -11,7 +11,9 @@ import xarray as xr
 from ..version import __version__
 
 BOUNDS_DIM = "bnds"  # the CF bounds variables' second dimension: a cell's two edges
-FORMAT_VERSION = 5  # 4: stabmap_system; every variable of the system written as declared; 5: cell and axis bounds
+# 4: stabmap_system; every variable of the system written as declared; 5: cell and axis bounds; 6: discrete axes (bounds
+# equal to the value)
+FORMAT_VERSION = 6
 CRITICAL_KIND = "critical values"  # the global attribute stabmap_kind of every critical-values Dataset
 
 
@@ -30,8 +32,12 @@ def edges(values) -> np.ndarray:
     return out
 
 
-def bounds(values) -> np.ndarray:
-    """CF bounds of an axis, shape (len, 2): each grid cell's two edges, in the axis's order."""
+def bounds(values, discrete: bool = False) -> np.ndarray:
+    """CF bounds of an axis, shape (len, 2): each grid cell's two edges, in the axis's order; along a discrete axis
+    (separate cases, ``Axis.discrete``) both edges are the value itself, so no cell spans two cases."""
+    if discrete:
+        values = np.asarray(values, dtype=np.float64)
+        return np.column_stack([values, values])
     e = edges(values)
     return np.column_stack([e[:-1], e[1:]])
 
@@ -48,8 +54,9 @@ def coordinates(system, scene, skip: tuple[str, ...] = ()) -> dict:
         if axis.display_units:  # the unit the scene gave (rpm, Hz): values stay SI, readers may show them in it
             attrs["display_units"] = axis.display_units
         coords[axis.name] = (axis.name, axis.array, attrs)
-        coords[name] = ((axis.name, BOUNDS_DIM), bounds(axis.array), {"units": info.units,
-                        "long_name": f"edges of the grid cells along {axis.name} (midpoints between grid values)"})
+        what = "the value itself (a discrete axis: separate cases)" if axis.discrete else "midpoints between grid values"
+        coords[name] = ((axis.name, BOUNDS_DIM), bounds(axis.array, bool(axis.discrete)), {"units": info.units,
+                        "long_name": f"edges of the grid cells along {axis.name} ({what})"})
     for key, value in system.fixed_values(scene).items():
         info = system.parameter(scene, key)
         coords[key] = ((), np.float64(value), {"units": info.units, "long_name": info.long_name})

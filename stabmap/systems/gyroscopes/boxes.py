@@ -228,6 +228,6 @@ def box_cost(scene: Scene) -> float:
     scripts/bench_cells.py (a box of two bodies costs about 23 points, of six about 270, of eight about 1400)."""
     n = scene.n
     per_axis = [n + 1 if _is_spin(scene, a.name) else degree(scene, a.name) + 1 if _mechanical(scene, a.name) else 1
-                for a in scene.grid if len(a.values) > 1]
+                for a in scene.grid if a.continuous]
     nodes = float(np.prod(per_axis)) if len(per_axis) <= 2 else 1.0
     return nodes * (1.0 + n / 3.0 + 2.0**n / 64.0)
