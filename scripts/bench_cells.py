@@ -13,11 +13,14 @@ Three ways over the same grid, all cores, kernels loaded before any timing:
 Columns: seconds of each, node proofs per cell (nodes computed, and cell corners evaluated) and box proofs per cell
 of the cells way, the share of cells in each class, and the peer's labels that differ from the proved ones.
 
+The bundled scenes paper-n2-fixed and paper-n3-fixed on the same grid, and the README's scene (omega x m_2 x the
+listed K_1 = [0, 10, 120], a discrete axis) on 300 x 100 x 3 points.
+
 Scenes of the degree ladder: a seeded random fixed chain of n bodies with ``modes`` liquid modes each (the
 parameter ranges of scripts/bench_kernel.py), scanned over omega in [1, 100] x K_1 in [0, 40] (c_1 for n = 1).
 
 Stress set (quick mode: E = 1e-6 only): the two-body chain of the narrow-window case, `WINDOW` in tests/systems.py with its liquid's E from 1e-3 down to 1e-8
-(unstable bands down to 1e-6 rad/s wide), scanned along omega at 100 values: every boundary (critical values,
+(unstable bands down to 1e-6 rad/s wide), scanned along omega at STRESS_POINTS = 1000 values: every boundary (critical values,
 located to 1e-10 and checked against the exact discriminant by tests/test_boxes.py) must lie in a cell that is
 not whole_cell, and whole cells must hold their label at random interior points in exact arithmetic.
 """
@@ -48,6 +51,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_critical import REGIONS  # noqa: E402  (the narrow-window case of tests/systems.py)
 from float_peer import float_atlas  # noqa: E402
 
+STRESS_POINTS = 1000  # values of omega on the stress scene: bands far narrower than a step, cells that boxes prove
 LADDER = [(3, 0), (2, 1), (3, 2), (4, 2), (6, 2), (6, 4), (8, 4)]  # degrees 6, 6, 12, 16, 24, 36, 48
 QUICK_LADDER = [(2, 1), (3, 2)]
 
@@ -79,8 +83,8 @@ class Tally:
         self.lock = threading.Lock()
 
     def __enter__(self):
-        self.saved = (cells._Chunk._prove, cells._Chunk.classify)
-        prove, classify = self.saved
+        self.saved = (cells._Chunk._prove, cells._Chunk.classify, cells._Chunk.afford)
+        prove, classify, afford = self.saved
         tally = self
 
         def counted_prove(chunk, lower, upper, tile):
@@ -94,24 +98,34 @@ class Tally:
         def counted_classify(chunk, nodes, label, sub_boxes):
             with tally.lock:
                 tally.counts["nodes"] += nodes.shape[0]
-                near = cells._beside_change(label, nodes, chunk.axis_tile) if chunk.provable else np.zeros(0, dtype=bool)
-                if near.any():  # the corners of those cells, each computed once per chunk
-                    d = nodes.shape[1]
-                    corners = np.concatenate([nodes[near] + np.array(s) for s in np.ndindex(*(2,) * d)])
-                    tally.counts["corners"] += np.unique(corners, axis=0).shape[0]
             return classify(chunk, nodes, label, sub_boxes)
 
-        cells._Chunk._prove, cells._Chunk.classify = counted_prove, counted_classify
+        def counted_afford(chunk, tile, cost, keep=None):
+            paid = afford(chunk, tile, cost, keep)
+            if cost == 1.0:  # labels at the faces of cells beside a change, one node proof each
+                with tally.lock:
+                    tally.counts["faces"] += int(paid.sum())
+            return paid
+
+        cells._Chunk._prove, cells._Chunk.classify, cells._Chunk.afford = counted_prove, counted_classify, counted_afford
         return self
 
     def __exit__(self, *exc):
-        cells._Chunk._prove, cells._Chunk.classify = self.saved
+        cells._Chunk._prove, cells._Chunk.classify, cells._Chunk.afford = self.saved
 
 
 def _timed(f, *args, **kwargs):
     t0 = time.perf_counter()
     out = f(*args, **kwargs)
     return out, time.perf_counter() - t0
+
+
+def readme_scene():
+    """The scene of the README's walkthrough (its scene.toml): omega x m_2 x the listed K_1 = [0, 10, 120]."""
+    import re
+
+    text = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    return stabmap.loads_scene(re.search(r"<!-- doc-test: file scene.toml -->\n```toml\n(.*?)```", text, re.S).group(1))
 
 
 def compare(scene, label: str) -> dict:
@@ -130,7 +144,7 @@ def compare(scene, label: str) -> dict:
     cell = ds["cell"].values
     return {
         "scene": label, "degree": scene.degree, "points": npts, "peer_s": t_peer, "nodes_s": t_nodes, "cells_s": t_cells,
-        "node_proofs_per_cell": (tally.counts["nodes"] + tally.counts["corners"]) / npts,
+        "node_proofs_per_cell": (tally.counts["nodes"] + tally.counts["faces"]) / npts,
         "box_proofs_per_cell": tally.counts["boxes"] / npts,
         "shares": {m: float((cell == v).mean()) for v, m in CELL.flags},
         "peer_wrong": int((peer != label_cells).sum()),
@@ -161,7 +175,7 @@ def stress(E: float, rng) -> dict:
 
     table = tomllib.loads(REGIONS)
     table["bodies"] = [dict(b, fluid=dict(b["fluid"], E=[E])) for b in table["bodies"]]
-    scene = from_dict(table)
+    scene = resample(from_dict(table), omega=STRESS_POINTS)
     ds = stabmap.compute_atlas(scene, progress=False)
     crit = critical(scene, "omega", rtol=1e-10, progress=False)
     keep = np.isfinite(crit["boundary_lower"].values)
@@ -201,8 +215,11 @@ def main(argv=None) -> dict:
         print(f"| {r['scene']} | {r['degree']} | {r['points']:,} | {r['peer_s']:.2f} | {r['nodes_s']:.2f} | {r['cells_s']:.2f} "
               f"| {r['cells_s'] / r['peer_s']:.2f} | {r['cells_s'] / r['nodes_s']:.2f} | {r['node_proofs_per_cell']:.3f} "
               f"| {r['box_proofs_per_cell']:.3f} | {_shares(r['shares'])} | {r['peer_wrong']} |", flush=True)
-    for name in ("paper-n2-fixed", "paper-n3-fixed"):
-        scene = resample(stabmap.example(name), **{a.name: num for a in stabmap.example(name).grid})
+    bundled = [(name, resample(stabmap.example(name), **{a.name: num for a in stabmap.example(name).grid}))
+               for name in ("paper-n2-fixed", "paper-n3-fixed")]
+    readme = readme_scene()
+    bundled.append(("README scene", resample(readme, omega=24, m_2=16) if args.quick else resample(readme, omega=300, m_2=100)))
+    for name, scene in bundled:
         r = compare(scene, name)
         out["ladder"].append(r)
         print(f"| {r['scene']} | {r['degree']} | {r['points']:,} | {r['peer_s']:.2f} | {r['nodes_s']:.2f} | {r['cells_s']:.2f} "

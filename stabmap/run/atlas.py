@@ -278,12 +278,17 @@ def compute_to_file(
     return FileReport(path, len(layout.locations), len(todo), len(done))
 
 
+def _tiles(shape: tuple[int, ...], tile: tuple[int, ...]) -> int:
+    """How many tiles cover a grid of ``shape``."""
+    return math.prod(-(-n // t) for n, t in zip(shape, tile, strict=True))
+
+
 class _Layout:
     """The chunks of one run's grid (a resumed run keeps its checkpoint's), where their tasks go, and the run's
     progress line (closed on leaving the ``with``).
 
     Without a checkpoint or ``chunk_points``, a probe task first times a few hundred points spread over the grid
-    (``stabmap.run.tasks.probe``): the chunks hold about BLOCK_SECONDS of work at that pace (CELL_BLOCK_SECONDS decided cell by cell), and tasks of several
+    (``stabmap.run.tasks.probe``): the chunks hold about BLOCK_SECONDS of work at that pace, and tasks of several
     chunks about TASK_SECONDS, resized as tasks finish.
     """
 
@@ -307,7 +312,8 @@ class _Layout:
                 )
         elif chunk_points is not None:
             chunks = chunk_shape(scene.shape, chunk_points, order, tile)
-        elif self.total // (8 * run.slots()) <= MIN_CHUNK_POINTS:  # a small grid: balance decides, not time
+        elif self.total // (8 * run.slots()) <= MIN_CHUNK_POINTS or (tile is not None and _tiles(scene.shape, tile) <= 8 * run.slots()):
+            # a small grid, or one of few tiles (a chunk holds at least one): balance decides, not time
             chunks = chunk_shape(scene.shape, chunk_points_for(scene, 0.0, run.slots()), order, tile)
         else:
             try:
