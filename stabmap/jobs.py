@@ -133,15 +133,13 @@ def _no_checkpoint():
 
 
 def summary_line(system, s: dict, evaluated=None) -> str:
-    """One line about a finished atlas: points, stable share, who decided, the saving of refinement."""
-    if system.stable_label is not None:
-        line = f"{s['points']} points, {100 * s['stable_fraction']:.1f} % {system.stable_word}"
-    else:  # a system without stability: how often each class of its label occurs
-        line = f"{s['points']} points; " + ", ".join(f"{system.class_name(v)}: {c}" for v, c in s[system.label].items())
+    """One line about a finished atlas: its headline (:mod:`stabmap.read.headline`), who decided, the saving of
+    refinement."""
+    line = s["headline"]
+    if system.stable_label is None:  # a system without stability: how often each class of its label occurs
+        line += "; " + ", ".join(f"{system.class_name(v)}: {c}" for v, c in s[system.label].items())
     if system.provenance in s:
         line += "; decided by " + ", ".join(f"{m.replace('_', ' ')} {c}" for m, c in s[system.provenance].items() if c)
-    if "cell_volume" in s and evaluated is None:
-        line += f"; label proved over {100 * s['cell_volume']['whole_cell']:.1f} % of the scanned volume (whole cells)"
     if evaluated is not None and int(evaluated) >= s["points"]:
         line += ("; refined: nothing to infer, every point computed (the grid is too coarse to refine: the default "
                  "stride is 1 along axes of fewer than 129 points; --coarse-stride sets it, docs/refine.md)")

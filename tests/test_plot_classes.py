@@ -1,5 +1,6 @@
 """What a figure says about its classes: xarray's own plots in stabmap's colours, legends that name unstable classes,
-and titles that give the share of the scanned area the cells prove (checked against Maievskii's closed form).
+and titles that give the grid points' share, then the share of the scanned area the cells prove (checked against
+Maievskii's closed form).
 """
 
 from __future__ import annotations
@@ -15,7 +16,9 @@ from scipy.integrate import quad
 
 import stabmap
 from stabmap.errors import StabmapError
+from stabmap.read.areas import area_shares
 from stabmap.read.plot import atlas_figure, class_label, colour
+from stabmap.read.summary import cell_sizes
 from stabmap.systems import closed as closed_system
 from stabmap.systems import gyroscopes
 from stabmap.systems.gyroscopes.outputs import STABILITY, stability_from_pairs
@@ -167,25 +170,31 @@ def test_the_drawn_legend_names_stable_and_unstable(dry):
 
 
 # ------------------------------------------------------------------------------------------------------- titles
-def test_title_gives_the_proved_share_of_the_area_bracketing_the_closed_form(dry):
-    exact = exact_stable_share()
+def test_title_gives_the_grid_points_then_the_proved_share_of_the_area(dry):
     title = atlas_figure(dry).axes[0].get_title().replace("\n", " ")
-    assert "of the scanned area proved stable" in title and "grid points" not in title
-    stable, unstable, undecided, change = numbers(title)
-    assert stable + unstable + undecided == pytest.approx(100.0, abs=0.15)
-    # a proof cannot claim more than the truth, and what it leaves undecided holds the rest
-    assert stable / 100 <= exact + 1e-3 and exact - 1e-3 <= (stable + undecided) / 100
-    assert unstable / 100 <= 1 - exact + 1e-3
-    assert 0 < change <= undecided < 15
-    # the same share from the file's own bounds variables (the cells proved), whole stable cells only
+    points = 100 * float((dry.n_complex_pairs == 0).mean())
+    assert f"{points:.1f} % of {dry.n_complex_pairs.size:,} grid points stable (every point proved);" in title
+    assert "of the scanned area" in title and "undecided" not in title
+    _, whole, change = numbers(title)
+    # the cells' shares from the file's own bounds variables (the cells proved), each cell weighted by its size
     w = np.diff(dry.omega_bounds.values, axis=1)[:, 0]
     h = np.diff(dry.c_1_bounds.values, axis=1)[:, 0]
     area = np.outer(w, h) if dry.stability.dims == ("omega", "c_1") else np.outer(h, w)
-    proved = (dry.cell.values == 1) & (dry.n_complex_pairs.values == 0)
-    assert stable == pytest.approx(100 * area[proved].sum() / area.sum(), abs=0.05)
-    # on this log axis the grid points' share is another number (80 %, the truth 69 %): the title does not give it
-    points = 100 * float((dry.n_complex_pairs == 0).mean())
-    assert abs(points - 100 * exact) > 5 and f"{points:.1f} %" not in title
+    assert whole == pytest.approx(100 * area[dry.cell.values == 1].sum() / area.sum(), abs=0.05)
+    assert change == pytest.approx(100 * area[dry.cell.values == 2].sum() / area.sum(), abs=0.05)
+    assert 85 < whole < 100 and 0 < change < 15
+
+
+def test_the_proved_stable_share_of_the_area_brackets_the_closed_form(dry):
+    # what panel titles give: on this log axis the grid points' share is another number (80 %, the truth 69 %)
+    exact = exact_stable_share()
+    d0, d1 = dry.n_complex_pairs.dims
+    (s,) = area_shares([dry.n_complex_pairs.values], [dry.cell.values], cell_sizes(dry, d0), cell_sizes(dry, d1), 0)
+    assert s.stable + s.unstable + s.change + s.undecided == pytest.approx(1.0)
+    # a proof cannot claim more than the truth, and what it leaves undecided holds the rest
+    assert s.stable <= exact + 1e-3 and exact - 1e-3 <= s.stable + s.change + s.undecided
+    assert s.unstable <= 1 - exact + 1e-3 and 0 < s.change <= s.change + s.undecided < 0.15
+    assert abs(float((dry.n_complex_pairs == 0).mean()) - exact) > 0.05
 
 
 def test_title_counts_grid_points_where_no_cell_is_proved():
@@ -196,10 +205,13 @@ def test_title_counts_grid_points_where_no_cell_is_proved():
     assert f"{share:.1f} % of {ds.n_complex_pairs.size:,} grid points stable" in title and "area" not in title
 
 
-def test_panels_give_their_own_proved_share(dry):
+def test_panels_give_their_own_shares(dry):
     # two panels: the atlas, and the atlas with every cell node_only (nothing proved over its area)
     k = xr.DataArray([0.0, 1.0], dims="K_1", name="K_1", attrs={"long_name": "stiffness of joint 1", "units": "N m rad-1"})
     both = xr.concat([dry, dry.assign(cell=dry.cell * 0)], dim=k, combine_attrs="override")
     fig = atlas_figure(both.transpose("omega", "c_1", "K_1", ...), facet="K_1")
     one, none = (ax.get_title() for ax in fig.subfigs[0].axes)
-    assert "% of its area proved stable" in one and numbers(one)[0] > 50 and numbers(none) == [0.0]
+    points = round(100 * float((dry.n_complex_pairs == 0).mean()))
+    whole = 100 * float(area_shares([dry.n_complex_pairs.values], [dry.cell.values], *(cell_sizes(dry, d) for d in dry.cell.dims), 0)[0].whole)
+    assert one.endswith(f"{points} % stable; label proved over {whole:.0f} % of its area") and whole > 85
+    assert none.endswith(f"({points} % stable)")  # nothing proved over a cell: no share of the area to give

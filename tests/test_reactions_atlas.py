@@ -156,7 +156,7 @@ def test_cli_atlas_info_query_plot(tmp_path, capsys):
     scene_file.write_text(SCENE)
     out, png = tmp_path / "a.nc", tmp_path / "a.png"
     assert main(["atlas", str(scene_file), "-o", str(out), "--png", str(png), "-q"]) == 0
-    assert "117 points; node 0:" in capsys.readouterr().err
+    assert "117 grid points (every point proved); cells: nothing proved between grid points; node 0:" in capsys.readouterr().err
     assert out.is_file() and png.read_bytes()[:4] == b"\x89PNG"
     assert main(["info", str(out)]) == 0
     text = capsys.readouterr().out

@@ -82,6 +82,7 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
     lines = textwrap.wrap(f"{name}: {a.get('title', '')}", width=WIDTH, subsequent_indent="    ")
     for line in system.describe(a):
         lines += textwrap.wrap(line, width=WIDTH, initial_indent="  ", subsequent_indent="    ")
+    lines += textwrap.wrap(s["headline"], width=WIDTH, initial_indent="  ", subsequent_indent="    ")  # before the details
     notes = scene_notes(a)
     lines.append("  axes:")
     dims = ds[system.label].dims
@@ -134,11 +135,9 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
         lines += wrapped("growth rate: ", [top, *(f"{m.replace('_', ' ')} {n}" for m, n in g["method"].items() if n)])
     for line in system.caveats(ds):
         lines += textwrap.wrap(line, width=WIDTH, initial_indent="  ", subsequent_indent="    ")
-    if "cell" in s:
-        share = s["cell_volume"]
-        lines += wrapped("cells: ", [f"{m.replace('_', ' ')} {n}" for m, n in s["cell"].items() if n])
-        lines += wrapped("  ", [f"the label is proved over {100 * share['whole_cell']:.2f} % of the scanned volume, "
-                                f"a change of label in {100 * share['contains_change']:.2f} %; docs/cells.md"])
+    if "cell" in s:  # their shares of the region are in the headline
+        counts = [f"{m.replace('_', ' ')} {n}" for m, n in s["cell"].items() if n]
+        lines += wrapped("cells: ", counts[:-1] + [counts[-1] + " (docs/cells.md)"])
     lines += provenance(a)
     return "\n".join(lines)
 

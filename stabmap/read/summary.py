@@ -9,6 +9,7 @@ from .. import systems
 from ..errors import StabmapError
 from ..store.dataset import edges, is_critical
 from ..store.variables import CELL
+from .headline import Headline
 
 
 def _counts(values) -> dict[int, int]:
@@ -29,7 +30,8 @@ def summary(ds: xr.Dataset) -> dict:
     ``stable_fraction``, the label's name (a
     histogram, e.g. ``n_complex_pairs``) and the provenance variable's name (counts by flag meaning, e.g.
     ``decided_by``).  An atlas with cells (``stabmap.run.cells``) adds ``cell`` (counts by flag meaning) and
-    ``cell_volume`` (each meaning's share of the scanned volume, cells weighted by their size).
+    ``cell_volume`` (each meaning's share of the scanned region, cells weighted by their size).  ``headline``: the
+    sentence that sums it all up (:mod:`stabmap.read.headline`), as ``stabmap info`` and figure titles print it.
     """
     if is_critical(ds):  # its own counts: intervals, boundaries, gaps per line
         from .table import critical_summary
@@ -61,7 +63,20 @@ def summary(ds: xr.Dataset) -> dict:
         out["cell_volume"] = volume_shares(ds)
     if "growth_rate" in ds:
         out["growth_rate"] = growth_rates(ds, system)
+    out["headline"] = headline(ds, out).text(system)
     return out
+
+
+def headline(ds: xr.Dataset, s: dict) -> Headline:
+    """What the headline of the whole atlas says (:mod:`stabmap.read.headline`), from its :func:`summary` ``s``."""
+    system = systems.of_atlas(ds.attrs)
+    cells, shares = s.get(CELL.name), s.get("cell_volume")
+    return Headline(
+        points=s["points"], stable=s["stable"] if system.stable_label is not None else None,
+        inferred=cells["not_proved"] if cells else 0, undecided=s["undecided"],
+        whole=shares["whole_cell"] if shares else None, change=shares["contains_change"] if shares else 0.0,
+        axes=scanned_axes(ds, ds[system.label].dims),
+    )
 
 
 def growth_rates(ds: xr.Dataset, system) -> dict:
@@ -81,14 +96,31 @@ def growth_rates(ds: xr.Dataset, system) -> dict:
 
 
 def cell_sizes(ds: xr.Dataset, dim: str) -> np.ndarray:
-    """The widths of the grid cells along ``dim`` (the midpoints between its values; ``stabmap.store.dataset.edges``);
-    an axis of one value has one cell of width 1, so that it weighs nothing."""
-    e = edges(ds[dim].values)
-    return np.abs(np.diff(e)) if e.size > 2 else np.ones(ds[dim].size)
+    """The widths of the grid cells along ``dim``: from its CF bounds variable when the atlas has one (the cells its
+    labels are proved on), else the midpoints between its values (``stabmap.store.dataset.edges``).
+
+    An axis whose cells all have width 0 weighs 1 per value: an axis of one value (it then weighs nothing), and a
+    discrete axis (a list of cases, bounds with both edges at the value), whose cases shares then average over.
+    """
+    w = _widths(ds, dim)
+    return w if np.any(w > 0) else np.ones(ds[dim].size)
+
+
+def _widths(ds: xr.Dataset, dim: str) -> np.ndarray:
+    name = ds[dim].attrs.get("bounds", f"{dim}_bounds")
+    if name in ds.variables and ds[name].ndim == 2 and ds[name].dims[0] == dim:
+        b = np.asarray(ds[name].values, dtype=np.float64)
+        return np.abs(b[:, 1] - b[:, 0])
+    return np.abs(np.diff(edges(ds[dim].values)))
+
+
+def scanned_axes(ds: xr.Dataset, dims) -> int:
+    """How many of ``dims`` span the region that cells tile: cells of some width (not one value, not a list of cases)."""
+    return sum(1 for d in dims if np.any(_widths(ds, d) > 0))
 
 
 def volume_shares(ds: xr.Dataset) -> dict[str, float]:
-    """Each ``cell`` meaning's share of the scanned volume (cells weighted by their size), chunk by chunk."""
+    """Each ``cell`` meaning's share of the scanned region (cells weighted by their size), chunk by chunk."""
     import dask.array as da
 
     from .blocks import as_dask, compute

@@ -23,6 +23,7 @@ from ...store.variables import CELL
 from ..blocks import compute
 from ..plot.captions import fixed_caption
 from ..plot.palette import BOUNDARY, CLASS_EDGE, system_colour
+from ..summary import summary
 from . import widgets
 from .frames import EAGER_POINTS, MAP_PIXELS, Frame, map_grid, read_frame
 from .page import MAX_MB, Page, budget, fitted
@@ -160,7 +161,9 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: l
 
     controls = widgets.sliders(ds, plan.sliders, plan.positions)
     radix = [len(plan.positions[s]) for s in plan.sliders]
-    titles = [title_html(ds, system, plan, f, at) for f, at in zip(chosen, plan.frames, strict=True)]
+    head = summary(ds)["headline"]  # of the whole atlas: the title of a single map, else in the caption
+    whole = not plan.sliders and not plan.fixed
+    titles = [title_html(ds, system, plan, f, at, head if whole else None) for f, at in zip(chosen, plan.frames, strict=True)]
     readout = widgets.readout()
     title = widgets.title(titles)
     describe = {"sliders": controls, "radix": radix, "tables": tables, "current": current}
@@ -182,7 +185,7 @@ title.text = titles[k];
                          frames=[[rect_columns(f), widgets.array(i), segment_columns(f.classes), segment_columns(f.stability)]
                                  for f, i in zip(chosen, ids, strict=True)])
     side = widgets.legend(plain(system.label_title), legend_entries(system, chosen))
-    return column(title, row(p, side), *controls, readout, widgets.caption(caption_lines(ds, plan, grid)))
+    return column(title, row(p, side), *controls, readout, widgets.caption(caption_lines(ds, plan, grid, None if whole else head)))
 
 
 def rect_columns(f: Frame) -> dict[str, np.ndarray]:
@@ -202,12 +205,15 @@ def where_text(ds: xr.Dataset, at: dict[str, int]) -> str:
     return "\n".join(value_text(ds, d, float(ds[d][i])) for d, i in at.items())
 
 
-def title_html(ds: xr.Dataset, system, plan: PagePlan, f: Frame, at: dict[str, int]) -> str:
-    """The title of one frame: the atlas's title, the share of this map's grid points proved stable, the values of
-    the sliders and of the axes fixed by ``sel``."""
+def title_html(ds: xr.Dataset, system, plan: PagePlan, f: Frame, at: dict[str, int], headline: str | None = None) -> str:
+    """The title of one frame: the atlas's title, the ``headline`` of a page that shows the whole atlas in one map
+    (:mod:`stabmap.read.headline`) or else the share of this map's grid points stable, the values of the sliders and
+    of the axes fixed by ``sel``."""
     total = sum(f.counts.values())
     lines = [f"<b>{escape(plain(ds.attrs.get('title', '') or 'stabmap atlas'))}</b>"]
-    if system.stable_label is not None:
+    if headline is not None:
+        lines.append(escape(headline))
+    elif system.stable_label is not None:
         share = 100 * f.counts.get(system.stable_label, 0) / max(1, total)
         lines.append(f"{share:.1f} % of the {total:,} grid points of this map {escape(system.stable_word)}")
     shown = [value_text(ds, d, float(ds[d][i])) for d, i in at.items()]
@@ -241,9 +247,12 @@ def legend_entries(system, chosen: list[Frame]) -> list[str]:
     return entries
 
 
-def caption_lines(ds: xr.Dataset, plan: PagePlan, grid) -> list[str]:
-    """The caption: the fixed parameters and caveats (as under the PNG maps), how blocks were drawn, the notes."""
-    lines = [plain(fixed_caption(ds, 10_000)).replace("\u00a0", " ")]
+def caption_lines(ds: xr.Dataset, plan: PagePlan, grid, headline: str | None = None) -> list[str]:
+    """The caption: the ``headline`` of the whole atlas when the maps show part of it (:mod:`stabmap.read.headline`;
+    each map's title has its own share of stable points), the fixed parameters and caveats (as under the PNG maps),
+    how blocks were drawn, the notes."""
+    lines = [f"whole atlas: {headline}"] if headline else []
+    lines.append(plain(fixed_caption(ds, 10_000)).replace("\u00a0", " "))
     fy, fx = grid.factors
     if (fy, fx) != (1, 1):
         lines.append(f"{ds.sizes[plan.x]:,}" + (f" × {ds.sizes[plan.y]:,}" if plan.y else "") + f" grid points drawn in blocks of {fx}"

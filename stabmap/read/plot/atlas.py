@@ -12,6 +12,7 @@ import xarray as xr
 
 from ... import systems
 from ..areas import AreaShares
+from ..headline import Headline
 from .captions import atlas_title, captioned_figure
 from .geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges, touches_stability
 from .labels import axis_label, display_ticks, log_axis, log_ticks, value_text
@@ -120,11 +121,20 @@ def map_edges(ds: xr.Dataset, plan: FigurePlan, factors: tuple[int, int]) -> tup
 
 def figure_title(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, width: float) -> str:
     """The title over the map or the panels (:func:`stabmap.read.plot.captions.atlas_title`), in lines as wide as
-    the maps."""
-    stable = system.stable_label
-    n_stable = None if stable is None else reduced.totals.get(stable, 0)
-    return atlas_title(ds, plan, n_stable, reduced.points, 70 if plan.facet is None else int(12 * (width - LEGEND_WIDTH)),
-                       reduced.factors, reduced.shape, shares=None if reduced.shares is None else AreaShares.mean(reduced.shares))
+    the maps, with the headline (:mod:`stabmap.read.headline`) of the grid points and cells drawn."""
+    from ..summary import scanned_axes
+
+    stable, undecided = system.stable_label, system.undecided_label
+    shares = None if reduced.shares is None else AreaShares.mean(reduced.shares)
+    head = Headline(
+        points=reduced.points, stable=None if stable is None else reduced.totals.get(stable, 0),
+        inferred=0 if shares is None else shares.inferred,
+        undecided=0 if undecided is None else reduced.totals.get(undecided, 0),
+        whole=None if shares is None else shares.whole, change=0.0 if shares is None else shares.change,
+        axes=scanned_axes(ds, [d for d in (plan.x, plan.y) if d]), shown=plan.facet is not None or bool(plan.fixed),
+    )
+    return atlas_title(ds, plan, head.text(system), 70 if plan.facet is None else int(12 * (width - LEGEND_WIDTH)),
+                       reduced.factors, reduced.shape)
 
 
 def draw_panel(ax, blocks, xe: np.ndarray, ye: np.ndarray, system, cmap, norm, span: tuple[float, float],
@@ -170,17 +180,20 @@ def draw_panel(ax, blocks, xe: np.ndarray, ye: np.ndarray, system, cmap, norm, s
 
 
 def panel_title(ds: xr.Dataset, plan: FigurePlan, system, blocks, r: int | None, c: int, share: AreaShares | None) -> str:
-    """A small multiple's title: its facet (and row) value, and its share proved stable (of its area with
-    ``share``, else of its grid points)."""
+    """A small multiple's title: its facet (and row) value, and in the headline's order its grid points' share
+    stable, then the share of its area over which its cells prove the label (``share``; left out where none does)."""
     assert plan.facet is not None  # only small multiples have panel titles
     parts = [value_text(ds, plan.facet, float(ds[plan.facet][c]))]
     if plan.row is not None:
         parts.append(value_text(ds, plan.row, float(ds[plan.row][r])))
     if system.stable_label is None:  # a system without stability: the panel's coordinates only
         return "\n".join(parts)
-    parts.append(f"{100 * share.stable:.0f} % of its area proved stable" if share is not None  # as the title
-                 else f"{100 * blocks.counts.get(system.stable_label, 0) / sum(blocks.counts.values()):.0f} % {system.stable_word}")
-    two_lines = plan.row is not None or share is not None  # the longer text of areas needs its own line
+    text = f"{100 * blocks.counts.get(system.stable_label, 0) / sum(blocks.counts.values()):.0f} % {system.stable_word}"
+    proved = share is not None and share.whole > 0  # a coarse grid's cells prove changes at most: nothing to add
+    if proved:
+        text += f"; label proved over {100 * share.whole:.0f} % of its area"
+    parts.append(text)
+    two_lines = plan.row is not None or proved  # the longer text of areas needs its own line
     return "\n".join([", ".join(parts[:-1]), parts[-1]]) if two_lines else f"{parts[0]}  ({parts[1]})"
 
 

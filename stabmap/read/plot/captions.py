@@ -1,4 +1,4 @@
-"""Titles and captions: the atlas title with what is proved stable, the fixed axes, the panels and the notes; the
+"""Titles and captions: the atlas title with its headline, the fixed axes, the panels and the notes; the
 caption of fixed parameters under every figure; and the filling of long lines that hold mathtext."""
 
 from __future__ import annotations
@@ -10,39 +10,19 @@ import textwrap
 import xarray as xr
 
 from ... import systems
-from ..areas import AreaShares
 from ..info import fixed_parameters, scene_notes
 from .labels import axis_label, symbol, units_text, value_text
 from .layout import FigurePlan
 
 
-def area_text(s: AreaShares, part: bool) -> str:
-    """'69.2 % of the scanned area proved stable, 28.5 % unstable; 2.3 % undecided (...)'."""
-    text = f"{100 * s.stable:.1f} % of the {'area shown' if part else 'scanned area'} proved stable, {100 * s.unstable:.1f} % unstable"
-    if s.other > 0:
-        text += f", {100 * s.other:.1f} % degenerate"
-    text += f"; {100 * (s.change + s.undecided):.1f} % undecided"
-    if s.change > 0:
-        text += f" ({100 * s.change:.1f} % in cells holding a boundary)"
-    return text
-
-
 def atlas_title(
-    ds: xr.Dataset, plan: FigurePlan, stable: int | None, points: int, chars: int, factors: tuple[int, int] = (1, 1), shape: tuple[int, int] = (1, 1),
-    shares: AreaShares | None = None,
+    ds: xr.Dataset, plan: FigurePlan, headline: str, chars: int, factors: tuple[int, int] = (1, 1), shape: tuple[int, int] = (1, 1),
 ) -> str:
-    """The atlas title, the share of the area drawn that its cells prove stable (``shares``), or else the stable
-    fraction of the ``points`` shown (``stable``: how many are stable; None for a system without stability), the
-    fixed axes, the panels, the notes and the rule that reduced a large grid."""
+    """The atlas title, its ``headline`` (:mod:`stabmap.read.headline`: the grid points and cells drawn), the fixed
+    axes, the panels, the notes and the rule that reduced a large grid."""
     title = [fill_title(ds.attrs.get("title", "") or "stabmap atlas", chars)]
-    part = plan.facet is not None or bool(plan.fixed)
-    if shares is not None:
-        title.append(textwrap.fill(area_text(shares, part), min(chars, 60)))  # narrower: clear of the legend beside it
-    elif stable is not None:
-        word = systems.of_atlas(ds.attrs).stable_word
-        title.append(f"{100 * stable / points:.1f} % of {'the ' if part else ''}{points:,} grid points{' shown' if part else ''} {word}")
-    else:
-        title.append(f"{points:,} grid points{' shown' if part else ''}")
+    # narrower: clear of the legend beside it; the cells' part on a line of its own, after the grid points'
+    title.append(";\n".join(textwrap.fill(part, min(chars, 60)) for part in headline.split("; ")))
     if plan.fixed:
         fixed = []
         for k, (i, asked) in plan.fixed.items():

@@ -22,7 +22,7 @@ FLAG_INFERRED, FLAG_NODE_ONLY, FLAG_CHANGE = 1, 2, 4
 class Reduced:
     """What the panels of one figure draw: ``blocks`` per panel (``panels``: its (row, facet) indices), the block
     ``factors`` along (y, x), the ``shape`` of a panel's grid, the label's counts over all panels and each panel's
-    proved shares of its area (None: the atlas proves no class over a whole cell here)."""
+    proved shares of its area (None: the atlas has no ``cell`` variable)."""
 
     panels: list
     blocks: list
@@ -70,18 +70,16 @@ def panel_map(da: xr.DataArray, plan: FigurePlan, r: int | None, c: int | None):
 
 
 def panel_areas(ds: xr.Dataset, plan: FigurePlan, label: xr.DataArray, fix: dict, panels: list, stable: int | None) -> list[AreaShares] | None:
-    """Each panel's shares of its area proved stable, unstable, ... (:mod:`stabmap.read.areas`); None where the atlas
-    proves no class over a whole cell here (no ``cell``, no stability, or a grid too coarse for box proofs): the
-    title then counts grid points. ``label``: the atlas's label with the fixed axes (``fix``) selected."""
-    if stable is None or CELL.name not in ds:
+    """Each panel's shares of its area proved stable, unstable, ... (:mod:`stabmap.read.areas`); None for an atlas
+    without ``cell``. ``label``: the atlas's label with the fixed axes (``fix``) selected."""
+    if CELL.name not in ds:
         return None
     from ..summary import cell_sizes
 
     cell = ds[CELL.name].isel(fix)
     wy = cell_sizes(ds, plan.y) if plan.y else np.ones(1)
-    shares = area_shares([panel_map(label, plan, r, c) for r, c in panels], [panel_map(cell, plan, r, c) for r, c in panels],
-                         wy, cell_sizes(ds, plan.x), stable)
-    return shares if any(s.proved_any for s in shares) else None
+    return area_shares([panel_map(label, plan, r, c) for r, c in panels], [panel_map(cell, plan, r, c) for r, c in panels],
+                       wy, cell_sizes(ds, plan.x), stable)
 
 
 def reduce_panels(ds: xr.Dataset, plan: FigurePlan, system, width: float, nrows: int, ncols: int) -> Reduced:
