@@ -10,8 +10,9 @@ Three ways over the same grid, all cores, kernels loaded before any timing:
                  researcher writes by hand: nothing proved; its labels are compared with the proved ones);
   node by node   ``compute_atlas(prove_cells=False)``: every node proved on its own, every cell node_only;
   cells          ``compute_atlas()``, the default: boxes proved first, nodes computed only where no box proves.
-Columns: seconds of each, node proofs per cell (nodes computed, and cell corners evaluated) and box proofs per cell
-of the cells way, the share of cells in each class, and the peer's labels that differ from the proved ones.
+Columns: seconds of each, node proofs per cell (nodes computed, and labels at the faces of cells beside a change)
+and box proofs per cell of the cells way, the share of cells in each class, and the peer's labels that differ from
+the proved ones.
 
 The bundled scenes paper-n2-fixed and paper-n3-fixed on the same grid, and the README's scene (omega x m_2 x the
 listed K_1 = [0, 10, 120], a discrete axis) on 300 x 100 x 3 points.

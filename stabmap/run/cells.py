@@ -1,29 +1,30 @@
 """Atlases decided cell by cell: large boxes proved first, nodes computed only where no box proves.
 
-A grid node's **cell** is the box between the midpoints to its neighbours along every axis (the scan's first
-and last values close the outermost cells), so the cells tile the scanned box (``stabmap.store.dataset.edges``).  Every chunk of an
-atlas is decided here (``decide_chunk``):
+A grid node's **cell** is the box between the midpoints to its neighbours along every scanned axis (the scan's
+first and last values close the outermost cells), so the cells tile the scanned box (``cell_edges``: the CF
+bounds of ``stabmap.store.dataset``).  Along a discrete axis (``Axis.discrete``: listed, separate cases) a cell is
+the node's value alone.  Every chunk of an atlas is decided here (``decide_chunk``):
 
-1. The grid is cut into **tiles** of up to TILE_CELLS cells (``tile_shape``, fixed by the grid alone); a chunk
-   holds whole tiles (``stabmap.run.chunks.chunk_shape``), and each tile is decided on its own, so the file
-   is the same whatever the chunks, threads or workers.  Each tile's cells, taken together as one box, go to
-   ``System.prove_boxes``.  A proved box gives its label to every node inside it and ``whole_cell`` to every
-   cell: no node of it is computed.
+1. The grid is cut into **tiles** of up to TILE_CELLS cells (``tile_shape``, fixed by the grid alone; one value
+   along a discrete axis); a chunk holds whole tiles (``stabmap.run.chunks.chunk_shape``), and each tile is
+   decided on its own, so the file is the same whatever the chunks, threads or workers.  Each tile's cells, taken
+   together as one box, go to ``System.prove_boxes``.  A proved box gives its label to every node inside it and
+   ``whole_cell`` to every cell: no node of it is computed.
 2. A box that does not prove is split in two along each of its long axes (those with at least half as many cells
    as its longest), or along the one axis the system names (``System.prove_and_cut_boxes``: for gyroscopes, the
    axis along which its corners' polynomials moved most), and its parts are tried in the next round, down to
-   single cells.  The rounds run all the
-   chunk's boxes of one round in one call of the kernels.
-3. A single cell that does not prove has its node computed (``System.evaluate``), and, where a neighbouring
-   node of its tile has another label, its corners: a corner with another label proves a change of label in the cell
-   (``contains_change``).  Otherwise the cell is cut at its node into sub-boxes, proved in up to SUB_ROUNDS
-   rounds of halving: all proved with the node's label is ``whole_cell``, one proved with another label is
+   single cells.  The rounds run all the chunk's boxes of one round in one call of the kernels.
+3. A single cell that does not prove has its node computed (``System.evaluate``).  Where two neighbouring nodes of
+   a tile have other labels, the label at the point where the segment between them crosses their cells' shared
+   face differs from one of them at least: that node's cell holds a change of label (``contains_change``).
+   Otherwise a cell whose own box failed is cut at its node into sub-boxes, proved in up to SUB_ROUNDS rounds of
+   halving: all proved with the node's label is ``whole_cell``, one proved with another label is
    ``contains_change``, and anything left undecided is ``node_only``: the node is proved, the rest of the cell
    is not.
 
-Box proofs stop where they do not pay (PAYS) and at a budget (BOX_BUDGET), both counted per tile, so that a
-cell-by-cell atlas never costs much more than a node-by-node one; the cells they leave are ``node_only``, never
-guessed.
+Everything beyond the nodes is paid from each tile's credit (SPARE, plus what its proved boxes saved), so that a
+cell-by-cell atlas never costs much more than a node-by-node one; box proofs also stop where they fail broadly
+(PAYS).  What the credit leaves is ``node_only``, never guessed.
 
 No label is inferred: every node's label is a box proof that holds it, or its own computation.  A system that
 proves no boxes along some scanned axis gives ``node_only`` cells, every node computed.
