@@ -96,3 +96,21 @@ def test_a_facet_shows_the_class_colour_of_every_node():
     for ax in fig.subfigs[0].axes:
         seen = node_colours(fig, ds, ax)
         assert all(np.abs(np.subtract(got, want)).max() <= 3 for _, got, want in seen), seen
+
+
+def test_the_axes_a_change_may_lie_along_are_those_the_cells_span():
+    """What a cell spans comes from the bounds variables: an axis off the map whose cells have width, not one of
+    zero width or without bounds among axes with them (discrete, listed values); no bounds at all: the cells reach
+    halfway to the neighbours, as drawn."""
+    from stabmap.read.plot.marks import hidden_cell_axes
+
+    def hidden(ds):
+        return hidden_cell_axes(ds, "n_complex_pairs", ("omega", "K_1"))
+
+    three = flagged_atlas([1.0, 2.0])
+    assert hidden(flagged_atlas()) == []
+    assert hidden(three) == ["m_2"]
+    assert hidden(flagged_atlas([1.0, 2.0], discrete=True)) == []
+    assert hidden(three.drop_vars("m_2_bounds")) == []
+    assert hidden(three.drop_vars(["m_2_bounds", "K_1_bounds", "omega_bounds"])) == ["m_2"]
+    assert hidden(flagged_atlas([1.0])) == []  # one value: nothing to span

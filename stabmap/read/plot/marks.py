@@ -12,7 +12,7 @@ import xarray as xr
 
 from .labels import symbol
 
-HATCH_CHANGE = "\\\\\\\\"  # dark diagonal lines against the light '////' of inferred cells and the 'xxxx' of degenerate ones
+HATCH_CHANGE = "\\\\\\\\\\\\"  # dark diagonal lines against the light '////' of inferred cells and the 'xxxx' of degenerate ones
 CHANGE_INK = "#000000D9"  # almost black, so the hatch reads over every class colour, pale yellow as dark purple
 PAGE_HATCH = "\\"  # the page's hatch (bokeh's left_diagonal_line), the same direction as the figures'
 
@@ -21,15 +21,23 @@ def hidden_cell_axes(ds: xr.Dataset, label: str, drawn: tuple[str | None, ...]) 
     """The axes of ``ds[label]`` not among ``drawn`` along which a cell spans more than its grid value: a cell
     flagged contains_change in the map drawn may change along these only.
 
-    An axis whose bounds variable gives every cell zero width (a discrete axis, its values listed) is left out:
-    a slice at one of its values holds its own cells. Without a bounds variable the cells reach halfway to the
-    neighbours, as the figures draw them."""
+    The atlas's CF bounds variables say what a cell spans. An axis is left out when its cells have zero width, or
+    when it has no bounds while other axes have some (a discrete axis, its values listed: a slice at one of its
+    values holds its own cells). An atlas with no bounds at all is read as the figures draw it: cells reach
+    halfway to the neighbours along every axis."""
+    def bounds_of(d) -> str:
+        return ds[d].attrs.get("bounds", f"{d}_bounds")
+
+    any_bounds = any(bounds_of(d) in ds.variables for d in ds[label].dims)
     out = []
     for d in ds[label].dims:
         if d in drawn or ds.sizes[d] < 2:
             continue
-        name = ds[d].attrs.get("bounds", f"{d}_bounds")
-        if name in ds.variables and not np.any(np.diff(np.asarray(ds[name], dtype=float), axis=-1)):
+        name = bounds_of(d)
+        if name in ds.variables:
+            if not np.any(np.diff(np.asarray(ds[name], dtype=float), axis=-1)):
+                continue
+        elif any_bounds:
             continue
         out.append(str(d))
     return out

@@ -96,6 +96,6 @@ def legend_handles(system, present: list[int], drawn: dict[str, bool], change: s
     elif drawn["node-only"]:
         handles.append(Patch(facecolor="#DDDDDD", edgecolor="none", label="lighter: proved at the grid\nnode, not over its cell"))
     if drawn["change"]:
-        words = textwrap.fill(change, 31, break_on_hyphens=False)
+        words = textwrap.fill(change, 26, break_on_hyphens=False)  # as wide as the entries above
         handles.append(Patch(facecolor="white", edgecolor=CHANGE_INK, lw=0, hatch=HATCH_CHANGE, label=words))
     return handles
