@@ -274,3 +274,44 @@ def test_critical_page_shows_the_files_stable_intervals(two_tops_scene, tmp_path
             want |= {(round(float(a), 9), round(float(b), 9), round(float(m), 9)) for a, b in zip(cuts[::2], cuts[1::2], strict=True) if b > a}
     assert drawn("N_c = 0:") == want and want
     assert drawn("undecided gap") == gaps and gaps  # this grid has gaps: the test sees them drawn
+
+
+def painted_fills(page) -> tuple[np.ndarray, object]:
+    """The fill id the first frame paints on every block (rows along y), read from the page's quads, and their glyph
+    (its colour mapper and hatch table turn an id into what the browser draws)."""
+    (blocks,) = [r for r in models(page, "GlyphRenderer") if type(r.glyph).__name__ == "Quad"]
+    rects = blocks.data_source
+    ids = np.full((max(rects.data["r1"]), max(rects.data["c1"])), -1)
+    for c0, c1, r0, r1, k in zip(*(rects.data[n] for n in ("c0", "c1", "r0", "r1", "colour")), strict=True):
+        ids[r0:r1, c0:c1] = k
+    return ids, blocks.glyph
+
+
+def test_a_cell_holding_a_change_keeps_its_class_colour_under_a_hatch(monkeypatch):
+    """Every block of one class is painted in its class's colour (lighter where proved at its node only or inferred),
+    hatched exactly where a cell in it is proved to hold a change: node by node, and in blocks of 2 x 2 nodes of
+    one class, some holding a change."""
+    from flagged import CELLS, CHANGE, LABELS, NODE_ONLY, NOT_PROVED, flagged_atlas
+
+    import stabmap.read.explore.atlas as page_module
+    from stabmap.read.explore.states import lighter
+    from stabmap.read.plot.marks import PAGE_HATCH
+    from stabmap.read.plot.palette import system_colour
+
+    for repeat, pixels in ((1, None), (2, (5, 6))):
+        ds = flagged_atlas(repeat=repeat)
+        system = stabmap.systems.of_atlas(ds.attrs)
+        if pixels is not None:  # a map of 10 x 12 points on 5 x 6 pixels: blocks of 2 x 2, each one node of LABELS
+            monkeypatch.setattr(page_module, "map_grid", lambda ds_, plan, p=pixels: map_grid(ds_, plan, pixels=p))
+        page = atlas_page(ds, x="omega", y="K_1")
+        ids, quad = painted_fills(page)
+        assert ids.shape == LABELS.shape
+        colour = np.array(quad.fill_color.transform.palette, dtype=object)[ids]
+        want = np.array([[system_colour(int(v), system) for v in row] for row in LABELS], dtype=object)
+        light = (CELLS == NODE_ONLY) | (CELLS == NOT_PROVED)
+        want[light] = [lighter(c) for c in want[light]]
+        assert (colour == want).all(), (colour, want)
+        hatch = np.array(quad.hatch_pattern.transform.args["h"], dtype=object)[ids]
+        assert ((hatch == PAGE_HATCH) == (CELLS == CHANGE)).all()
+        (legend,) = [m for m in page.layout.references() if getattr(m, "name", None) == "legend"]
+        assert "hatched: a change of label is proved inside the cell (colour: the label at its grid point)" in legend.text

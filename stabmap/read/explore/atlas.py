@@ -22,6 +22,7 @@ from ...errors import StabmapError
 from ...store.variables import CELL
 from ..blocks import compute
 from ..plot.captions import fixed_caption
+from ..plot.marks import CHANGE_INK, change_text, hidden_cell_axes
 from ..plot.palette import BOUNDARY, CLASS_EDGE, system_colour
 from ..summary import summary
 from . import widgets
@@ -121,7 +122,7 @@ def frame_bytes(f: Frame) -> int:
 def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: list[Frame]) -> object:
     """The bokeh layout of an atlas page: title, map, sliders, readout, legend and caption."""
     from bokeh.layouts import column, row
-    from bokeh.models import ColumnDataSource, CustomJS, CustomJSExpr, CustomJSHover, HoverTool, LinearColorMapper, Range1d
+    from bokeh.models import ColumnDataSource, CustomJS, CustomJSExpr, CustomJSHover, CustomJSTransform, HoverTool, LinearColorMapper, Range1d
     from bokeh.plotting import figure
 
     has_prov, has_cell = system.provenance in ds, CELL.name in ds
@@ -151,8 +152,12 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: l
     rects = ColumnDataSource(rect_columns(chosen[0]))
     current = ColumnDataSource({"state": widgets.array(ids[0])})
     edges = {side: CustomJSExpr(args={"xe": tables["xe"], "ye": tables["ye"]}, code=code) for side, code in RECT_EDGES_JS.items()}
+    # A fill id names a colour and a hatch: cells proved to hold a change keep their class colour under the hatch.
+    hatch = CustomJSTransform(args={"h": legend.hatches}, v_func="return Array.from(xs, x => h[x] || ' ');")
     blocks = p.quad(left={"expr": edges["left"]}, right={"expr": edges["right"]}, bottom={"expr": edges["bottom"]},
-                    top={"expr": edges["top"]}, source=rects, fill_color={"field": "colour", "transform": mapper}, line_color=None)
+                    top={"expr": edges["top"]}, source=rects, fill_color={"field": "colour", "transform": mapper}, line_color=None,
+                    hatch_pattern={"field": "colour", "transform": hatch}, hatch_color=CHANGE_INK[:7], hatch_alpha=0.85,
+                    hatch_scale=8, hatch_weight=1.2)
     lines = []
     for kind, colour in (("classes", CLASS_EDGE), ("stability", BOUNDARY)):
         seg = ColumnDataSource(segment_columns(getattr(chosen[0], kind)))
@@ -184,7 +189,8 @@ title.text = titles[k];
 """, rects=rects, current=current, lines=lines, title=title, titles=titles,
                          frames=[[rect_columns(f), widgets.array(i), segment_columns(f.classes), segment_columns(f.stability)]
                                  for f, i in zip(chosen, ids, strict=True)])
-    side = widgets.legend(plain(system.label_title), legend_entries(system, chosen))
+    change = change_text(hidden_cell_axes(ds, system.label, (plan.x, plan.y)), ds, plain)
+    side = widgets.legend(plain(system.label_title), legend_entries(system, chosen, change))
     return column(title, row(p, side), *controls, readout, widgets.caption(caption_lines(ds, plan, grid, None if whole else head)))
 
 
@@ -224,9 +230,9 @@ def title_html(ds: xr.Dataset, system, plan: PagePlan, f: Frame, at: dict[str, i
     return "<br>".join(lines)
 
 
-def legend_entries(system, chosen: list[Frame]) -> list[str]:
+def legend_entries(system, chosen: list[Frame], change: str = "") -> list[str]:
     """The legend: the classes drawn, then the lines and marks drawn, as the PNG legend names them (of the frames on
-    the page only, not of those left out)."""
+    the page only, not of those left out; ``change``: the words of the change hatch)."""
     present = sorted({v for f in chosen for v in f.counts})
     entries = [widgets.swatch(system_colour(v, system), system.class_name(v)) for v in present]
     drawn = frozenset().union(*(f.drawn for f in chosen))
@@ -239,7 +245,7 @@ def legend_entries(system, chosen: list[Frame]) -> list[str]:
     if "node-only" in drawn:
         entries.append(widgets.swatch(lighter("#888888"), "lighter: proved at the grid node, not over its cell"))
     if "change" in drawn:
-        entries.append(widgets.swatch(CLASS_EDGE, "cell proved to hold a change of label"))
+        entries.append(widgets.swatch(CHANGE_INK[:7], change, "hatch"))
     if "mixed-stability" in drawn:
         entries.append(widgets.swatch(BOUNDARY, "block holding stable and unstable points"))
     if "mixed-classes" in drawn:
@@ -257,7 +263,8 @@ def caption_lines(ds: xr.Dataset, plan: PagePlan, grid, headline: str | None = N
     if (fy, fx) != (1, 1):
         lines.append(f"{ds.sizes[plan.x]:,}" + (f" × {ds.sizes[plan.y]:,}" if plan.y else "") + f" grid points drawn in blocks of {fx}"
                      + (f" × {fy}" if plan.y else "") + " (no block smaller than a pixel): a block shows its class where all its points "
-                     "agree, black if it holds stable and unstable points, dark grey if several other classes; hover names them.")
+                     "agree (hatched where a cell in it holds a change), black if it holds stable and unstable points, dark grey if "
+                     "several other classes; hover names them.")
     lines += [f"note: {n}" for n in plan.notes]
     lines.append(widgets.how_to(bool(plan.sliders)))
     return lines

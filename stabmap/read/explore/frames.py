@@ -10,7 +10,7 @@ import numpy as np
 import xarray as xr
 
 from ..blocks import block_factors, compute, reduce_blocks
-from ..plot.geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges, touches_stability
+from ..plot.geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges
 from ..plot.labels import log_axis
 from .plan import PagePlan
 from .states import Legend, block_colours, pack
@@ -107,8 +107,7 @@ def read_frame(label: xr.DataArray, bits: xr.DataArray | None, plan: PagePlan, a
     if values.size <= EAGER_POINTS:  # one read of a small map, rather than a task graph for each of many small frames
         values, flags = compute(values, flags)
     blocks = reduce_blocks(values, flags, stable, grid.factors)
-    near = touches_stability(blocks, stable) if stable is not None else np.zeros(blocks.low.shape, dtype=bool)
-    colours, marks = block_colours(blocks, legend, near)
+    colours, marks = block_colours(blocks, legend)
     codes, state = block_classes(blocks, stable)
     stab, other = cell_edge_boundaries(codes, grid.xe, grid.ye, stable, state=state)
     return Frame(pack(blocks, colours), dict(blocks.counts), colour_rectangles(colours),

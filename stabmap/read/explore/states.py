@@ -4,7 +4,8 @@ one small integer per block, an index into its table of distinct states, so that
 and not with the text shown on hover.
 
 A state is packed into one int64 (:func:`pack`): the page gathers the distinct ones over every frame, then
-writes each state's colour once (the colour mapper's palette) and its text once (the hover's table).
+writes each state's colour once (the colour mapper's palette, with a hatch per colour id) and its text once (the
+hover's table).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import numpy as np
 import xarray as xr
 
 from ...store.variables import CELL, INFERRED
+from ..plot.marks import PAGE_HATCH
 from ..plot.palette import BOUNDARY, CLASS_EDGE, system_colour
 from .text import plain
 
@@ -20,7 +22,7 @@ CELL_SHIFT = 16  # provenance meanings take bits 0..15 of a point's bits, the me
 VEIL = 0.45  # share of white over the class colour of cells proved at their node only, or inferred: "lighter"
 CELL_TEXT = {
     "whole_cell": "the label holds at every point of the cell",
-    "contains_change": "the cell is proved to hold a change of label",
+    "contains_change": "the cell is proved to hold a change of label (the label given is its grid point's)",
     "node_only": "proved at the grid node only, not over its cell",
     "not_proved": "not proved: inferred from the cell's corners",
 }
@@ -55,18 +57,28 @@ def _look_up(a: np.ndarray, *, values: np.ndarray, table: np.ndarray) -> np.ndar
 
 
 class Legend:
-    """The colours a page draws, each numbered once."""
+    """The fills a page draws, each numbered once: a colour and a hatch pattern ("" for none)."""
 
     def __init__(self, system, has_provenance: bool) -> None:
         self.system = system
-        self.colours: list[str] = []
+        self.fills: list[tuple[str, str]] = []
         flags = system.variable(system.provenance).meanings if has_provenance else ()
         self.inferred_bit = (1 << flags.index(INFERRED)) if INFERRED in flags else 0
 
-    def id(self, colour: str) -> int:
-        if colour not in self.colours:
-            self.colours.append(colour)
-        return self.colours.index(colour)
+    def id(self, colour: str, hatch: str = "") -> int:
+        if (colour, hatch) not in self.fills:
+            self.fills.append((colour, hatch))
+        return self.fills.index((colour, hatch))
+
+    @property
+    def colours(self) -> list[str]:
+        """The colour of each id (the colour mapper's palette)."""
+        return [c for c, _ in self.fills]
+
+    @property
+    def hatches(self) -> list[str]:
+        """The hatch pattern of each id (bokeh's ``hatch_pattern``; "" for none)."""
+        return [h for _, h in self.fills]
 
 
 def lighter(colour: str) -> str:
@@ -80,27 +92,29 @@ def cell_bit(meaning: str) -> int:
     return 1 << (CELL_SHIFT + CELL.meanings.index(meaning))
 
 
-def block_colours(blocks, legend: Legend, near_stable: np.ndarray) -> tuple[np.ndarray, set[str]]:
-    """The colour id of every block, as the PNG maps colour it: a block of one class in that class's colour (lighter
-    where a cell is proved at its node only or inferred), a block of stable and unstable points and a cell proved
-    to hold a change next to stable ones black, other mixed blocks and changes dark grey; and the marks drawn, for
-    the legend ("inferred", "node-only", "change", "mixed-classes", "mixed-stability")."""
+def block_colours(blocks, legend: Legend) -> tuple[np.ndarray, set[str]]:
+    """The colour id of every block, as the PNG maps draw it: a block of one class in that class's colour (lighter
+    where a cell is proved at its node only or inferred, hatched where a cell is proved to hold a change: the
+    colour stays the grid points' label), a block of stable and unstable points black, other mixed blocks dark
+    grey; and the marks drawn, for the legend ("inferred", "node-only", "change", "mixed-classes",
+    "mixed-stability")."""
     system = legend.system
     low, mixed = blocks.low, blocks.low != blocks.high
     bits = np.zeros(low.shape, dtype=np.int64) if blocks.any_flag is None else blocks.any_flag.astype(np.int64)
     inferred = ((bits & legend.inferred_bit) > 0) | ((bits & cell_bit("not_proved")) > 0)
     node_only = ((bits & cell_bit("node_only")) > 0) & ~inferred
-    change = (bits & cell_bit("contains_change")) > 0
+    change = ((bits & cell_bit("contains_change")) > 0) & ~mixed
     out = np.empty(low.shape, dtype=np.int64)
     for v in np.unique(low):
-        at = low == v
-        out[at] = legend.id(system_colour(int(v), system))
-        if (at & (inferred | node_only)).any():
-            out[at & (inferred | node_only)] = legend.id(lighter(system_colour(int(v), system)))
-    shown = ~mixed & ~change
-    marks = {entry for mask, entry in ((inferred & shown, "inferred"), (node_only & shown, "node-only")) if mask.any()}
-    for mask, colour, entry in ((change & ~near_stable, CLASS_EDGE, "change"), (change & near_stable, BOUNDARY, "change"),
-                                (mixed & ~blocks.mixed_stability, CLASS_EDGE, "mixed-classes"),
+        base = system_colour(int(v), system)
+        for light in (False, True):
+            for hatched in (False, True):
+                at = (low == v) & ((inferred | node_only) == light) & (change == hatched)
+                if at.any():
+                    out[at] = legend.id(lighter(base) if light else base, PAGE_HATCH if hatched else "")
+    marks = {entry for mask, entry in ((inferred & ~mixed, "inferred"), (node_only & ~mixed, "node-only"), (change, "change"))
+             if mask.any()}
+    for mask, colour, entry in ((mixed & ~blocks.mixed_stability, CLASS_EDGE, "mixed-classes"),
                                 (blocks.mixed_stability, BOUNDARY, "mixed-stability")):
         if mask.any():
             out[mask] = legend.id(colour)
@@ -110,18 +124,18 @@ def block_colours(blocks, legend: Legend, near_stable: np.ndarray) -> tuple[np.n
 
 def pack(blocks, colour_ids: np.ndarray) -> np.ndarray:
     """Every block's state as one int64: low and high label (16 bits each), holds the stability boundary (1 bit),
-    colour id (6 bits), the ORed point bits (20 bits)."""
+    colour id (7 bits: a class may come plain, lighter, hatched and both), the ORed point bits (20 bits)."""
     low = (blocks.low.astype(np.int64) + 2**15) & 0xFFFF
     high = (blocks.high.astype(np.int64) + 2**15) & 0xFFFF
     bits = np.zeros(low.shape, dtype=np.int64) if blocks.any_flag is None else blocks.any_flag.astype(np.int64) & 0xFFFFF
-    if colour_ids.max(initial=0) >= 64:
-        raise ValueError("more than 64 colours on one page")
-    return low | (high << 16) | (blocks.mixed_stability.astype(np.int64) << 32) | (colour_ids << 33) | (bits << 39)
+    if colour_ids.max(initial=0) >= 128:
+        raise ValueError("more than 128 fills on one page")
+    return low | (high << 16) | (blocks.mixed_stability.astype(np.int64) << 32) | (colour_ids << 33) | (bits << 40)
 
 
 def unpack(key: int) -> tuple[int, int, bool, int, int]:
     """low, high, holds the stability boundary, colour id, point bits of a packed state."""
-    return ((key & 0xFFFF) - 2**15, ((key >> 16) & 0xFFFF) - 2**15, bool((key >> 32) & 1), int((key >> 33) & 63), int(key >> 39))
+    return ((key & 0xFFFF) - 2**15, ((key >> 16) & 0xFFFF) - 2**15, bool((key >> 32) & 1), int((key >> 33) & 127), int(key >> 40))
 
 
 def state_text(key: int, system, has_provenance: bool, has_cell: bool) -> str:

@@ -18,9 +18,11 @@ label, its provenance flags and ``cell``, and their coordinates, chunk by chunk 
   cross-hatched, points whose class was not proved (``System.undecided_label``) dark grey and cross-hatched;
   points of an adaptive atlas that were inferred from their cell's corners carry a light diagonal hatch (a light
   veil in very large adaptive atlases).
-- Cells (``cell``, docs/cells.md): a cell whose label is proved at its node only is dotted (a light veil when
-  there are very many); a cell proved to hold a change of label is filled as a boundary (black where stable
-  cells are next to it, dark grey between other classes), so a band narrower than the grid still shows.
+- Cells (``cell``, docs/cells.md): a grid point keeps its class colour whatever its cell proves; a cell whose
+  label is proved at its node only is dotted (a light veil when there are very many); a cell proved to hold a
+  change of label carries a dark diagonal hatch over its colour (:mod:`.marks`), so a band narrower than the grid
+  still shows and the class of its nodes stays readable. In a slice of a larger atlas the change may lie along
+  an axis not drawn: the legend names it.
 - Boundaries are drawn on grid-cell edges, between every two neighbouring points whose label differs: thick
   where one side is stable and the other not, thin where only the class of the unstable side changes. A line is
   drawn only where two grid points differ, never interpolated between them.
@@ -28,6 +30,7 @@ label, its provenance flags and ``cell``, and their coordinates, chunk by chunk 
 One module an idea:
 
 - :mod:`.palette`: colours, hatches and legend entries of the classes;
+- :mod:`.marks`: the hatch of cells holding a change, its words, the axes not drawn it may lie along;
 - :mod:`.layout`: which axis goes where (:class:`FigurePlan`, :func:`plan_figure`) and the room a map gets;
 - :mod:`.geometry`: cell edges, runs, rectangles, boundary segments and their widths, blocks;
 - :mod:`.labels`: symbols, units, axis labels and ticks;

@@ -14,9 +14,10 @@ from ... import systems
 from ..areas import AreaShares
 from ..headline import Headline
 from .captions import atlas_title, captioned_figure
-from .geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges, touches_stability
+from .geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges
 from .labels import axis_label, display_ticks, log_axis, log_ticks, value_text
 from .layout import LEGEND_WIDTH, MAX_PANELS, FigurePlan, figure_size, panel_grid, panel_points, plan_figure
+from .marks import change_text, hidden_cell_axes
 from .paint import fill_classes, hatch_cells, paint_cells
 from .palette import BOUNDARY, CLASS_EDGE, class_colours, legend_handles
 from .reduce import FLAG_CHANGE, FLAG_INFERRED, FLAG_NODE_ONLY, Reduced, reduce_panels
@@ -103,7 +104,8 @@ def atlas_figure(
         maps.supxlabel(axis_label(ds, plan.x, width=int(12 * (size[0] - LEGEND_WIDTH)), shown=shown[plan.x]), fontsize=10)
         maps.supylabel(axis_label(ds, plan.y, width=int(10 * size[1]), shown=shown.get(plan.y, "")), fontsize=10)
 
-    add_legend(fig if plan.facet is None else side, plan, system, reduced.present, drawn)
+    change = change_text(hidden_cell_axes(ds, system.label, (plan.x, plan.y)), ds)  # a facet is a slice too
+    add_legend(fig if plan.facet is None else side, plan, system, reduced.present, drawn, change)
     if plan.facet is None:
         axes[0].set_title(title, fontsize=10)
     else:
@@ -139,8 +141,8 @@ def figure_title(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, wid
 
 def draw_panel(ax, blocks, xe: np.ndarray, ye: np.ndarray, system, cmap, norm, span: tuple[float, float],
                log: tuple[bool, bool]) -> dict[str, bool]:
-    """Draw one panel's blocks into ``ax``: the classes, the hatches (inferred, node only, degenerate), blocks of
-    mixed labels and cells holding a change, then the boundaries on cell edges, as wide as the bands allow.
+    """Draw one panel's blocks into ``ax``: the classes, the hatches (inferred, node only, degenerate, cells holding
+    a change), blocks of mixed labels, then the boundaries on cell edges, as wide as the bands allow.
     Returns which of these it drew, for the legend."""
     from matplotlib.collections import LineCollection
 
@@ -160,14 +162,16 @@ def draw_panel(ax, blocks, xe: np.ndarray, ye: np.ndarray, system, cmap, norm, s
             elif gid == "node-only-cells":
                 drawn["node-only"], drawn["node-only-light"] = True, light
     codes, state = block_classes(blocks, stable)
-    change = (bits & FLAG_CHANGE) > 0
-    near_stable = touches_stability(blocks, stable) if stable is not None else np.zeros(values.shape, dtype=bool)
+    # A block of one class holding a change is hatched over its class colour; a block of several classes (below a
+    # pixel) is filled, black where it holds stable and unstable points: a matter of resolution, not of cell flags.
+    change = ((bits & FLAG_CHANGE) > 0) & ~mixed
+    if change.any():
+        hatch_cells(ax, change, xe, ye, "change-cells")
     drawn["change"] = bool(change.any())
     for mask, col, gid in ((mixed & ~blocks.mixed_stability, CLASS_EDGE, "mixed-class-blocks"),
-                           (blocks.mixed_stability, BOUNDARY, "mixed-stability-blocks"),
-                           (change & ~near_stable, CLASS_EDGE, "change-cells"), (change & near_stable, BOUNDARY, "stability-change-cells")):
+                           (blocks.mixed_stability, BOUNDARY, "mixed-stability-blocks")):
         if mask.any():
-            paint_cells(ax, mask, xe, ye, col, gid, vector=gid.endswith("-cells") and tuple(blocks.factors) == (1, 1))
+            paint_cells(ax, mask, xe, ye, col, gid)
     stab, other = cell_edge_boundaries(codes, xe, ye, stable, state=state)
     for segs, widest, col, gid in ((other, 0.6, CLASS_EDGE, "class-boundary"), (stab, 1.5, BOUNDARY, "stability-boundary")):
         widths = boundary_widths(segs, xe, ye, span, widest, log=log, codes=codes)
@@ -222,11 +226,11 @@ def set_map_axes(first, ds: xr.Dataset, plan: FigurePlan, xe: np.ndarray, ye: np
     return {dim: display_ticks(ds, dim, axis) for dim, axis in ((plan.x, first.xaxis), (plan.y, first.yaxis)) if dim}
 
 
-def add_legend(where, plan: FigurePlan, system, present: list[int], drawn: dict[str, bool]) -> None:
-    """The legend of the classes ``present`` and the marks ``drawn``: beside a single map, or at the top of the
-    right-hand subfigure of small multiples (``where``)."""
+def add_legend(where, plan: FigurePlan, system, present: list[int], drawn: dict[str, bool], change: str = "") -> None:
+    """The legend of the classes ``present`` and the marks ``drawn`` (``change``: the words of the change hatch):
+    beside a single map, or at the top of the right-hand subfigure of small multiples (``where``)."""
     legend = {"frameon": False, "title": system.label_title, "fontsize": 9, "title_fontsize": 9}
-    handles = legend_handles(system, present, drawn)
+    handles = legend_handles(system, present, drawn, change)
     if plan.facet is None:
         where.legend(handles=handles, loc="outside right upper", alignment="left", **legend)
     else:

@@ -114,16 +114,6 @@ def rectangles(mask: np.ndarray, xe: np.ndarray, ye: np.ndarray) -> list[np.ndar
     return [np.array([[xe[a], ye[j0]], [xe[b], ye[j0]], [xe[b], ye[j1]], [xe[a], ye[j1]]]) for a, b, j0, j1 in done]
 
 
-def touches_stability(blocks, stable: int) -> np.ndarray:
-    """Blocks next to (or holding) both stable and not stable points: where a change of label is a stability
-    boundary."""
-    from scipy.ndimage import maximum_filter
-
-    some_stable = (blocks.low == stable) | (blocks.high == stable) | blocks.mixed_stability
-    some_other = (blocks.low != stable) | (blocks.high != stable)
-    return maximum_filter(some_stable, size=3, mode="nearest") & maximum_filter(some_other, size=3, mode="nearest")
-
-
 def block_edges(edges: np.ndarray, k: int) -> np.ndarray:
     """Edges of blocks of ``k`` cells from the cells' edges: every k-th edge and the last."""
     n = len(edges) - 1

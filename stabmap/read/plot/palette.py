@@ -6,9 +6,12 @@ classes warm colours in the order of their label, so a class keeps its colour wh
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 
 from .labels import mathtext
+from .marks import CHANGE_INK, HATCH_CHANGE
 
 STABLE_COLOUR = "#56B4E9"
 UNSTABLE_COLOUR = ["#F0E442", "#E69F00", "#D55E00", "#CC79A7", "#882255", "#332288", "#117733", "#44AA99", "#999933", "#AA4499"]
@@ -69,9 +72,11 @@ def class_colours(present: list[int], system):
     return cmap, BoundaryNorm(np.arange(bottom - 0.5, top + 1.5), cmap.N)
 
 
-def legend_handles(system, present: list[int], drawn: dict[str, bool]) -> list:
+def legend_handles(system, present: list[int], drawn: dict[str, bool], change: str = "") -> list:
     """The legend's entries: the classes ``present``, then the lines and marks a map drew (``drawn``: which of
-    stability, classes, inferred, light, node-only, node-only-light and change appear)."""
+    stability, classes, inferred, light, node-only, node-only-light and change appear; ``change``: the words of the
+    change hatch, :func:`stabmap.read.plot.marks.change_text`)."""
+
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -91,5 +96,6 @@ def legend_handles(system, present: list[int], drawn: dict[str, bool]) -> list:
     elif drawn["node-only"]:
         handles.append(Patch(facecolor="#DDDDDD", edgecolor="none", label="lighter: proved at the grid\nnode, not over its cell"))
     if drawn["change"]:
-        handles.append(Patch(facecolor=CLASS_EDGE, edgecolor="none", label="cell proved to hold\na change of label"))
+        words = textwrap.fill(change, 26, break_on_hyphens=False)  # as wide as the entries above
+        handles.append(Patch(facecolor="white", edgecolor=CHANGE_INK, lw=0, hatch=HATCH_CHANGE, label=words))
     return handles
