@@ -123,7 +123,7 @@ def probe_tiles(scene: SceneBase, locations: list) -> tuple[int, float]:
 
     Each part is the tile's first PROBE_PART along every axis it spans: the probe's work is thrown away, and a whole
     tile of a long chain takes seconds."""
-    evaluate_block(scene, _part(locations[0], 2))
+    evaluate_block(scene, tuple((a, min(b, a + 2)) for a, b in locations[0]))
     done, spent = 0, 0.0
     for location in locations:
         if spent >= PROBE_SECONDS:
