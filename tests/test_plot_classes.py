@@ -213,5 +213,5 @@ def test_panels_give_their_own_shares(dry):
     one, none = (ax.get_title() for ax in fig.subfigs[0].axes)
     points = round(100 * float((dry.n_complex_pairs == 0).mean()))
     whole = 100 * float(area_shares([dry.n_complex_pairs.values], [dry.cell.values], *(cell_sizes(dry, d) for d in dry.cell.dims), 0)[0].whole)
-    assert one.endswith(f"{points} % stable; label proved over {whole:.0f} % of its area") and whole > 85
+    assert one.endswith(f"{points} % stable; {whole:.0f} % of area proved") and whole > 85
     assert none.endswith(f"({points} % stable)")  # nothing proved over a cell: no share of the area to give

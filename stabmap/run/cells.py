@@ -52,7 +52,7 @@ PAYS, PAYS_MIN, PAYS_CELLS = 0.25, 32, 4
 # compute).  So a tile never costs more than 1 + SPARE times its nodes computed one by one, whether its boxes
 # prove or not, and where they prove it goes on trying them.  Boxes leave RESERVE a cell of it to the labels that
 # prove a change in the cells beside one (``_Chunk.classify``), which need the nodes' labels and so come last.
-SPARE, RESERVE = 0.2, 0.1
+SPARE, RESERVE = 0.2, 0.05
 TILE_CELLS = 1024  # cells of a tile: 1024 along one axis, 32 x 32, 8 x 8 x 8 (a power of two along every axis)
 
 NODE_ONLY, WHOLE_CELL, CONTAINS_CHANGE = (CELL.value(m) for m in ("node_only", "whole_cell", "contains_change"))

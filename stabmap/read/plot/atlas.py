@@ -194,8 +194,8 @@ def panel_title(ds: xr.Dataset, plan: FigurePlan, system, blocks, r: int | None,
         return "\n".join(parts)
     text = f"{100 * blocks.counts.get(system.stable_label, 0) / sum(blocks.counts.values()):.0f} % {system.stable_word}"
     proved = share is not None and share.whole > 0  # a coarse grid's cells prove changes at most: nothing to add
-    if proved:
-        text += f"; label proved over {100 * share.whole:.0f} % of its area"
+    if proved:  # short: three panels side by side share a line
+        text += f"; {100 * share.whole:.0f} % of area proved"
     parts.append(text)
     two_lines = plan.row is not None or proved  # the longer text of areas needs its own line
     return "\n".join([", ".join(parts[:-1]), parts[-1]]) if two_lines else f"{parts[0]}  ({parts[1]})"
