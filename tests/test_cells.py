@@ -23,6 +23,7 @@ from stabmap.systems.gyroscopes import exact
 from stabmap.systems.gyroscopes.outputs import BY_BOX
 from stabmap.systems.gyroscopes.points import point_arrays
 from stabmap.systems.gyroscopes.scene import from_dict
+from cellspare import spare as larger_spare
 from systems import EXACT_BOUNDARIES, WINDOW, random_system
 
 WHOLE, CHANGE, NODE = (CELL.value(m) for m in ("whole_cell", "contains_change", "node_only"))
@@ -37,13 +38,8 @@ def _exact(scene, values: dict[str, np.ndarray]) -> np.ndarray:
 def _atlas(scene, spare: float | None = None, **kwargs):
     """The atlas of ``scene``; ``spare``: the tiles' spare for proofs (cells.SPARE) for this atlas, so that a test of what
     cells claim sees boxes tried on a coarse grid, where the default spare tries few."""
-    if spare is None:
+    with larger_spare(cells.SPARE if spare is None else spare):
         return stabmap.compute_atlas(scene, threads=1, progress=False, **kwargs)
-    saved, cells.SPARE = cells.SPARE, spare
-    try:
-        return stabmap.compute_atlas(scene, threads=1, progress=False, **kwargs)
-    finally:
-        cells.SPARE = saved
 
 
 def _cell_points(scene, index: tuple[int, ...], rng, k: int) -> dict[str, np.ndarray]:

@@ -22,6 +22,7 @@ from browser import Page, browser
 from scenes import TWO_TOPS
 
 import stabmap
+from stabmap.store.dataset import edges
 from stabmap import systems
 from stabmap.cli import main
 from stabmap.scene.grid import resample
@@ -157,9 +158,13 @@ def hover_every_point(page: Page, ds: xr.Dataset, name: str, sliders: dict[str, 
 
 
 def inside(ds: xr.Dataset, dim: str, i: int) -> float:
-    """The middle of grid point ``i``'s cell along ``dim`` (its CF bounds): at the ends of the scan the cell ends at
-    the point itself, which lies on the map's border, where a pointer may fall outside the map."""
+    """The middle of grid point ``i``'s cell along ``dim`` as drawn: its CF bounds (at the ends of the scan the cell
+    ends at the point itself, which lies on the map's border, where a pointer may fall outside the map); along a
+    discrete axis, whose cells are the values themselves, the strip the map draws for it (midpoints between
+    values)."""
     lo, hi = (float(v) for v in ds[f"{dim}_bounds"][i])
+    if lo == hi and ds.sizes[dim] > 1:
+        lo, hi = (float(v) for v in edges(ds[dim].values)[[i, i + 1]])
     return (lo + hi) / 2
 
 

@@ -22,7 +22,7 @@ def atlas_title(
     axes, the panels, the notes and the rule that reduced a large grid."""
     title = [fill_title(ds.attrs.get("title", "") or "stabmap atlas", chars)]
     # narrower: clear of the legend beside it; the cells' part on a line of its own, after the grid points'
-    title.append(";\n".join(textwrap.fill(part, min(chars, 72)) for part in headline.split("; ")))
+    title.append(";\n".join(textwrap.fill(part, min(chars, 72 if plan.facet else 60)) for part in headline.split("; ")))
     if plan.fixed:
         fixed = []
         for k, (i, asked) in plan.fixed.items():
