@@ -42,8 +42,9 @@ class AreaShares:
     @staticmethod
     def mean(shares: list[AreaShares]) -> AreaShares:
         """The shares of several maps of equal area together (the panels of one figure); their inferred points summed."""
-        return AreaShares(*(float(np.mean([getattr(s, k) for s in shares])) for k in ("stable", "unstable", "other", "change", "undecided")),
-                          inferred=sum(s.inferred for s in shares))
+        stable, unstable, other, change, undecided = (float(np.mean([getattr(s, k) for s in shares]))
+                                                      for k in ("stable", "unstable", "other", "change", "undecided"))
+        return AreaShares(stable, unstable, other, change, undecided, inferred=sum(s.inferred for s in shares))
 
 
 def area_shares(labels, cells, wy: np.ndarray, wx: np.ndarray, stable: int | None) -> list[AreaShares]:

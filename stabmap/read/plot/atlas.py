@@ -193,9 +193,10 @@ def panel_title(ds: xr.Dataset, plan: FigurePlan, system, blocks, r: int | None,
     if system.stable_label is None:  # a system without stability: the panel's coordinates only
         return "\n".join(parts)
     text = f"{100 * blocks.counts.get(system.stable_label, 0) / sum(blocks.counts.values()):.0f} % {system.stable_word}"
-    proved = share is not None and share.whole > 0  # a coarse grid's cells prove changes at most: nothing to add
+    whole = 0.0 if share is None else share.whole  # a coarse grid's cells prove changes at most: nothing to add
+    proved = whole > 0
     if proved:  # short: three panels side by side share a line
-        text += f"; {100 * share.whole:.0f} % of area proved"
+        text += f"; {100 * whole:.0f} % of area proved"
     parts.append(text)
     two_lines = plan.row is not None or proved  # the longer text of areas needs its own line
     return "\n".join([", ".join(parts[:-1]), parts[-1]]) if two_lines else f"{parts[0]}  ({parts[1]})"
