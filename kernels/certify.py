@@ -1,13 +1,15 @@
 """N_c of one point without the coefficients of p: inertia for the real roots, disks for the rest.
 
-docs/certification.md, section 4, gives the proofs.  In short, with
-Phi^(x) = diag(Q(x)) Phi(x) diag(Q(x)) (a real symmetric polynomial matrix,
-det Phi^ = p prod Q, every zero of prod Q real) and nu(x) the number of
-negative eigenvalues of Phi(x), which is that of Phi^(x) off the poles:
+docs/certification.md, section 4, gives the proofs.  In short, with H(x)
+the pole-free symmetric form of Phi bordered by one row per liquid mode
+(a polynomial matrix, det H = prod c_kl p) and nu_H(x) = nu(Phi(x)) +
+#{kl : c_kl (x + beta_kl) < 0} its number of negative eigenvalues:
 
 * between increasing separators a < b at which Phi is provably nonsingular,
-  p has at least |nu(b) - nu(a)| - (poles in (a, b)) real roots (the analytic
-  eigenvalue branches of Phi^ must cross zero for nu to change);
+  p has at least |nu_H(b) - nu_H(a)| real roots (the analytic eigenvalue
+  branches of H must cross zero for nu_H to change; each real root moves it
+  by its Krein type, a pole not at all), so one interval counts a whole
+  cluster of roots of one type;
 * a Newton disk around z (radius d / |p~'/p~(z)|, the ratio enclosed by
   elimination of [Phi(z) | Phi'(z)] in balls) holds a root of p~ = p / z^m;
   disjoint ones clear of the axis hold distinct non-real roots.  Where those
@@ -25,6 +27,8 @@ branches cross zero together and nu jumps by k.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import allatonce, approximations, ball, disks, elimination, layout, pencil
@@ -41,7 +45,12 @@ WARM_SWEEPS = 4  # Aberth sweeps on a neighbour's roots that the inertia found o
 PAUSE = 16  # points done cold when warm starts do not pay, before the next try
 SMOOTH = 0.1  # weight of the newest point in those running means
 LOOSE_TOL = 2.0**-26  # enough for separators; the disks polish their own roots further
-MERGE = 2.0**-40  # features closer than this share of their size get no separator between them
+MERGE = 2.0**-40  # features closer than this share of their size get no separator between them (FINE)
+# ... and in the first, COARSE, placement: a cluster of roots of one Krein type needs no separator inside it (the
+# low-spin liquid roots of a chain lie 1e-6 apart, relative); KREIN.md measured 1e-3
+GROUP = 2.0**-10
+COARSE, FINE, POLES = 0, 1, 2  # placements of ``_real_roots_at_least``
+UNTRIED = -2  # a candidate separator not evaluated (-1: evaluated, Phi not proved nonsingular there)
 FENCE = 2.0**-30  # separators this close (relative) either side of each pole
 NEAR_REAL = 2.0**-20  # approximations this close to the axis (relative) are expected to be real roots
 NUDGE = 2.0**-10  # relative imaginary offset given to suspect real approximations before polishing
@@ -96,26 +105,28 @@ def allocate(n, nmodes, parent):
 
 
 @kernel
-def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, suspect, with_poles):
-    """Lower bound of the real roots of p from the inertia of Phi at separators.
+def _real_roots_at_least(z, d, m, lead_nu, body, E, nmodes, parent, pws, feat, Sm, Sr, suspect, placement):
+    """Lower bound of the real roots of p from the inertia of the pole-free form H at separators.
 
-    Neighbouring features (approximations that may be real, within NUDGE of
-    the axis, and poles) get a separator midway; poles with such an
-    approximation close by, and the exact zero roots, are fenced by
-    separators just either side instead.  So a root that moved past a pole
-    since z was found is still counted.  Where a root lies inside a pole's
-    fence (a tiny E), every neighbouring pair gets its midway separator too:
-    if the fences cannot be evaluated, the sign change of p between those
-    still proves the root beside its pole (``_sign_of_p``).  Where nu changes
-    less across an interval than the near-real roots and poles inside it, the
-    approximations inside are marked in ``suspect``: polishing them is usually
-    all a retry needs.  ``feat`` needs 2 degree + 4 sum L + 8 entries.
+    nu_H(x) = nu(Phi(x)) + #{modes kl : c_kl (x + beta_kl) < 0} changes only at real roots of p, by the
+    roots' Krein types, and not at the poles (``_between``; docs/certification.md, section 4).  So an
+    interval needs separators at its ends only, wherever its roots all have one type.  ``placement``:
 
-    ``with_poles`` False: separators between the approximations that may be real alone (and the fences of the
-    exact zero roots).  p is a polynomial, so its sign change proves a root in an interval whatever poles of Phi
-    lie there: one separator between neighbouring simple real roots is all they need, against one or two more
-    for every pole.  Repeated roots (no sign change), or a pole's jump in nu cancelling theirs, then leave
-    suspects, and the caller counts again with ``with_poles`` True.
+    * COARSE: the approximations that may be real (within NUDGE of the axis) and the exact zero roots, grouped
+      where neighbours lie within GROUP (relative); separators only between groups, and only where needed:
+      from the ends (+-inf, whose nu_H the leading matrix gives, ``lead_nu``) an interval is cut at the middle
+      gap between its groups while it proves fewer roots than the features in it.  A run of roots of one type
+      costs no separator inside it; a point costs about one evaluation per change of type.
+    * FINE: a separator between every two such features more than MERGE apart.
+    * POLES: FINE, with the poles as features too, fenced either side where an approximation is near.  The
+      pole-free count does not need them; they stay as the last placement, which the earlier count, with
+      |nu(b) - nu(a)| - (poles inside), needed.
+
+    The exact zero roots are fenced either side (2^-30 of the features' size).  Where the count across an
+    interval falls short of the near-real approximations inside it, those are marked in ``suspect``: a finer
+    placement, or polishing them, is what a retry needs.  ``feat`` needs 2 degree + 4 sum L + 8 entries.
+    ``lead_nu`` < 0 (the leading matrix's inertia unproved): the ends are evaluated beyond the features instead.
+    Returns (the bound, the separators evaluated).
     """
     n = body.shape[0]
     beta = pws.beta
@@ -135,27 +146,29 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
                 continue  # kappa = 2: no pole (pencil._liquid_real); its zero of prod Q is among the m exact zero roots
             feat[nr + lsum] = -beta[0, k, l]
             lsum += 1
+    with_poles = placement == POLES
     if nr + lsum == 0 or (nr == 0 and not with_poles):
         suspect[:d] = False
-        return 0  # nothing may be real: no real root is proved (and none is expected)
-    roots = np.sort(feat[:nr])
-    poles = np.sort(feat[nr : nr + lsum])
+        return 0, 0  # nothing may be real: no real root is proved (and none is expected)
+    roots = feat[:nr]
+    poles = feat[nr : nr + lsum]
+    _sort(roots)
+    _sort(poles)
     sep = feat[nr + lsum :]
-    # the poles that place separators; all of them count in each interval's jump of nu below
-    lsep = lsum if with_poles else 0
-    lo = min(roots[0], poles[0]) if lsum and nr else (poles[0] if lsum else roots[0])
-    hi = max(roots[nr - 1], poles[lsum - 1]) if lsum and nr else (poles[lsum - 1] if lsum else roots[nr - 1])
+    lsep = lsum if with_poles else 0  # the poles that place separators
+    merge = GROUP if placement == COARSE else MERGE
+    if lsep and nr:
+        lo, hi = min(roots[0], poles[0]), max(roots[nr - 1], poles[lsep - 1])
+    elif lsep:
+        lo, hi = poles[0], poles[lsep - 1]
+    else:
+        lo, hi = roots[0], roots[nr - 1]
     pad = 0.25 * (hi - lo) + 1e-3 * max(abs(lo), abs(hi)) + 1e-300
     zero_eps = FENCE * max(abs(lo), abs(hi)) + 1e-300
-    # a separator midway between neighbouring features (approximations that may be real, poles);
-    # a pole with such an approximation within RIDE of it, and the exact zero roots, are fenced on
-    # both sides instead, so that a root that moved past its pole since z was found is still counted
-    sep[0] = lo - pad
+    sep[0] = -np.inf if lead_nu >= 0 else lo - pad
     ns = 1
-    # a root inside a pole's fence (a tiny E) may be too close to it for the fences to be evaluated: then every
-    # neighbouring pair of features gets its midway separator, fenced or not, so that the pole and that root
-    # still get an interval of their own, whose sign change of p proves the root.  Otherwise fenced features get
-    # no midway separator: it would only cost an inertia evaluation.
+    # POLES: a root inside a pole's fence (a tiny E) may be too close to it for the fences to be evaluated: then
+    # every neighbouring pair of features gets its midway separator, fenced or not
     tight = False
     for t in range(lsep):
         tight = tight or _gap_to_root(roots, nr, poles[t]) < 2.0 * (FENCE * abs(poles[t]) + 1e-300)
@@ -177,7 +190,7 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
             fence = m > 0 and x == 0.0
             eps = zero_eps
             i += 1
-        if started and (tight or not (fence or last_fenced)) and x - last > MERGE * max(abs(x), abs(last)):
+        if started and (tight or not (fence or last_fenced)) and x - last > merge * max(abs(x), abs(last)):
             sep[ns] = 0.5 * (x + last)
             ns += 1
         if fence:
@@ -185,44 +198,194 @@ def _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, su
             sep[ns + 1] = x + eps
             ns += 2
         last, last_fenced, started = x, fence, True
-    sep[ns] = hi + pad
+    sep[ns] = np.inf if lead_nu >= 0 else hi + pad
     ns += 1
     # the count below needs increasing separators (a fence may lie beyond a neighbouring root)
-    sep[:ns].sort()
+    _sort(sep[:ns])
+    if placement == COARSE:
+        return _cut_where_short(z, d, m, lead_nu, body, E, nmodes, parent, pws, sep, ns, zero_eps, Sm, Sr, suspect)
+    return _krein_count(z, d, m, lead_nu, body, E, nmodes, parent, pws, sep, ns, Sm, Sr, suspect)
+
+
+@kernel
+def _sort(a):
+    """Sort a few floats in place (insertion sort: numba's np.sort costs about 1 us on a dozen)."""
+    for i in range(1, a.size):
+        x = a[i]
+        j = i - 1
+        while j >= 0 and a[j] > x:
+            a[j + 1] = a[j]
+            j -= 1
+        a[j + 1] = x
+
+
+@kernel
+def _fixed(s, ns, x, zero_eps):
+    """Whether sep[s] of sep[:ns] is one every count evaluates: an end, or a fence of the exact zero roots."""
+    return s == 0 or s == ns - 1 or abs(x) == zero_eps
+
+
+@kernel
+def _cut_where_short(z, d, m, lead_nu, body, E, nmodes, parent, pws, sep, ns, zero_eps, Sm, Sr, suspect):
+    """``_krein_count`` on the fixed separators and those of sep[:ns] it needs: from the left, an interval whose
+    count falls short of the features that may be real inside it is cut at its middle candidate, until it is not
+    short or no candidate is left in it.  Returns (the bound, the separators evaluated)."""
+    nus = np.full(ns, UNTRIED, np.int64)
+    signs = np.zeros(ns, np.int64)
+    evaluated = 0
+    for s in range(ns):
+        if _fixed(s, ns, sep[s], zero_eps):
+            nus[s], signs[s] = _value(sep[s], lead_nu, d + m, body, E, nmodes, parent, pws, Sm, Sr)
+            evaluated += not math.isinf(sep[s])
     suspect[:d] = False
-    total, last, prev, sign_last = 0, -1, 0.0, 0
+    total = 0
+    a = 0
+    while a < ns and nus[a] < 0:
+        a += 1
+    while a < ns:
+        b = a + 1  # the next proved separator: the candidates before it are untried (or failed)
+        while b < ns and nus[b] < 0:
+            b += 1
+        if b >= ns:
+            break
+        here, expected, maybe = _between(sep[a], sep[b], nus[a], nus[b], signs[a], signs[b], z, d, m, body, E, nmodes, pws)
+        if here < maybe:
+            k = _middle_untried(nus, a, b)
+            if k >= 0:
+                nus[k], signs[k] = _value(sep[k], lead_nu, d + m, body, E, nmodes, parent, pws, Sm, Sr)
+                evaluated += 1
+                continue  # (a, k) next, if k was proved; else (a, b) again with k out
+        total += here
+        if here < expected:
+            _mark(z, d, sep[a], sep[b], suspect)
+        a = b
+    return total, evaluated
+
+
+@kernel
+def _middle_untried(nus, a, b):
+    """The index in (a, b) of the untried separator nearest the middle, or -1."""
+    best, gap = -1, b - a
+    mid = 0.5 * (a + b)
+    for k in range(a + 1, b):
+        if nus[k] == UNTRIED and abs(k - mid) < gap:
+            best, gap = k, abs(k - mid)
+    return best
+
+
+@kernel
+def _krein_count(z, d, m, lead_nu, body, E, nmodes, parent, pws, sep, ns, Sm, Sr, suspect):
+    """Real roots of p proved between the increasing separators sep[:ns] (those where Phi is proved
+    nonsingular; +-inf from the leading matrix).  Returns (the bound, the separators evaluated)."""
+    suspect[:d] = False
+    total, last, prev, sign_last, evaluated = 0, -1, 0.0, 0, 0
     for s in range(ns):
         x = sep[s]
-        if not pencil.real_matrix(x, body, E, nmodes, parent, pws, Sm, Sr):
-            continue
-        nu = elimination.inertia(Sm, Sr, n)
+        nu, sign = _value(x, lead_nu, d + m, body, E, nmodes, parent, pws, Sm, Sr)
+        evaluated += not math.isinf(x)
         if nu < 0:
             continue
-        sign = _sign_of_p(x, nu, beta, nmodes, n)
         if last >= 0:
-            # roots of p in (prev, x) >= |jump| - poles inside (and >= m around the zero roots)
-            inside = 0
-            for t in range(lsum):
-                inside += prev < poles[t] < x
-            here = max(abs(nu - last) - inside, 0)
-            if sign * sign_last < 0:
-                # p changes sign: at least one root, though a pole's jump may cancel the root's in nu (a tiny E
-                # puts a root within a few hundred ulps of its pole, too close for a separator between them)
-                here = max(here, 1)
-            expected = 0
-            for i in range(d):
-                if prev < z[i].real < x and abs(z[i].imag) <= NEAR_REAL * abs(z[i]):
-                    expected += 1
-            if m > 0 and prev < 0.0 < x:
-                here = max(here, m)
-                expected += m
+            here, expected, _ = _between(prev, x, last, nu, sign_last, sign, z, d, m, body, E, nmodes, pws)
             total += here
             if here < expected:
-                for i in range(d):
-                    if prev < z[i].real < x:
-                        suspect[i] = True
+                _mark(z, d, prev, x, suspect)
         last, prev, sign_last = nu, x, sign
-    return total
+    return total, evaluated
+
+
+@kernel
+def _mark(z, d, a, b, suspect):
+    for i in range(d):
+        if a < z[i].real < b:
+            suspect[i] = True
+
+
+@kernel
+def _value(x, lead_nu, degree, body, E, nmodes, parent, pws, Sm, Sr):
+    """(nu_H(x), the sign of p(x)) at a separator (``nu_h``); at x = +-inf from the leading matrix M' = M -
+    diag(sum E), nonsingular with ``lead_nu`` negative eigenvalues: nu_H(+-inf) = nu(M') + #{kl : +-c_kl < 0}
+    (Phi(x) ~ x^2 M'), and p(+-inf) has the sign of lc p = det M' times (+-1)^degree."""
+    if not math.isinf(x):
+        return nu_h(x, body, E, nmodes, parent, pws, Sm, Sr)
+    side = 1 if x > 0.0 else -1
+    nu = lead_nu
+    for k in range(body.shape[0]):
+        for l in range(nmodes[k]):
+            nu += side * pws.krein[k, l] < 0
+    sign = -1 if lead_nu % 2 else 1
+    if side < 0 and degree % 2:
+        sign = -sign
+    return nu, sign
+
+
+@kernel
+def _between(a, b, nu_a, nu_b, sign_a, sign_b, z, d, m, body, E, nmodes, pws):
+    """(real roots of p proved in (a, b), near-real approximations there, approximations that may be real there)
+    from nu_H and the sign of p at its ends.
+
+    With c_kl = E_kl beta_kl^2 (omega_k - beta_kl) over the modes with a pole term (sign in ``pws.krein``), the
+    symmetric matrix H(x) of size n + L, [[x^2 M + x G - K - diag_k sum_l E_kl q_kl(x), C], [C^t, diag c_kl (x +
+    beta_kl)]], is a polynomial in x, its Schur complement is Phi(x) and det H = prod c_kl * p(x) / (the factors of
+    p it leaves out), so by Haynsworth's inertia additivity nu_H(x) = nu(Phi(x)) + #{kl : c_kl (x + beta_kl) < 0}
+    (Gohberg, Lancaster & Rodman 1982, the sign characteristic; Kollar & Miller 2014).  Rellich's theorem: across
+    (a, b) nu_H changes only where an analytic eigenvalue branch of H vanishes, at a root of p, by at most the
+    root's multiplicity, so
+
+        real roots of p in (a, b) >= |nu_H(b) - nu_H(a)| + (modes with E = 0 whose root -beta lies inside),
+
+    and >= m around the exact zero roots, and >= 1 where p changes sign.  A mode whose c has no proved sign (none
+    from the model's inputs; kept for safety) stays a pole of the bordered form: its jump is subtracted, as in the
+    bound |nu(b) - nu(a)| - (poles inside) this count replaces.
+    """
+    beta, krein = pws.beta, pws.krein
+    inside, exact_roots = 0, 0
+    for k in range(body.shape[0]):
+        for l in range(nmodes[k]):
+            if (beta[0, k, l] == 0.0 and beta[1, k, l] == 0.0) or krein[k, l] != 0:
+                continue
+            # the balls a + beta_kl and b + beta_kl exclude 0 (real_matrix succeeded at both, or an end is
+            # infinite), so -beta_kl lies inside (a, b) exactly when their midpoints differ in sign
+            crossed = a + beta[0, k, l] < 0.0 < b + beta[0, k, l]
+            if E[k, l] == 0.0:
+                exact_roots += crossed  # p's exact factor x + beta_kl
+            else:
+                inside += crossed  # a pole of unknown type
+    here = max(abs(nu_b - nu_a) - inside, 0) + exact_roots
+    if sign_a * sign_b < 0:
+        # p changes sign: at least one root, whatever the count of the eigenvalue branches
+        here = max(here, 1)
+    expected, maybe = 0, 0
+    for i in range(d):
+        if a < z[i].real < b:
+            r = abs(z[i].imag)
+            expected += r <= NEAR_REAL * abs(z[i])
+            maybe += r <= NUDGE * abs(z[i])
+    if m > 0 and a < 0.0 < b:
+        here = max(here, m)
+        expected += m
+        maybe += m
+    return here, expected, maybe
+
+
+@kernel
+def nu_h(x, body, E, nmodes, parent, pws, Sm, Sr):
+    """(nu_H(x), the sign of p(x)) at the real float x, or (-1, 0) where Phi(x) is not proved nonsingular.
+
+    nu_H = nu(Phi(x)) + #{kl : c_kl (x + beta_kl) < 0} (``_krein_count``).  real_matrix succeeded, so each
+    ball x + beta_kl (beta_kl != 0) excludes 0 and its midpoint has its sign."""
+    n = body.shape[0]
+    if not pencil.real_matrix(x, body, E, nmodes, parent, pws, Sm, Sr):
+        return -1, 0
+    nu = elimination.inertia(Sm, Sr, n)
+    if nu < 0:
+        return -1, 0
+    sign = _sign_of_p(x, nu, pws.beta, nmodes, n)
+    for k in range(n):
+        for l in range(nmodes[k]):
+            if pws.krein[k, l] != 0 and pws.krein[k, l] * (x + pws.beta[0, k, l]) < 0.0:
+                nu += 1
+    return nu, sign
 
 
 @kernel
@@ -266,18 +429,22 @@ def _attempt(z, d, m, degree, body, E, nmodes, parent, ws, sweeps):
     """
     pws, F, dF, Sm, Sr, R, group, done = ws.pws, ws.F, ws.dF, ws.Sm, ws.Sr, ws.R, ws.group, ws.done
     feat, dm, dr, centre = ws.feat, ws.dm, ws.dr, ws.centre
-    # approximations from the eigenvalue problem (no sweeps) are accurate: separators between them alone
-    # usually prove every real root; a neighbour's, extrapolated, often leave suspects, so those count at once
-    # with the poles fenced
-    real = _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, done, sweeps > 0)
-    if sweeps == 0 and done[:d].any():  # an interval short of its expected roots: count again, poles fenced
-        real = _real_roots_at_least(z, d, m, body, E, nmodes, parent, pws, feat, Sm, Sr, done, True)
+    # separators between groups of near-real approximations first: a group of roots of one Krein type is
+    # counted whole; where an interval is short of its expected roots (a group holds both types), a separator
+    # between every two, then the poles fenced too.  Every count is a lower bound: the largest holds.
+    lead_nu = ws.state[layout.LEAD_NU]
+    real, evaluated = _real_roots_at_least(z, d, m, lead_nu, body, E, nmodes, parent, pws, feat, Sm, Sr, done, COARSE)
+    for placement in (FINE, POLES):
+        if not done[:d].any():
+            break
+        more, count = _real_roots_at_least(z, d, m, lead_nu, body, E, nmodes, parent, pws, feat, Sm, Sr, done, placement)
+        real = max(real, more)
+        evaluated += count
     real = max(m, real)
-    near, upper = 0, 0
+    upper = 0
     for i in range(d):
-        near += abs(z[i].imag) <= NUDGE * abs(z[i])
         upper += z[i].imag > approximations.UPPER * abs(z[i])
-    cost = SEPARATOR_COST * (near + 2 * nmodes.sum() + 2)
+    cost = SEPARATOR_COST * evaluated
     if real > degree:  # impossible for a proved bound: never label from it
         return real, -1, UNDECIDED, cost
     if real == degree:
@@ -343,7 +510,8 @@ def certify_point(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse)
     m = pencil.prepare(body, joint, at, g, E, kappa, nmodes, parent, free, pws, reuse)
     state[layout.KEPT] = 1
     d = degree - m
-    ok, lead_m, lead_e = disks.lead_bound(pws, n, Sm, Sr)
+    ok, lead_m, lead_e, lead_nu = disks.lead_bound(pws, n, Sm, Sr)
+    state[layout.LEAD_NU] = lead_nu
     if not ok:  # deg p unproved: nothing below counts
         state[layout.PREV_DECIDED] = 0
         return -1, UNDECIDED

@@ -72,14 +72,15 @@ def nonreal_in_disks(z, d, m, body, E, nmodes, pws, R, group, lead_m, lead_e):
 
 @kernel
 def lead_bound(pws, n, Sm, Sr):
-    """Lower bound of |det (M - diag(sum E))| (the leading coefficient of p) as (ok, mantissa, exponent)."""
+    """Lower bound of |det (M - diag(sum E))| (the leading coefficient of p) as (ok, mantissa, exponent), and the
+    number of negative eigenvalues of that matrix (-1 if unproved)."""
     mat, vec = pws.mat, pws.vec
     for i in range(n):
         for j in range(i + 1):
             Sm[i, j], Sr[i, j] = mat[layout.M_MID, i, j], mat[layout.M_RAD, i, j]
         Sm[i, i], Sr[i, i] = ball.radd(Sm[i, i], Sr[i, i], -vec[layout.ESUM_MID, i], vec[layout.ESUM_RAD, i])
     neg, mant, expo = elimination.ldl(Sm, Sr, n)
-    return neg >= 0, mant, expo
+    return neg >= 0, mant, expo, neg
 
 
 @kernel

@@ -44,7 +44,8 @@ HISTORY = 3  # 1 if zold holds the roots of the point before the previous one (e
 KEPT = 4  # 1 if the workspace holds M T and K T of the last point given (``reuse`` may take them)
 AAO_COLD_RUN = 5  # the all-at-once certificate's cold starts in a row
 AAO_PAUSE = 6  # its last pause [points]
-CERTIFY_STATE = 7
+LEAD_NU = 7  # negative eigenvalues of M - diag(sum E) (the leading matrix), -1 if unproved
+CERTIFY_STATE = 8
 
 # certify.allocate().costs: running means of what each way costs, in n x n complex solves
 WARM_COST = 0  # a warm start
@@ -67,7 +68,7 @@ ALLATONCE_STATE = 6
 CharpolyWork = namedtuple("CharpolyWork", "J M K q w P D T sub zero zero1")
 # pencil: T the path matrix; jmk (3, n, n, 3) J, M T, K T in double-double intervals; sub scratch; mat (10, n, n)
 # and vec (4, n) balls (``pencil.allocate``); beta (2, n, lmax) mid, rad; cm, cr Phi(z) mid, rad
-PencilWork = namedtuple("PencilWork", "T jmk sub mat vec beta cm cr")
+PencilWork = namedtuple("PencilWork", "T jmk sub mat vec beta krein cm cr")
 # count: the Sturm sequence W, the polynomial X, its float coefficients a and roots z, disk radii R, group, flags
 CountWork = namedtuple("CountWork", "W X a z R group flags")
 # allatonce: ``allatonce.allocate`` says what each holds; state has the AAO_* slots above

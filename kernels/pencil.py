@@ -38,9 +38,10 @@ def allocate(n, lmax, parent):
     mat = np.empty((layout.PENCIL_MAT, n, n))  # planes named in layout: M T, K T, M, K balls (mid, rad)
     vec = np.zeros((layout.PENCIL_VEC, n))  # rows named in layout: G, sum E balls (mid, rad)
     beta = np.zeros((2, n, max(1, lmax)))  # mid, rad
+    krein = np.zeros((n, max(1, lmax)), np.int64)  # sign of c_kl (``prepare``)
     cm = np.empty((n, n), np.complex128)
     cr = np.empty((n, n))
-    return layout.PencilWork(T, jmk, sub, mat, vec, beta, cm, cr)
+    return layout.PencilWork(T, jmk, sub, mat, vec, beta, krein, cm, cr)
 
 
 @kernel
@@ -55,8 +56,13 @@ def prepare(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
 
     Returns the number m of exact zero roots: columns of K T that are exactly zero, and modes with beta exactly 0
     (kappa = 2, or omega_k = 0), each a factor z of prod Q with no pole in Phi (``_liquid_real``).
+
+    ``ws.krein[k, l]`` gets the sign of c_kl = E_kl beta_kl^2 (omega_k - beta_kl), the bordering entry of the
+    pole-free form H (docs/certification.md, section 4): omega_k - beta_kl = 2 omega_k / kappa_kl, so it is the sign
+    of E_kl omega_k kappa_kl, read off the inputs with no arithmetic; 0 where the mode has no pole term (beta exactly
+    0, or E exactly 0: then p has the exact factor x + beta_kl and H no row for it).
     """
-    jmk, sub, mat, vec, beta = ws.jmk, ws.sub, ws.mat, ws.vec, ws.beta
+    jmk, sub, mat, vec, beta, krein = ws.jmk, ws.sub, ws.mat, ws.vec, ws.beta, ws.krein
     n = body.shape[0]
     if not reuse:
         structure(body, joint, at, g, parent, free, sub, jmk[0], jmk[1], jmk[2])
@@ -81,17 +87,24 @@ def prepare(body, joint, at, g, E, kappa, nmodes, parent, free, ws, reuse):
             # kappa - 2 exactly as a float pair, so beta is an exact zero when kappa == 2
             h, lo = two_sum(kappa[k, l], -2.0)
             t = ball.rmul(body[k, layout.OMEGA], 0.0, h, abs(lo))
+            krein[k, l] = 0
             if h == 0.0 or body[k, layout.OMEGA] == 0.0:
                 beta[0, k, l], beta[1, k, l] = 0.0, 0.0
                 m += 1
             else:
                 beta[0, k, l], beta[1, k, l] = ball.rdiv(t[0], t[1], kappa[k, l], 0.0)
+                krein[k, l] = _sign(E[k, l]) * _sign(body[k, layout.OMEGA]) * _sign(kappa[k, l])
         vec[layout.ESUM_MID, k], vec[layout.ESUM_RAD, k] = sm, sr
     # the exact zero roots: a column of K T that is exactly zero makes that column of Phi T divisible by z
     for j in range(n):
         if not _column_nonzero(mat[layout.KT_MID], mat[layout.KT_RAD], j):
             m += 1
     return m
+
+
+@kernel
+def _sign(x):
+    return 1 if x > 0.0 else (-1 if x < 0.0 else 0)
 
 
 @kernel

@@ -952,10 +952,11 @@ def _real_bounds(pts: PointArrays, p: int, z_of):
     assert kernels.approximations.eigenvalues(C, wr, wi, vdummy, z, degree, m)
     poles = np.array([-pws.beta[0, k, l] for k in range(n) for l in range(nmodes[k])])
     z[:d] = z_of(z[:d].copy(), d, poles)
-    args = (z, d, m, body[p], E[p], nmodes, parent, pws, feat, Sm, Sr, done)
-    cheap = max(m, certify._real_roots_at_least(*args, False))
+    lead_nu = kernels.disks.lead_bound(pws, n, Sm, Sr)[3]
+    args = (z, d, m, lead_nu, body[p], E[p], nmodes, parent, pws, feat, Sm, Sr, done)
+    cheap = max(m, certify._real_roots_at_least(*args, certify.COARSE)[0])
     suspects = int(done[:d].sum())
-    full = max(m, certify._real_roots_at_least(*args, True))
+    full = max(m, max(certify._real_roots_at_least(*args, placement)[0] for placement in (certify.FINE, certify.POLES)))
     return exact.count_real_roots(exact_poly(pts, p)), cheap, full, suspects
 
 
