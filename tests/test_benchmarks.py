@@ -22,6 +22,15 @@ def test_bench_kernel_quick(capsys):
     assert "| n | modes |" in capsys.readouterr().out
 
 
+def test_bench_krein_quick(capsys):
+    rows = runpy.run_path(str(SCRIPTS / "bench_krein.py"))["main"](["--quick"])
+    assert rows and all(r["points"] > 0 for r in rows)
+    for r in rows:
+        # separators only where the count falls short: never more than between every two near-real approximations
+        assert r["coarse"]["separators"] <= r["fine"]["separators"] <= r["poles"]["separators"]
+    assert "coarse / fine / poles" in capsys.readouterr().out
+
+
 def test_bench_kernel_density_quick():
     """The same chain at two spacings: only the number of points along the line changes."""
     rows = runpy.run_path(str(SCRIPTS / "bench_kernel.py"))["main"](["--density", "--quick"])
