@@ -2,6 +2,8 @@
 
     python scripts/bench_krein.py            # bench_kernel.py's rows and paper-n3-fixed at low and high spin (minutes)
     python scripts/bench_krein.py --quick    # seconds; run once by the test suite
+    python scripts/bench_krein.py --labels   # decide_block per point on bench_kernel.py's sets (run it in two
+                                             # checkouts, alternating, to compare a change)
 
 For every point, the linearisation's eigenvalues (the cold start's approximations, unpolished) place separators
 three ways (kernels/certify.py, ``_real_roots_at_least``):
@@ -126,11 +128,36 @@ def scenes(quick: bool):
         yield f"{n} x {m} {kind}", bk.any_set(rng, kind, lines, per_line, n, m)
 
 
+LABEL_ROWS = ((3, 2, "identical", 4, 100), (3, 2, "sameshape", 4, 100), (6, 4, "mixed", 4, 100), (6, 4, "identical", 4, 100),
+              (8, 4, "mixed", 2, 100), (8, 3, "kappa2", 4, 50), (8, 3, "free", 4, 50), (6, 3, "free", 4, 50), (12, 3, "mixed", 2, 50))
+
+
+def labels(quick: bool) -> list[dict]:
+    """decide_block per point, one thread, process time, minimum of three."""
+    rng = np.random.default_rng(7)
+    out = []
+    for n, m, kind, lines, per in LABEL_ROWS[:1] if quick else LABEL_ROWS:
+        pts = bk.any_set(rng, kind, 1 if quick else lines, 8 if quick else per, n, m)
+        bk.decide_threads(bk._subset(pts, slice(0, 4)), 1)
+        best = np.inf
+        for _ in range(1 if quick else 3):
+            (_, st), t = bk.timed(bk.decide_threads, pts, 1, clock=time.process_time)
+            best = min(best, t)
+        us = 1e6 * best / pts.body.shape[0]
+        out.append({"name": f"{n} x {m} {kind}", "us": us, "undecided_pct": 100.0 * float(np.mean(st == 1))})
+        print(f"| {n} x {m} {kind} | {us:.1f} | {out[-1]['undecided_pct']:.1f} |", flush=True)
+    return out
+
+
 def main(argv=None) -> list[dict]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="tiny sizes, for the test suite")
+    ap.add_argument("--labels", action="store_true", help="decide_block per point (LABEL_ROWS)")
     args = ap.parse_args(argv)
     print(f"# machine: {os.cpu_count()} cores, {platform.processor() or platform.machine()}, python {platform.python_version()}")
+    if args.labels:
+        print("| points | decide_block us a point | undecided % |\n|---|---|---|")
+        return labels(args.quick)
     print("| points | degree | n | separators a point: coarse / fine / poles | all real roots found (%): coarse / fine / poles "
           "| count us a point: coarse / fine / poles |")
     print("|---|---|---|---|---|---|")

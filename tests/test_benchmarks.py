@@ -29,6 +29,8 @@ def test_bench_krein_quick(capsys):
         # separators only where the count falls short: never more than between every two near-real approximations
         assert r["coarse"]["separators"] <= r["fine"]["separators"] <= r["poles"]["separators"]
     assert "coarse / fine / poles" in capsys.readouterr().out
+    timed = runpy.run_path(str(SCRIPTS / "bench_krein.py"))["main"](["--quick", "--labels"])
+    assert timed and timed[0]["us"] > 0
 
 
 def test_bench_kernel_density_quick():
