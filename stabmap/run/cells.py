@@ -195,6 +195,7 @@ class _Chunk:
         self.spans = np.array([a.continuous for a in scene.grid], dtype=bool)
         self.provable = provable(scene)
         self.cost = self.system.box_cost(scene) if self.provable else 1.0
+        self.cheap = self.system.cheap_box_cost(scene) if self.provable else 0.0  # 0: no cheap proof first
         # tiles: index along each axis of the chunk's cells; tiles numbered in C order of the chunk's tile grid
         size = tile_shape(scene)
         self.axis_tile = [(np.arange(s, e) // t) - s // t for (s, e), t in zip(location, size, strict=True)]
@@ -255,15 +256,27 @@ class _Chunk:
         along = np.ones((npts, len(self.names)), dtype=bool)
         if not self.provable or npts == 0:
             return label, proved, tried, along
-        tried = self.afford(tile, self.cost, self.reserve)
-        rows = np.flatnonzero(tried)
+        left = np.ones(npts, dtype=bool)  # boxes for the full proof
+        if self.cheap > 0.0:
+            # the cheap proof first, each box charged its price; those it leaves pay the full price on top
+            tried = self.afford(tile, self.cheap, self.reserve)
+            rows = np.flatnonzero(tried)
+            if rows.size:
+                got, ok = self.system.prove_boxes_cheaply(self.scene, {k: v[rows] for k, v in lower.items()},
+                                                          {k: v[rows] for k, v in upper.items()})
+                label[rows], proved[rows] = got, ok
+            left = tried & ~proved
+        full = np.zeros(npts, dtype=bool)
+        full[left] = self.afford(tile[left], self.cost, self.reserve)
+        rows = np.flatnonzero(full)
         if rows.size:
             got, ok, cut = self.system.prove_and_cut_boxes(self.scene, {k: v[rows] for k, v in lower.items()},
                                                            {k: v[rows] for k, v in upper.items()})
             label[rows], proved[rows] = got, ok
             for d, name in enumerate(self.names):
                 along[rows, d] = cut[name]
-        return label, proved, tried, along
+        # tried: every proof the box has was paid (a box the cheap proof left, with no credit for the full one, was not)
+        return label, proved, proved | full, along
 
     def classify(self, nodes: np.ndarray, label: np.ndarray, sub_boxes: np.ndarray) -> np.ndarray:
         """The ``cell`` flag of the cells of ``nodes`` (computed; ``label`` holds the chunk's labels), none proved whole.

@@ -295,6 +295,15 @@ class System(ABC, Generic[SceneT]):
         the budget of box proofs in an atlas (``stabmap.run.cells``)."""
         return 1.0
 
+    def prove_boxes_cheaply(self, scene: SceneT, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+        """(label, proved) as ``prove_boxes``, by a proof that costs ``cheap_box_cost`` a box, which an atlas tries
+        first; the boxes it leaves go on to ``prove_and_cut_boxes``.  None (the default): no such proof."""
+        return None
+
+    def cheap_box_cost(self, scene: SceneT) -> float:
+        """What one ``prove_boxes_cheaply`` costs, in proofs of one point; 0 where the system has none."""
+        return 0.0
+
     def box_axes(self, scene: SceneT) -> set[str]:
         """The grid axes along which ``prove_boxes`` can prove a box of this scene (default: none)."""
         return set()
