@@ -1,0 +1,657 @@
+"""Krein boxes: N_c proved on a whole box of the spin-scaled model from a few definite compressions (KREIN.md, 2).
+
+A box moves the one spin rate omega of every body (not through 0) and at most one mechanical axis t whose kernel
+inputs are copies of its value and enter M, C and K affinely (a mass, an inertia A or C, a joint's stiffness, g;
+not a length, whose entries are quadratic).  In mu = lambda / omega (docs/certification.md, section 6)
+
+    Phi_1(mu; u, t) = mu^2 M(t) + mu diag(C(t)) - u K(t) - liquid_1(mu),      u = 1 / omega^2,
+
+the poles mu = -beta_kl (unit spin) are fixed and Phi_1 is bilinear in (u, t): on the rectangle
+[u_lo, u_hi] x [t_lo, t_hi] it is a convex combination of its four corner values.
+
+**Real roots, sign-aware (KREIN.md, 1).**  Border the polynomial part of Phi_1 with one row per liquid mode with
+E != 0 and beta != 0: H(mu) = [[A(mu), C], [C^T, diag(c (mu + beta))]], c = E beta^2 (1 - beta), whose Schur
+complement is Phi_1.  H is a real symmetric matrix polynomial, det H = prod c * p_1 / (the exact factors below),
+and by Haynsworth nu_H(mu) = nu(Phi_1(mu)) + #{c (mu + beta) < 0} off the poles, with sign(c) = sign(E kappa)
+(1 - beta = 2 / kappa at unit spin).  Its eigenvalues are analytic in mu (Rellich) and their product is det H, so
+nu_H changes only at real roots of p_1, by at most their multiplicity: real roots in (a, b) >= |nu_H(b) - nu_H(a)|,
+poles not subtracted.  With M' = M - diag(sum E) positive definite, nu_H(+inf) = #{c < 0}, nu_H(-inf) = #{c > 0}.
+Modes with E = 0 (beta != 0) give the exact real root -beta of p_1, modes with beta = 0 (kappa = 2) the exact
+root 0: p_1 has those besides the roots of det H.
+
+**Constant inertia over the box.**  Separators mu_s are floats fixed over the box, placed (by float approximations
+at the box's centre, which prove nothing) between runs of real roots of one Krein type.  At mu_s, V- and V+ are
+float eigenvectors of Phi_1(mu_s; centre) for its negative and positive eigenvalues.  If V-^T Phi_1 V- < 0 and
+V+^T Phi_1 V+ > 0 at the four corners (balls: ``pencil.real_matrix`` from the corners' exact inputs, the compression
+in balls, ``elimination.inertia``), they hold on the whole box (convex combinations), and by Courant-Fischer
+Phi_1(mu_s; .) has exactly dim V- negative and dim V+ positive eigenvalues everywhere on it (dim V- + dim V+ = n).
+The pole terms of nu_H(mu_s) are fixed (mu_s + beta excludes 0).  M' > 0 at the two t corners holds on the box
+(M' is affine in t), so deg p_1 = D = sum (2 + L_k) on it.  So every point of the box has at least
+R = sum |delta nu_H| + (exact roots) real roots.  R = D: N_c = 0 on the whole box.
+
+**Complex pairs.**  For k = (D - R) / 2 upper approximations, an eigenpair Krawczyk test over the box: with
+a, s in [-1, 1] the box's u and t, Phi_1 = P0 + a Pa + s Ps + a s Pas exactly (bilinear), P0 the centre's
+matrix, Pa = -ru K0, Ps = mu^2 M1 + mu diag(C1) - uc K1, Pas = -ru K1 (M0, M1 the mean and half difference of
+M at t_lo, t_hi, and so on).  F(v, mu) = [Phi_1(mu) v; v_k - 1].  With x~ = (v~, mu~) and R ~ J(x~)^-1 floats,
+K = x~ - R F(x~) + (I - R J(X)) (X - x~) over X = x~ + discs(rho) and the box; R F and R J are expanded in the four
+parts and each product R * part is formed in balls before its absolute value (the centred form: the plain ball
+form loses the cancellation in w^T K v, KREIN.md).  |K - x~| < rho componentwise proves a unique zero in X for
+every point of the box (Krawczyk, complex discs are convex), so an eigenvalue of Phi_1, not a pole since the disc
+lies in the upper half plane: a non-real root of p_1.  k discs pairwise disjoint, clear of the real axis: 2k
+distinct non-real roots at every point, R + 2k = D, and N_c = k on the whole box.
+
+Everything that decides is balls with outward rounding (``ball.py``); floats only choose separators, the
+vectors V-, V+, the approximations and R.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+
+from . import ball, elimination, layout, pencil
+from .options import kernel
+from .status import DECIDED_DISKS, DECIDED_INERTIA, UNDECIDED
+
+NEAR_REAL = 1e-6  # approximations within this of the axis (relative to 1 + |mu|) are taken as real roots
+KRAWCZYK_STEPS = 8  # epsilon-inflation steps of the Krawczyk test
+NEWTON_STEPS = 4  # float Newton steps on the bordered eigenpair system at the centre
+TINY = 2.0**-60  # the smallest radius the Krawczyk test starts from (relative to 1 + |x|)
+
+# info columns written by ``krein_box_block`` per box
+INFO_SEPARATORS = 0
+INFO_PAIRS = 1
+INFO_REAL = 2  # real roots proved (inertia count plus exact roots), -1 if the separators failed
+INFO_STAGE = 3  # where it stopped: 0 inputs, 1 lc, 2 approximations, 3 separators, 4 count, 5 krawczyk, 6 proved
+NINFO = 4
+
+KreinWork = namedtuple("KreinWork", "T jmk sub tmat tvec cmat cvec beta cm cr C Mo F dF Sm Sr Wm Wr V P "
+                                    "feat ftype seps bord "
+                                    "pm pr qm qr cr0 cr1 Jm Jr Xm Xr Rm bm br Bm Bv")
+
+
+@kernel
+def allocate(n, lmax, parent):
+    """Scratch for one block of boxes of n bodies, at most lmax modes a body (ValueError for a bad ``parent``)."""
+    pw = pencil.allocate(n, lmax, parent)
+    L = max(1, lmax)
+    D = n * (L + 2)
+    N = n + 1
+    tmat = np.zeros((2, layout.PENCIL_MAT, n, n))  # the two t corners at u = 1
+    tvec = np.zeros((2, layout.PENCIL_VEC, n))
+    cmat = np.zeros((5, layout.PENCIL_MAT, n, n))  # corners (u_i, t_j) at 2 i + j; 4: the centre (floats)
+    cvec = np.zeros((5, layout.PENCIL_VEC, n))
+    return KreinWork(pw.T, pw.jmk, pw.sub, tmat, tvec, cmat, cvec, pw.beta, pw.cm, pw.cr,
+                     np.zeros((D, D)), np.zeros((n, n)), np.zeros((n, n), np.complex128), np.zeros((n, n), np.complex128),
+                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros(D + 1), np.zeros(D + 1, np.int64), np.zeros(D + 1), np.zeros((3, n * L + 1)),
+                     # Krawczyk: centred parts as real balls (mid, rad): 0 M0, 1 M1, 2 K0 uc, 3 K1 uc, 4 K0 ru, 5 K1 ru
+                     np.zeros((6, n, n)), np.zeros((6, n, n)), np.zeros((2, n)), np.zeros((2, n)),  # qm, qr: G0, G1
+                     np.zeros(N), np.zeros(N),
+                     np.zeros((N, N), np.complex128), np.zeros((N, N)), np.zeros((N, N), np.complex128), np.zeros((N, N)),
+                     np.zeros((N, N), np.complex128), np.zeros(N, np.complex128), np.zeros(N), np.zeros((N, N)), np.zeros(N))
+
+
+@kernel
+def _ws(kw, c):
+    """A ``pencil`` workspace whose matrices are those of slot c of ``kw.cmat`` (a corner, or 4 the centre)."""
+    return layout.PencilWork(kw.T, kw.jmk, kw.sub, kw.cmat[c], kw.cvec[c], kw.beta, kw.cm, kw.cr)
+
+
+@kernel
+def _twork(kw, j):
+    return layout.PencilWork(kw.T, kw.jmk, kw.sub, kw.tmat[j], kw.tvec[j], kw.beta, kw.cm, kw.cr)
+
+
+@kernel
+def _corners(kw, u_lo, u_hi, n):
+    """kw.cmat[2 i + j]: the t corner j with the stiffness times u_i (u_0 = u_lo, u_1 = u_hi), in balls;
+    kw.cmat[4]: the centre in floats (means; radii 0), which only steers."""
+    for i in range(2):
+        u = u_lo if i == 0 else u_hi
+        for j in range(2):
+            c = 2 * i + j
+            kw.cmat[c, :, :, :] = kw.tmat[j]
+            kw.cvec[c, :, :] = kw.tvec[j]
+            for a in range(n):
+                for b in range(n):
+                    kw.cmat[c, layout.K_MID, a, b], kw.cmat[c, layout.K_RAD, a, b] = ball.rmul(
+                        u, 0.0, kw.tmat[j, layout.K_MID, a, b], kw.tmat[j, layout.K_RAD, a, b])
+    uc = 0.5 * u_lo + 0.5 * u_hi
+    kw.cmat[4] = 0.0
+    kw.cvec[4] = 0.0
+    for a in range(n):
+        for b in range(n):
+            kw.cmat[4, layout.M_MID, a, b] = 0.5 * (kw.tmat[0, layout.M_MID, a, b] + kw.tmat[1, layout.M_MID, a, b])
+            kw.cmat[4, layout.K_MID, a, b] = uc * 0.5 * (kw.tmat[0, layout.K_MID, a, b] + kw.tmat[1, layout.K_MID, a, b])
+        for r in (layout.G_MID, layout.ESUM_MID):
+            kw.cvec[4, r, a] = 0.5 * (kw.tvec[0, r, a] + kw.tvec[1, r, a])
+
+
+@kernel
+def _lc_positive(kw, n):
+    """M' = M - diag(sum_l E_kl) proved positive definite at both t corners (so on the box: affine in t)."""
+    for j in range(2):
+        for a in range(n):
+            for b in range(a + 1):
+                kw.Sm[a, b], kw.Sr[a, b] = kw.tmat[j, layout.M_MID, a, b], kw.tmat[j, layout.M_RAD, a, b]
+            kw.Sm[a, a], kw.Sr[a, a] = ball.radd(kw.Sm[a, a], kw.Sr[a, a], -kw.tvec[j, layout.ESUM_MID, a], kw.tvec[j, layout.ESUM_RAD, a])
+        if elimination.inertia(kw.Sm, kw.Sr, n) != 0:
+            return False
+    return True
+
+
+@kernel
+def _compress(Sm, Sr, V, cols, ncols, n, Wm, Wr):
+    """Balls of W = V[:, cols]^T S V[:, cols] (lower triangle) for the symmetric ball matrix S (lower triangle read)
+    and the float V."""
+    for a in range(ncols):
+        for b in range(a + 1):
+            wm, wr = 0.0, 0.0
+            for i in range(n):
+                # (S V_b)_i
+                sm, sr = 0.0, 0.0
+                for j in range(n):
+                    em, er = (Sm[i, j], Sr[i, j]) if j <= i else (Sm[j, i], Sr[j, i])
+                    t = ball.rmul(em, er, V[j, cols[b]], 0.0)
+                    sm, sr = ball.radd(sm, sr, t[0], t[1])
+                t = ball.rmul(V[i, cols[a]], 0.0, sm, sr)
+                wm, wr = ball.radd(wm, wr, t[0], t[1])
+            Wm[a, b], Wr[a, b] = wm, wr
+
+
+@kernel
+def _separator_inertia(s, body2, E, nmodes, parent, kw, n):
+    """nu(Phi_1(s; .)) proved constant over the box (four corners, two compressions): that count, or -1."""
+    ws = _ws(kw, 4)
+    pencil.float_matrices(s + 0.0j, body2[0], E, nmodes, ws, kw.F, kw.dF)
+    for a in range(n):
+        for b in range(n):
+            kw.Wm[a, b] = kw.F[a, b].real
+    w, V = np.linalg.eigh(kw.Wm)
+    neg = np.empty(n, np.int64)
+    pos = np.empty(n, np.int64)
+    nn, npos = 0, 0
+    for i in range(n):
+        if w[i] < 0.0:
+            neg[nn] = i
+            nn += 1
+        else:
+            pos[npos] = i
+            npos += 1
+    for c in range(4):
+        if not pencil.real_matrix(s, body2[c % 2], E, nmodes, parent, _ws(kw, c), kw.Sm, kw.Sr):
+            return -1
+        if nn > 0:
+            _compress(kw.Sm, kw.Sr, V, neg, nn, n, kw.Wm, kw.Wr)
+            if elimination.inertia(kw.Wm, kw.Wr, nn) != nn:
+                return -1
+        if npos > 0:
+            _compress(kw.Sm, kw.Sr, V, pos, npos, n, kw.Wm, kw.Wr)
+            if elimination.inertia(kw.Wm, kw.Wr, npos) != 0:
+                return -1
+    return nn
+
+
+@kernel
+def _pole_terms(s, kw, nb):
+    """#{bordered modes: c (s + beta) < 0}, or -1 if some s + beta is not proved nonzero."""
+    count = 0
+    for i in range(nb):
+        dm, dr = ball.radd(s, 0.0, kw.bord[0, i], kw.bord[1, i])
+        if not ball.excludes_zero(dm, dr):
+            return -1
+        if (dm > 0.0) != (kw.bord[2, i] > 0.0):
+            count += 1
+    return count
+
+
+@kernel
+def _place_separators(kw, nreal, npole):
+    """Separators between neighbouring real approximations (sorted in kw.feat[:nreal]) of different types, each at
+    the middle of the widest gap between the two roots and the poles between them (kw.bord[0, :npole]: minus the
+    poles).  Returns how many (kw.seps)."""
+    ns = 0
+    for i in range(nreal - 1):
+        if kw.ftype[i] == kw.ftype[i + 1]:
+            continue
+        a, b = kw.feat[i], kw.feat[i + 1]
+        if not a < b:
+            continue
+        # widest gap among a, the poles in (a, b) (every pole: bordered or not), b
+        best, where = -1.0, 0.5 * (a + b)
+        left = a
+        while True:
+            nxt = b
+            for q in range(npole):
+                x = -kw.bord[0, q]
+                if left < x < nxt:
+                    nxt = x
+            if nxt - left > best:
+                best, where = nxt - left, 0.5 * (left + nxt)
+            if nxt >= b:
+                break
+            left = nxt
+        kw.seps[ns] = where
+        ns += 1
+    return ns
+
+
+@kernel
+def krein_box(body2, joint2, g2, at2, E, kappa, nmodes, free, parent, u_lo, u_hi, kw, info):
+    """N_c proved on the box (module docstring), or -1.  body2[j], joint2[j], g2[j], at2[j]: the kernel inputs at the
+    t corner j (every spin 1, the stiffness at u = 1); u in [u_lo, u_hi], 0 < u_lo <= u_hi."""
+    n = body2.shape[1]
+    info[:] = 0
+    info[INFO_REAL] = -1
+    if not (u_lo > 0.0 and u_lo <= u_hi and u_hi < math.inf):
+        return -1
+    for j in range(2):
+        for k in range(n):
+            if body2[j, k, layout.OMEGA] != 1.0:
+                return -1
+    for j in range(2):
+        pencil.prepare(body2[j], joint2[j], at2[j], g2[j], E, kappa, nmodes, parent, free, _twork(kw, j), False)
+    # the modes: exact roots (beta = 0: at 0; E = 0: at -beta) and the bordered ones with the sign of c
+    D, exact, nb = 0, 0, 0
+    for k in range(n):
+        D += 2 + nmodes[k]
+        for l in range(nmodes[k]):
+            bm, br = kw.beta[0, k, l], kw.beta[1, k, l]
+            if bm == 0.0 and br == 0.0:
+                exact += 1
+            elif E[k, l] == 0.0:
+                exact += 1
+            else:
+                kw.bord[0, nb], kw.bord[1, nb] = bm, br
+                kw.bord[2, nb] = 1.0 if (E[k, l] > 0.0) == (kappa[k, l] > 0.0) else -1.0  # sign(c) = sign(E kappa)
+                nb += 1
+    npole = nb  # then the poles of the modes with E = 0: no term of Phi_1, but real_matrix avoids them too
+    for k in range(n):
+        for l in range(nmodes[k]):
+            bm, br = kw.beta[0, k, l], kw.beta[1, k, l]
+            if E[k, l] == 0.0 and not (bm == 0.0 and br == 0.0):
+                kw.bord[0, npole], kw.bord[1, npole], kw.bord[2, npole] = bm, br, 0.0
+                npole += 1
+    info[INFO_STAGE] = 1
+    if not _lc_positive(kw, n):
+        return -1
+    _corners(kw, u_lo, u_hi, n)
+    info[INFO_STAGE] = 2
+    # approximations at the centre (floats: they only steer)
+    Dl = 0
+    for k in range(n):
+        Dl += 2 + nmodes[k]
+    C = kw.C[:Dl, :Dl]
+    cws = _ws(kw, 4)
+    if not pencil.linearisation(body2[0], E, nmodes, parent, cws, C, kw.Mo):
+        return -1
+    Cc = C.astype(np.complex128)
+    for i in range(Dl):
+        for j in range(Dl):
+            if not math.isfinite(C[i, j]):
+                return -1
+    w, X = np.linalg.eig(Cc)
+    nreal = 0
+    order = np.argsort(w.real)
+    for idx in order:
+        z = w[idx]
+        if abs(z.imag) > NEAR_REAL * (1.0 + abs(z)):
+            continue
+        # Krein type: sign of theta^T Phi_1'(z) theta, theta the first n entries of the eigenvector
+        big, kk = -1.0, 0
+        for i in range(n):
+            if abs(X[i, idx]) > big:
+                big, kk = abs(X[i, idx]), i
+        if big <= 0.0:
+            continue
+        pencil.float_matrices(z.real + 0.0j, body2[0], E, nmodes, cws, kw.F, kw.dF)
+        tau = 0.0
+        for i in range(n):
+            ti = (X[i, idx] / X[kk, idx]).real
+            for j in range(n):
+                tau += ti * kw.dF[i, j].real * (X[j, idx] / X[kk, idx]).real
+        kw.feat[nreal] = z.real
+        kw.ftype[nreal] = 1 if tau >= 0.0 else -1
+        nreal += 1
+    info[INFO_STAGE] = 3
+    ns = _place_separators(kw, nreal, npole)
+    info[INFO_SEPARATORS] = ns
+    # nu_H at -inf, the separators, +inf
+    cpos = 0
+    for i in range(nb):
+        if kw.bord[2, i] > 0.0:
+            cpos += 1
+    last = cpos  # nu_H(-inf) = nu(M') + #{c > 0}, nu(M') = 0
+    real = 0
+    for i in range(ns):
+        s = kw.seps[i]
+        poles = _pole_terms(s, kw, nb)
+        if poles < 0:
+            return -1
+        nu = _separator_inertia(s, body2, E, nmodes, parent, kw, n)
+        if nu < 0:
+            return -1
+        nu += poles
+        real += abs(nu - last)
+        last = nu
+    real += abs((nb - cpos) - last)  # nu_H(+inf) = #{c < 0}
+    real += exact
+    info[INFO_REAL] = real
+    info[INFO_STAGE] = 4
+    if real > D or (D - real) % 2 != 0:
+        return -1
+    k = (D - real) // 2
+    if k == 0:
+        info[INFO_STAGE] = 6
+        return 0
+    # the k upper approximations farthest from the axis
+    info[INFO_STAGE] = 5
+    up = np.empty(Dl, np.int64)
+    nup = 0
+    for i in range(Dl):
+        if w[i].imag > NEAR_REAL * (1.0 + abs(w[i])):
+            up[nup] = i
+            nup += 1
+    if nup < k:
+        return -1
+    ims = np.empty(nup)
+    for i in range(nup):
+        ims[i] = -w[up[i]].imag
+    pick = np.argsort(ims)[:k]
+    _krawczyk_parts(kw, u_lo, u_hi, n)
+    cz = np.empty(k, np.complex128)
+    cr = np.empty(k)
+    for q in range(k):
+        ok, z, r = _krawczyk(w[up[pick[q]]], E, nmodes, kw, n)
+        if not ok:
+            return -1
+        cz[q], cr[q] = z, r
+    for a in range(k):
+        for b in range(a):
+            if not abs(cz[a] - cz[b]) * ball.LOW > (cr[a] + cr[b]) * ball.INFL:
+                return -1
+    info[INFO_PAIRS] = k
+    info[INFO_STAGE] = 6
+    return k
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The Krawczyk test of one complex pair over the box
+
+
+@kernel
+def _half(am, ar, bm, br, sign):
+    """(a + sign b) / 2 as a ball (the halving is exact but for underflow, covered by ETA in radd)."""
+    m, r = ball.radd(am, ar, sign * bm, br)
+    return 0.5 * m, 0.5 * r + ball.ETA
+
+
+@kernel
+def _krawczyk_parts(kw, u_lo, u_hi, n):
+    """kw.pm, kw.pr: 0 M0, 1 M1, 2 uc K0, 3 uc K1, 4 ru K0, 5 ru K1 (real balls, M0 = (M(t_lo) + M(t_hi)) / 2,
+    M1 = (M(t_hi) - M(t_lo)) / 2, K at u = 1); kw.qm, kw.qr: G0, G1.  [u_lo, u_hi] lies in [uc - ru, uc + ru]."""
+    uc = 0.5 * u_lo + 0.5 * u_hi
+    ru = np.nextafter(max(u_hi - uc, uc - u_lo), np.inf)
+    t = kw.tmat
+    for a in range(n):
+        for b in range(n):
+            for q in range(2):
+                sign = 1.0 if q == 0 else -1.0
+                mm, mr = _half(t[1, layout.M_MID, a, b], t[1, layout.M_RAD, a, b], t[0, layout.M_MID, a, b], t[0, layout.M_RAD, a, b], sign)
+                kw.pm[q, a, b], kw.pr[q, a, b] = mm, mr
+                km, kr = _half(t[1, layout.K_MID, a, b], t[1, layout.K_RAD, a, b], t[0, layout.K_MID, a, b], t[0, layout.K_RAD, a, b], sign)
+                kw.pm[2 + q, a, b], kw.pr[2 + q, a, b] = ball.rmul(uc, 0.0, km, kr)
+                kw.pm[4 + q, a, b], kw.pr[4 + q, a, b] = ball.rmul(ru, 0.0, km, kr)
+        for q in range(2):
+            sign = 1.0 if q == 0 else -1.0
+            kw.qm[q, a], kw.qr[q, a] = _half(kw.tvec[1, layout.G_MID, a], kw.tvec[1, layout.G_RAD, a],
+                                             kw.tvec[0, layout.G_MID, a], kw.tvec[0, layout.G_RAD, a], sign)
+
+
+@kernel
+def _phi_disc(z, zr, which, E, nmodes, kw, n, Fm, Fr, dFm, dFr):
+    """Complex balls of P(Z), P'(Z) over the disc Z = (z, zr): which 0 the centre's Phi_1 (M0, G0, uc K0, liquid),
+    1 the t part Ps (M1, G1, uc K1, no liquid).  False if Z may hold a pole."""
+    beta = kw.beta
+    z2m, z2r = ball.cmul(z, zr, z, zr)
+    im, kk = (0, 2) if which == 0 else (1, 3)
+    for a in range(n):
+        for b in range(n):
+            m, r = ball.cmul(z2m, z2r, kw.pm[im, a, b] + 0.0j, kw.pr[im, a, b])
+            Fm[a, b], Fr[a, b] = ball.cadd(m, r, -kw.pm[kk, a, b] + 0.0j, kw.pr[kk, a, b])
+            m, r = ball.cmul(2.0 * z, 2.0 * zr, kw.pm[im, a, b] + 0.0j, kw.pr[im, a, b])
+            dFm[a, b], dFr[a, b] = m, r
+        gm, gr = ball.cmul(z, zr, kw.qm[which, a] + 0.0j, kw.qr[which, a])
+        Fm[a, a], Fr[a, a] = ball.cadd(Fm[a, a], Fr[a, a], gm, gr)
+        dFm[a, a], dFr[a, a] = ball.cadd(dFm[a, a], dFr[a, a], kw.qm[which, a] + 0.0j, kw.qr[which, a])
+        if which != 0:
+            continue
+        # liquid: L = z^2 (z + 1) A + z (z + 1) e, L' = (3 z^2 + 2 z) A + z^2 (z + 1) A' + (2 z + 1) e,
+        # A = sum E / (z + beta), A' = -sum E / (z + beta)^2 over beta != 0, e = sum E over beta = 0
+        am, ar, pm_, pr_, em, er = 0.0j, 0.0, 0.0j, 0.0, 0.0j, 0.0
+        for l in range(nmodes[a]):
+            if beta[0, a, l] == 0.0 and beta[1, a, l] == 0.0:
+                em, er = ball.cadd(em, er, E[a, l] + 0.0j, 0.0)
+                continue
+            dm, dr = ball.cadd(z, zr, beta[0, a, l] + 0.0j, beta[1, a, l])
+            if not ball.excludes_zero(dm, dr):
+                return False
+            qm, qr = ball.cinv(dm, dr)
+            tm, tr = ball.cmul(E[a, l] + 0.0j, 0.0, qm, qr)
+            am, ar = ball.cadd(am, ar, tm, tr)
+            tm, tr = ball.cmul(tm, tr, qm, qr)
+            pm_, pr_ = ball.cadd(pm_, pr_, -tm, tr)
+        w1m, w1r = ball.cadd(z, zr, 1.0 + 0.0j, 0.0)  # z + 1
+        z3m, z3r = ball.cmul(z2m, z2r, w1m, w1r)  # z^2 (z + 1)
+        Lm, Lr = ball.cmul(z3m, z3r, am, ar)
+        zw = ball.cmul(z, zr, w1m, w1r)  # z (z + 1)
+        t = ball.cmul(zw[0], zw[1], em, er)
+        Lm, Lr = ball.cadd(Lm, Lr, t[0], t[1])
+        Fm[a, a], Fr[a, a] = ball.cadd(Fm[a, a], Fr[a, a], -Lm, Lr)
+        # L'
+        # 3 z^2 + 2 z: 2 z is exact, 3 z2m rounds by at most 2u |3 z2m| (covered with 4u), 3 z2r rounded up
+        c3 = ball.cadd(3.0 * z2m, (3.0 * z2r + 4.0 * ball.U * abs(3.0 * z2m)) * ball.INFL, 2.0 * z, 2.0 * zr)
+        t1 = ball.cmul(c3[0], c3[1], am, ar)
+        t2 = ball.cmul(z3m, z3r, pm_, pr_)
+        t3 = ball.cmul(2.0 * z + 1.0, (2.0 * zr + 2.0 * ball.U * abs(2.0 * z + 1.0)) * ball.INFL, em, er)
+        dl = ball.cadd(t1[0], t1[1], t2[0], t2[1])
+        dl = ball.cadd(dl[0], dl[1], t3[0], t3[1])
+        dFm[a, a], dFr[a, a] = ball.cadd(dFm[a, a], dFr[a, a], -dl[0], dl[1])
+    return True
+
+
+@kernel
+def _float_phi(z, E, nmodes, kw, n, F, dF):
+    """Floats of the centre's Phi_1(z), Phi_1'(z) (the midpoints of ``_phi_disc``)."""
+    Fr = np.empty((n, n))
+    dFr = np.empty((n, n))
+    ok = _phi_disc(z, 0.0, 0, E, nmodes, kw, n, F, Fr, dF, dFr)
+    return ok
+
+
+@kernel
+def _rball(R, Am, Ar, N, Om, Or):
+    """O = R A for the float R and the ball matrix A (N x N)."""
+    for i in range(N):
+        for j in range(N):
+            m, r = 0.0j, 0.0
+            for q in range(N):
+                t = ball.cmul(R[i, q], 0.0, Am[q, j], Ar[q, j])
+                m, r = ball.cadd(m, r, t[0], t[1])
+            Om[i, j], Or[i, j] = m, r
+
+
+@kernel
+def _rvec_abs(R, vm, vr, N, out):
+    """out += |R v| (upper bounds) for the float R and the ball vector v."""
+    for i in range(N):
+        m, r = 0.0j, 0.0
+        for q in range(N):
+            t = ball.cmul(R[i, q], 0.0, vm[q], vr[q])
+            m, r = ball.cadd(m, r, t[0], t[1])
+        out[i] = (out[i] + (abs(m) + r) * ball.INFL) * ball.INFL
+
+
+@kernel
+def _matvec_ball(Am, Ar, vm, vr, n, om, or_):
+    """o = A v in complex balls (n x n times n)."""
+    for i in range(n):
+        m, r = 0.0j, 0.0
+        for q in range(n):
+            t = ball.cmul(Am[i, q], Ar[i, q], vm[q], vr[q])
+            m, r = ball.cadd(m, r, t[0], t[1])
+        om[i], or_[i] = m, r
+
+
+@kernel
+def _krawczyk(z0, E, nmodes, kw, n):
+    """(ok, mu~, rho_mu): a disc about mu~ in the upper half plane holding, for every point of the box, exactly one
+    eigenvalue of Phi_1 with its eigenvector in the box about v~ (module docstring)."""
+    N = n + 1
+    F = np.empty((n, n), np.complex128)
+    dF = np.empty((n, n), np.complex128)
+    Fr = np.empty((n, n))
+    dFr = np.empty((n, n))
+    J = np.zeros((N, N), np.complex128)
+    z = z0
+    if not _float_phi(z, E, nmodes, kw, n, F, dF):
+        return False, z, 0.0
+    # the eigenvector: the null vector of Phi_1(z) by one inverse-iteration step from the smallest singular vector
+    U, S, Vh = np.linalg.svd(F)
+    v = np.empty(n, np.complex128)
+    for i in range(n):
+        v[i] = np.conj(Vh[n - 1, i])
+    k = 0
+    for i in range(n):
+        if abs(v[i]) > abs(v[k]):
+            k = i
+    v = v / v[k]
+    rhs = np.empty(N, np.complex128)
+    for _ in range(NEWTON_STEPS):
+        if not _float_phi(z, E, nmodes, kw, n, F, dF):
+            return False, z, 0.0
+        J[:, :] = 0.0
+        J[:n, :n] = F
+        J[:n, n] = dF @ v
+        J[n, k] = 1.0
+        rhs[:n] = F @ v
+        rhs[n] = v[k] - 1.0
+        try:
+            step = np.linalg.solve(J, rhs)
+        except Exception:  # singular in floats
+            return False, z, 0.0
+        v = v - step[:n]
+        z = z - step[n]
+        v = v / v[k]
+    v[k] = 1.0  # exactly: F's last entry v_k - 1 is then 0
+    if not (z.imag > 0.0) or not _float_phi(z, E, nmodes, kw, n, F, dF):
+        return False, z, 0.0
+    J[:, :] = 0.0
+    J[:n, :n] = F
+    J[:n, n] = dF @ v
+    J[n, k] = 1.0
+    try:
+        R = np.linalg.inv(J)
+    except Exception:
+        return False, z, 0.0
+    for i in range(N):
+        for j in range(N):
+            if not (math.isfinite(R[i, j].real) and math.isfinite(R[i, j].imag)):
+                return False, z, 0.0
+    vr0 = np.zeros(n)
+    bm, br = kw.bm, kw.br
+    base = np.zeros(N)
+    # R F(x~) over the box: F0 + a Fa + s Fs + a s Fas, each R * part in balls before |.|
+    if not _phi_disc(z, 0.0, 0, E, nmodes, kw, n, F, Fr, dF, dFr):
+        return False, z, 0.0
+    om = np.empty(n, np.complex128)
+    orr = np.empty(n)
+    _matvec_ball(F, Fr, v, vr0, n, om, orr)
+    bm[:n], br[:n] = om, orr
+    bm[n], br[n] = 0.0, 0.0
+    _rvec_abs(R, bm, br, N, base)
+    for part in range(3):  # Pa = -ru K0, Ps(z~), Pas = -ru K1
+        if part == 1:
+            _phi_disc(z, 0.0, 1, E, nmodes, kw, n, F, Fr, dF, dFr)
+        else:
+            q = 4 if part == 0 else 5
+            for a in range(n):
+                for b in range(n):
+                    F[a, b], Fr[a, b] = -kw.pm[q, a, b] + 0.0j, kw.pr[q, a, b]
+        _matvec_ball(F, Fr, v, vr0, n, om, orr)
+        bm[:n], br[:n] = om, orr
+        _rvec_abs(R, bm, br, N, base)
+    # epsilon-inflation
+    rho = np.empty(N)
+    xa = np.empty(N)
+    for i in range(n):
+        xa[i] = abs(v[i])
+    xa[n] = abs(z)
+    for i in range(N):
+        rho[i] = 2.0 * base[i] + TINY * (1.0 + xa[i])
+    Jm, Jr, Xm, Xr, B = kw.Jm, kw.Jr, kw.Xm, kw.Xr, kw.Bm
+    vb = np.empty(n)
+    for _ in range(KRAWCZYK_STEPS):
+        if not (rho[n] < z.imag * ball.LOW):
+            return False, z, 0.0
+        zr = rho[n]
+        for i in range(n):
+            vb[i] = rho[i]
+        B[:, :] = 0.0
+        for part in range(4):  # J0(X), Ja, Js(X), Jas: |I - R J0| + |R Ja| + |R Js| + |R Jas|
+            Jm[:, :] = 0.0
+            Jr[:, :] = 0.0
+            if part == 0 or part == 2:
+                if not _phi_disc(z, zr, 0 if part == 0 else 1, E, nmodes, kw, n, F, Fr, dF, dFr):
+                    return False, z, 0.0
+                for a in range(n):
+                    for b in range(n):
+                        Jm[a, b], Jr[a, b] = F[a, b], Fr[a, b]
+                _matvec_ball(dF, dFr, v, vb, n, om, orr)
+                for a in range(n):
+                    Jm[a, n], Jr[a, n] = om[a], orr[a]
+                if part == 0:
+                    Jm[n, k] = 1.0
+            else:
+                q = 4 if part == 1 else 5
+                for a in range(n):
+                    for b in range(n):
+                        Jm[a, b], Jr[a, b] = -kw.pm[q, a, b] + 0.0j, kw.pr[q, a, b]
+            _rball(R, Jm, Jr, N, Xm, Xr)
+            for i in range(N):
+                for j in range(N):
+                    m = -Xm[i, j] + (1.0 if (part == 0 and i == j) else 0.0)
+                    rad = Xr[i, j] + (2.0 * ball.U * abs(m) if part == 0 and i == j else 0.0)
+                    B[i, j] = (B[i, j] + (abs(m) + rad) * ball.INFL) * ball.INFL
+        # K - x~ within base + B rho (sums of nonnegative floats, each rounded up by INFL)
+        ok = True
+        kr = np.empty(N)
+        for i in range(N):
+            acc = base[i]
+            for j in range(N):
+                acc = (acc + B[i, j] * rho[j] * ball.INFL) * ball.INFL
+            kr[i] = acc
+            if not acc < rho[i]:
+                ok = False
+        if ok:
+            return True, z, rho[n]
+        for i in range(N):
+            rho[i] = 1.5 * kr[i] + TINY * (1.0 + xa[i])
+    return False, z, 0.0
+
+
+@kernel
+def krein_box_block(body, joint, g, at, E, kappa, nmodes, free, parent, u_lo, u_hi, out_nc, out_status, out_info):
+    """N_c of each of a block of Krein boxes (``krein_box``): body[p, j], joint[p, j], g[p, j], at[p, j] the inputs
+    at box p's t corner j (j = 0, 1; every spin 1, stiffness at u = 1), E[p], kappa[p] its modes, u in
+    [u_lo[p], u_hi[p]].  out_nc[p]: N_c or -1; out_status[p]: DECIDED_INERTIA (N_c = 0 by the real count alone),
+    DECIDED_DISKS (with Krawczyk pairs) or UNDECIDED; out_info[p] (NINFO columns, ``INFO_*``)."""
+    npts, n = body.shape[0], body.shape[2]
+    kw = allocate(n, max(1, nmodes.max()), parent)
+    for p in range(npts):
+        nc = krein_box(body[p], joint[p], g[p], at[p], E[p], kappa[p], nmodes, free, parent, u_lo[p], u_hi[p], kw, out_info[p])
+        out_nc[p] = nc
+        out_status[p] = UNDECIDED if nc < 0 else (DECIDED_INERTIA if nc == 0 else DECIDED_DISKS)
