@@ -51,7 +51,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from . import ball, elimination, layout, pencil
+from . import approximations, ball, elimination, layout, pencil
 from .options import kernel
 from .status import DECIDED_DISKS, DECIDED_INERTIA, UNDECIDED
 
@@ -67,17 +67,18 @@ INFO_REAL = 2  # real roots proved (inertia count plus exact roots), -1 if the s
 INFO_STAGE = 3  # where it stopped: 0 inputs, 1 lc, 2 approximations, 3 separators, 4 count, 5 krawczyk, 6 proved
 NINFO = 4
 
-KreinWork = namedtuple("KreinWork", "T jmk sub tmat tvec cmat cvec beta cm cr C Mo F dF Sm Sr Wm Wr V P "
+KreinWork = namedtuple("KreinWork", "T jmk sub tmat tvec cmat cvec beta cm cr C Mo F dF Sm Sr Wm Wr V P wr wi z "
                                     "feat ftype seps bord "
                                     "pm pr qm qr cr0 cr1 Jm Jr Xm Xr Rm bm br Bm Bv")
 
 
 @kernel
-def allocate(n, lmax, parent):
-    """Scratch for one block of boxes of n bodies, at most lmax modes a body (ValueError for a bad ``parent``)."""
+def allocate(n, nmodes, parent):
+    """Scratch for one block of boxes of n bodies with nmodes[k] modes each (ValueError for a bad ``parent``)."""
+    lmax = max(1, nmodes.max())
     pw = pencil.allocate(n, lmax, parent)
-    L = max(1, lmax)
-    D = n * (L + 2)
+    L = lmax
+    D = 2 * n + nmodes.sum()
     N = n + 1
     tmat = np.zeros((2, layout.PENCIL_MAT, n, n))  # the two t corners at u = 1
     tvec = np.zeros((2, layout.PENCIL_VEC, n))
@@ -86,6 +87,7 @@ def allocate(n, lmax, parent):
     return KreinWork(pw.T, pw.jmk, pw.sub, tmat, tvec, cmat, cvec, pw.beta, pw.cm, pw.cr,
                      np.zeros((D, D)), np.zeros((n, n)), np.zeros((n, n), np.complex128), np.zeros((n, n), np.complex128),
                      np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros(D), np.zeros(D), np.zeros(D, np.complex128),
                      np.zeros(D + 1), np.zeros(D + 1, np.int64), np.zeros(D + 1), np.zeros((3, n * L + 1)),
                      # Krawczyk: centred parts as real balls (mid, rad): 0 M0, 1 M1, 2 K0 uc, 3 K1 uc, 4 K0 ru, 5 K1 ru
                      np.zeros((6, n, n)), np.zeros((6, n, n)), np.zeros((2, n)), np.zeros((2, n)),  # qm, qr: G0, G1
@@ -284,35 +286,38 @@ def krein_box(body2, joint2, g2, at2, E, kappa, nmodes, free, parent, u_lo, u_hi
     Dl = 0
     for k in range(n):
         Dl += 2 + nmodes[k]
-    C = kw.C[:Dl, :Dl]
     cws = _ws(kw, 4)
-    if not pencil.linearisation(body2[0], E, nmodes, parent, cws, C, kw.Mo):
+    if not pencil.linearisation(body2[0], E, nmodes, parent, cws, kw.C, kw.Mo):
         return -1
-    Cc = C.astype(np.complex128)
     for i in range(Dl):
         for j in range(Dl):
-            if not math.isfinite(C[i, j]):
+            if not math.isfinite(kw.C[i, j]):
                 return -1
-    w, X = np.linalg.eig(Cc)
+    if not approximations.eigenvalues(kw.C, kw.wr, kw.wi, kw.V, kw.z, Dl, 0):
+        return -1
+    w = kw.z
     nreal = 0
     order = np.argsort(w.real)
     for idx in order:
         z = w[idx]
         if abs(z.imag) > NEAR_REAL * (1.0 + abs(z)):
             continue
-        # Krein type: sign of theta^T Phi_1'(z) theta, theta the first n entries of the eigenvector
-        big, kk = -1.0, 0
-        for i in range(n):
-            if abs(X[i, idx]) > big:
-                big, kk = abs(X[i, idx]), i
-        if big <= 0.0:
-            continue
+        # Krein type: sign of theta^T Phi_1'(z) theta, theta the eigenvector of Phi_1(z) of least |eigenvalue|
         pencil.float_matrices(z.real + 0.0j, body2[0], E, nmodes, cws, kw.F, kw.dF)
+        for i in range(n):
+            for j in range(n):
+                kw.Wm[i, j] = kw.F[i, j].real
+        if not np.all(np.isfinite(kw.Wm)):
+            continue
+        ev, Q = np.linalg.eigh(kw.Wm)
+        kk = 0
+        for i in range(n):
+            if abs(ev[i]) < abs(ev[kk]):
+                kk = i
         tau = 0.0
         for i in range(n):
-            ti = (X[i, idx] / X[kk, idx]).real
             for j in range(n):
-                tau += ti * kw.dF[i, j].real * (X[j, idx] / X[kk, idx]).real
+                tau += Q[i, kk] * kw.dF[i, j].real * Q[j, kk]
         kw.feat[nreal] = z.real
         kw.ftype[nreal] = 1 if tau >= 0.0 else -1
         nreal += 1
@@ -650,7 +655,7 @@ def krein_box_block(body, joint, g, at, E, kappa, nmodes, free, parent, u_lo, u_
     [u_lo[p], u_hi[p]].  out_nc[p]: N_c or -1; out_status[p]: DECIDED_INERTIA (N_c = 0 by the real count alone),
     DECIDED_DISKS (with Krawczyk pairs) or UNDECIDED; out_info[p] (NINFO columns, ``INFO_*``)."""
     npts, n = body.shape[0], body.shape[2]
-    kw = allocate(n, max(1, nmodes.max()), parent)
+    kw = allocate(n, nmodes, parent)
     for p in range(npts):
         nc = krein_box(body[p], joint[p], g[p], at[p], E[p], kappa[p], nmodes, free, parent, u_lo[p], u_hi[p], kw, out_info[p])
         out_nc[p] = nc

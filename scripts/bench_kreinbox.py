@@ -1,0 +1,98 @@
+"""Krein boxes (kernels/kreinbox.py) against today's tensor-grid box proof (block.nodes_box_block), same boxes, one process.
+
+    python scripts/bench_kreinbox.py            # 3000 boxes of each size
+    python scripts/bench_kreinbox.py --quick    # 300 boxes of each size
+
+paper-n3-fixed regridded to 300 x 300 (omega 1-200 x m_2 0.1-10, log), cell edges midway between grid values
+(``store.dataset.edges``, as scripts/bench_cell_boxes.py).  Boxes of 1 x 1, 4 x 4 and 16 x 16 cells at random
+positions.  For each kernel: the share proved and the microseconds per box of the kernel call alone (inputs
+formed before the clock starts; each kernel called once first, so compilation is not timed).  Where both prove a
+box they must agree on N_c (checked).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+import stabmap
+from stabmap.kernels import UNDECIDED, ZERO_POLYNOMIAL, nodes_box_block
+from stabmap.kernels.kreinbox import NINFO, krein_box_block
+from stabmap.scene.grid import resample
+from stabmap.store.dataset import edges
+from stabmap.systems.gyroscopes.boxes import boxes
+from stabmap.systems.gyroscopes.decide import kernel_args
+from stabmap.systems.gyroscopes.kreinboxes import krein_arrays
+from stabmap.systems.gyroscopes.nodes import NodeBoxes
+
+
+def cell_boxes(num: int, size: int, count: int, seed: int = 0):
+    scene = resample(stabmap.example("paper-n3-fixed"), omega=num, m_2=num)
+    values = {x.name: x.array for x in scene.grid}
+    ew, em = edges(values["omega"]), edges(values["m_2"])
+    rng = np.random.default_rng(seed + size)
+    i, j = rng.integers(0, num - size + 1, count), rng.integers(0, num - size + 1, count)
+    return scene, {"omega": ew[i], "m_2": em[j]}, {"omega": ew[i + size], "m_2": em[j + size]}
+
+
+def run_krein(scene, lower, upper):
+    npts = lower["omega"].size
+    nc = np.full(npts, -1, dtype=np.int16)
+    rows, part = krein_arrays(scene, lower, upper)
+    args = part.kernel_args()
+    count = np.empty(rows.size, np.int16)
+    status = np.empty(rows.size, np.int8)
+    info = np.zeros((rows.size, NINFO), np.int64)
+    t0 = time.perf_counter()
+    krein_box_block(*args, count, status, info)
+    seconds = time.perf_counter() - t0
+    ok = status != UNDECIDED
+    nc[rows[ok]] = count[ok]
+    return nc, seconds, info
+
+
+def run_nodes(scene, lower, upper):
+    npts = lower["omega"].size
+    nc = np.full(npts, -1, dtype=np.int16)
+    seconds = 0.0
+    for rows, part in boxes(scene, lower, upper):
+        assert isinstance(part, NodeBoxes)
+        args = kernel_args(part)
+        count = np.empty(rows.size, np.int16)
+        status = np.empty(rows.size, np.int8)
+        split = np.empty(rows.size, np.int8)
+        t0 = time.perf_counter()
+        nodes_box_block(*args, count, status, split)
+        seconds += time.perf_counter() - t0
+        ok = (status != UNDECIDED) & (status != ZERO_POLYNOMIAL)
+        nc[rows[ok]] = count[ok]
+    return nc, seconds
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--count", type=int, default=None)
+    args = ap.parse_args()
+    count = args.count or (300 if args.quick else 3000)
+    warm = cell_boxes(300, 1, 4)  # compile (or load) both kernels before any clock starts
+    run_krein(*warm)
+    run_nodes(*warm)
+    print(f"paper-n3-fixed 300 x 300, omega x m_2, {count} random boxes of each size")
+    print("cells    krein: proved   us/box  (N_c = 0 / pairs)   nodes_box_block: proved   us/box   both   disagree")
+    for size in (1, 4, 16):
+        scene, lower, upper = cell_boxes(300, size, count)
+        kn, ks, info = run_krein(scene, lower, upper)
+        nn, ns = run_nodes(scene, lower, upper)
+        both = (kn >= 0) & (nn >= 0)
+        disagree = int(np.sum(both & (kn != nn)))
+        print(f"{size:2d}x{size:<2d}   {100 * np.mean(kn >= 0):6.1f} %  {1e6 * ks / count:7.1f}   "
+              f"({int(np.sum(kn == 0))} / {int(np.sum(kn > 0))})          {100 * np.mean(nn >= 0):6.1f} %   "
+              f"{1e6 * ns / count:7.1f}   {int(both.sum()):5d}   {disagree}", flush=True)
+        assert disagree == 0, "the two box proofs disagree"
+
+
+if __name__ == "__main__":
+    main()
