@@ -56,7 +56,8 @@ from .options import kernel
 from .status import DECIDED_DISKS, DECIDED_INERTIA, UNDECIDED
 
 NEAR_REAL = 1e-6  # approximations within this of the axis (relative to 1 + |mu|) are taken as real roots
-KRAWCZYK_STEPS = 8  # epsilon-inflation steps of the Krawczyk test
+KRAWCZYK_STEPS = 16  # epsilon-inflation steps of the Krawczyk test
+INFLATE = 1.125  # each step starts from the last bound times this
 NEWTON_STEPS = 4  # float Newton steps on the bordered eigenpair system at the centre
 TINY = 2.0**-60  # the smallest radius the Krawczyk test starts from (relative to 1 + |x|)
 
@@ -644,7 +645,7 @@ def _krawczyk(z0, E, nmodes, kw, n):
         if ok:
             return True, z, rho[n]
         for i in range(N):
-            rho[i] = 1.5 * kr[i] + TINY * (1.0 + xa[i])
+            rho[i] = INFLATE * kr[i] + TINY * (1.0 + xa[i])
     return False, z, 0.0
 
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import stabmap
 from stabmap.kernels import layout
@@ -160,3 +162,62 @@ def test_the_corner_inputs_are_the_models_at_unit_spin_and_lengths_are_refused()
     two = from_dict(dict(WINDOW, grid={"omega": {"values": [20.0]}, "c_1": {"values": [0.1]}}))
     rows, part = krein_arrays(two, {"omega": np.array([20.0]), "c_1": np.array([0.1])}, {"omega": np.array([21.0]), "c_1": np.array([0.11])})
     assert rows.size == 0 and part is None
+
+
+@st.composite
+def _chains(draw):
+    """Small chains with the structural corners of the count: kappa = 2 (beta = 0, an exact root at 0), E = 0 (an
+    exact root at -beta, no pole term), negative kappa (c < 0), identical bodies, free chains, negative spins."""
+    n = draw(st.integers(1, 3))
+    free = draw(st.booleans())
+    identical = draw(st.booleans())
+    seed = draw(st.integers(0, 2**32 - 1))
+    axis = draw(st.sampled_from(["none", "m", "A", "C", "K", "g"] if not free else ["none", "A", "C", "K"]))
+    e_exp = draw(st.sampled_from([-6.0, -4.0, -3.0, -2.0]))
+    return n, free, identical, seed, axis, e_exp
+
+
+def _chain_scene(n, free, identical, seed, axis, e_exp):
+    rng = np.random.default_rng(seed)
+    bodies = []
+    for k in range(n):
+        if identical and k:
+            bodies.append(dict(bodies[0]))
+            continue
+        b = {"m": float(rng.uniform(0.5, 2)), "A": float(rng.uniform(0.01, 0.05)), "C": float(rng.uniform(0.02, 0.08)),
+             "c": float(rng.uniform(-0.05, 0.15)), "s": float(rng.uniform(0.1, 0.3))}
+        L = int(rng.integers(0, 3))
+        if L:
+            E = [float(x) for x in 10.0**e_exp * rng.uniform(0.5, 2.0, L)]
+            if rng.random() < 0.2:
+                E[0] = 0.0
+            b["fluid"] = {"E": E, "kappa": [float(x) for x in rng.choice([-2.5, 1.31, 2.0, 2.7, 4.5], L, replace=False)]}
+        bodies.append(b)
+    system = {"support": "fixed" if not free else "free", "bodies": bodies, "joints": [float(x) for x in rng.uniform(1, 40, n - 1)]}
+    if not free:
+        system["g"] = 9.81
+    names = {"m": "m_1", "A": f"A_{n}", "C": "C_1", "K": "K_1" if n > 1 else None, "g": "g", "none": None}
+    other = names[axis] if not (free and axis == "K" and n == 1) else None
+    grid = {"omega": {"values": [10.0]}}
+    if other:
+        grid[other] = {"values": [1.0]}
+    return from_dict(dict(system, grid=grid)), other, rng
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(_chains())
+def test_property_proved_krein_boxes_of_random_chains_hold_their_label_exactly(case):
+    scene, other, rng = _chain_scene(*case)
+    count = 6
+    w = rng.uniform(1.0, 80.0, count) * rng.choice([-1.0, 1.0], count)
+    lower, upper = {"omega": w}, {"omega": w * (1.0 + 10.0 ** rng.uniform(-4, -1, count))}
+    if other:
+        base = {"m_1": 1.0, "C_1": 0.05, "K_1": 10.0, "g": 9.81}.get(other, 0.03)
+        t = base * rng.uniform(0.5, 2.0, count)
+        lower[other], upper[other] = t, t * (1.0 + 10.0 ** rng.uniform(-4, -1, count))
+    nc, proved, _ = prove_krein_boxes(scene, lower, upper)
+    for i in np.flatnonzero(proved):
+        t = np.concatenate([SQUARE, rng.random((2, 2))])
+        values = {a: lower[a][i] + t[:, d] * (upper[a][i] - lower[a][i]) for d, a in enumerate(lower)}
+        got = _exact(scene, values)
+        assert np.all(got == nc[i]), (case, i, {a: (lower[a][i], upper[a][i]) for a in lower}, nc[i], got)
