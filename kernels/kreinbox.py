@@ -65,12 +65,12 @@ TINY = 2.0**-60  # the smallest radius the Krawczyk test starts from (relative t
 INFO_SEPARATORS = 0
 INFO_PAIRS = 1
 INFO_REAL = 2  # real roots proved (inertia count plus exact roots), -1 if the separators failed
-INFO_STAGE = 3  # where it stopped: 0 inputs, 1 lc, 2 approximations, 3 separators, 4 count, 5 krawczyk, 6 proved
+INFO_STAGE = 3  # where it stopped: 0 inputs, 1 lc, 2 approximations, 3 separators, 4 count, 5 krawczyk, 6 proved cold, 7 proved warm
 NINFO = 4
 
 KreinWork = namedtuple("KreinWork", "T jmk sub tmat tvec cmat cvec beta cm cr C Mo F dF Sm Sr Wm Wr V P wr wi z "
                                     "feat ftype seps bord "
-                                    "pm pr qm qr cr0 cr1 Jm Jr Xm Xr Rm bm br Bm Bv")
+                                    "pm pr qm qr cr0 cr1 Jm Jr Xm Xr Rm bm br Bm Bv bv prev pz pv")
 
 
 @kernel
@@ -94,7 +94,8 @@ def allocate(n, nmodes, parent):
                      np.zeros((6, n, n)), np.zeros((6, n, n)), np.zeros((2, n)), np.zeros((2, n)),  # qm, qr: G0, G1
                      np.zeros(N), np.zeros(N),
                      np.zeros((N, N), np.complex128), np.zeros((N, N)), np.zeros((N, N), np.complex128), np.zeros((N, N)),
-                     np.zeros((N, N), np.complex128), np.zeros(N, np.complex128), np.zeros(N), np.zeros((N, N)), np.zeros(N))
+                     np.zeros((N, N), np.complex128), np.zeros(N, np.complex128), np.zeros(N), np.zeros((N, N)), np.zeros(N),
+                     np.zeros(N), np.zeros(3, np.int64), np.zeros(D, np.complex128), np.zeros((D, n), np.complex128))
 
 
 @kernel
@@ -166,6 +167,80 @@ def _compress(Sm, Sr, V, cols, ncols, n, Wm, Wr):
 
 
 @kernel
+def _jacobi(A, n, w, V):
+    """Eigenvalues w and eigenvectors (columns of V) of the symmetric float A (n x n, destroyed): cyclic Jacobi,
+    no allocation (LAPACK's call costs more than the work at these sizes).  Only steers."""
+    for i in range(n):
+        for j in range(n):
+            V[i, j] = 1.0 if i == j else 0.0
+    for sweep in range(30):
+        off = 0.0
+        diag = 0.0
+        for i in range(n):
+            diag += A[i, i] * A[i, i]
+            for j in range(i + 1, n):
+                off += A[i, j] * A[i, j]
+        if off <= 1e-32 * diag or off == 0.0:
+            break
+        for p in range(n - 1):
+            for q in range(p + 1, n):
+                apq = A[p, q]
+                if apq == 0.0:
+                    continue
+                theta = (A[q, q] - A[p, p]) / (2.0 * apq)
+                t = (1.0 if theta >= 0.0 else -1.0) / (abs(theta) + math.sqrt(theta * theta + 1.0))
+                c = 1.0 / math.sqrt(t * t + 1.0)
+                sn = t * c
+                for k in range(n):
+                    akp, akq = A[k, p], A[k, q]
+                    A[k, p], A[k, q] = c * akp - sn * akq, sn * akp + c * akq
+                for k in range(n):
+                    apk, aqk = A[p, k], A[q, k]
+                    A[p, k], A[q, k] = c * apk - sn * aqk, sn * apk + c * aqk
+                for k in range(n):
+                    vkp, vkq = V[k, p], V[k, q]
+                    V[k, p], V[k, q] = c * vkp - sn * vkq, sn * vkp + c * vkq
+    for i in range(n):
+        w[i] = A[i, i]
+
+
+@kernel
+def _csolve(A, B, N, m, X):
+    """X = A^-1 B for the complex N x N A and N x m B by Gaussian elimination with partial pivoting, A and B
+    destroyed; False if a pivot is 0 or the result not finite.  Floats: only steers."""
+    for c in range(N):
+        p, best = c, -1.0
+        for i in range(c, N):
+            if abs(A[i, c]) > best:
+                p, best = i, abs(A[i, c])
+        if not best > 0.0:
+            return False
+        if p != c:
+            for j in range(N):
+                A[c, j], A[p, j] = A[p, j], A[c, j]
+            for j in range(m):
+                B[c, j], B[p, j] = B[p, j], B[c, j]
+        inv = 1.0 / A[c, c]
+        for i in range(c + 1, N):
+            f = A[i, c] * inv
+            if f == 0.0:
+                continue
+            for j in range(c, N):
+                A[i, j] -= f * A[c, j]
+            for j in range(m):
+                B[i, j] -= f * B[c, j]
+    for j in range(m):
+        for i in range(N - 1, -1, -1):
+            t = B[i, j]
+            for q in range(i + 1, N):
+                t -= A[i, q] * X[q, j]
+            X[i, j] = t / A[i, i]
+            if not (math.isfinite(X[i, j].real) and math.isfinite(X[i, j].imag)):
+                return False
+    return True
+
+
+@kernel
 def _separator_inertia(s, body2, E, nmodes, parent, kw, n):
     """nu(Phi_1(s; .)) proved constant over the box (four corners, two compressions): that count, or -1."""
     ws = _ws(kw, 4)
@@ -173,7 +248,8 @@ def _separator_inertia(s, body2, E, nmodes, parent, kw, n):
     for a in range(n):
         for b in range(n):
             kw.Wm[a, b] = kw.F[a, b].real
-    w, V = np.linalg.eigh(kw.Wm)
+    w, V = kw.bv[:n], kw.V
+    _jacobi(kw.Wm, n, w, V)
     neg = np.empty(n, np.int64)
     pos = np.empty(n, np.int64)
     nn, npos = 0, 0
@@ -243,12 +319,95 @@ def _place_separators(kw, nreal, npole):
 
 
 @kernel
+def _null_vector(A, n, x):
+    """A float null vector of the nearly singular A (n x n, destroyed): one step of inverse iteration from ones,
+    by Gaussian elimination with partial pivoting (a zero pivot replaced by a tiny one).  Only steers."""
+    for i in range(n):
+        x[i] = 1.0
+    for c in range(n):
+        p, best = c, -1.0
+        for i in range(c, n):
+            if abs(A[i, c]) > best:
+                p, best = i, abs(A[i, c])
+        if p != c:
+            for j in range(n):
+                A[c, j], A[p, j] = A[p, j], A[c, j]
+            x[c], x[p] = x[p], x[c]
+        if A[c, c] == 0.0:
+            A[c, c] = 2.0**-60 * (1.0 + best)
+        for i in range(c + 1, n):
+            f = A[i, c] / A[c, c]
+            for j in range(c, n):
+                A[i, j] -= f * A[c, j]
+            x[i] -= f * x[c]
+    for i in range(n - 1, -1, -1):
+        t = x[i]
+        for j in range(i + 1, n):
+            t -= A[i, j] * x[j]
+        x[i] = t / A[i, i]
+    big = 0.0
+    for i in range(n):
+        big = max(big, abs(x[i]))
+    if not (big > 0.0 and math.isfinite(big)):
+        return False
+    for i in range(n):
+        x[i] /= big
+    return True
+
+
+@kernel
+def _count(kw, ns, body2, E, nmodes, parent, n, nb, cpos):
+    """Real roots of det H proved at every point of the box: sum |delta nu_H| over -inf, kw.seps[:ns], +inf; or -1."""
+    last = cpos  # nu_H(-inf) = nu(M') + #{c > 0}, nu(M') = 0
+    real = 0
+    for i in range(ns):
+        s = kw.seps[i]
+        if i > 0 and not s > kw.seps[i - 1]:
+            return -1
+        poles = _pole_terms(s, kw, nb)
+        if poles < 0:
+            return -1
+        nu = _separator_inertia(s, body2, E, nmodes, parent, kw, n)
+        if nu < 0:
+            return -1
+        nu += poles
+        real += abs(nu - last)
+        last = nu
+    return real + abs((nb - cpos) - last)  # nu_H(+inf) = #{c < 0}
+
+
+@kernel
+def _pairs(kw, k, warm, E, nmodes, n):
+    """k pairs proved by Krawczyk tests from kw.pz[:k] (and with ``warm`` the eigenvectors kw.pv[:k]), the discs
+    pairwise disjoint and in the upper half plane; the polished approximations back into kw.pz, kw.pv."""
+    cz = np.empty(k, np.complex128)
+    cr = np.empty(k)
+    for q in range(k):
+        ok, z, r = _krawczyk(kw.pz[q], kw.pv[q], warm, E, nmodes, kw, n, kw.pv[q])
+        if not ok:
+            return False
+        cz[q], cr[q] = z, r
+        kw.pz[q] = z
+    for a in range(k):
+        for b in range(a):
+            if not abs(cz[a] - cz[b]) * ball.LOW > (cr[a] + cr[b]) * ball.INFL:
+                return False
+    return True
+
+
+@kernel
 def krein_box(body2, joint2, g2, at2, E, kappa, nmodes, free, parent, u_lo, u_hi, kw, info):
     """N_c proved on the box (module docstring), or -1.  body2[j], joint2[j], g2[j], at2[j]: the kernel inputs at the
-    t corner j (every spin 1, the stiffness at u = 1); u in [u_lo, u_hi], 0 < u_lo <= u_hi."""
+    t corner j (every spin 1, the stiffness at u = 1); u in [u_lo, u_hi], 0 < u_lo <= u_hi.
+
+    kw.prev holds what the last box proved with (kw.prev[0] = 1: its separators kw.seps[:prev[1]] and its prev[2]
+    pairs' approximations kw.pz, kw.pv): a neighbour's, tried first with no eigenvalue problem.  Approximations
+    only steer: any of them, from anywhere, leaves the proof as rigorous."""
     n = body2.shape[1]
     info[:] = 0
     info[INFO_REAL] = -1
+    warm = kw.prev[0] == 1
+    kw.prev[0] = 0
     if not (u_lo > 0.0 and u_lo <= u_hi and u_hi < math.inf):
         return -1
     for j in range(2):
@@ -278,15 +437,26 @@ def krein_box(body2, joint2, g2, at2, E, kappa, nmodes, free, parent, u_lo, u_hi
             if E[k, l] == 0.0 and not (bm == 0.0 and br == 0.0):
                 kw.bord[0, npole], kw.bord[1, npole], kw.bord[2, npole] = bm, br, 0.0
                 npole += 1
+    cpos = 0
+    for i in range(nb):
+        if kw.bord[2, i] > 0.0:
+            cpos += 1
     info[INFO_STAGE] = 1
     if not _lc_positive(kw, n):
         return -1
     _corners(kw, u_lo, u_hi, n)
+    _krawczyk_parts(kw, u_lo, u_hi, n)
+    # a neighbour's separators and pairs first
+    if warm:
+        ns, k = kw.prev[1], kw.prev[2]
+        real = _count(kw, ns, body2, E, nmodes, parent, n, nb, cpos)
+        if real >= 0 and real + exact + 2 * k == D and (k == 0 or _pairs(kw, k, True, E, nmodes, n)):
+            kw.prev[0] = 1
+            info[INFO_SEPARATORS], info[INFO_PAIRS], info[INFO_REAL], info[INFO_STAGE] = ns, k, real + exact, 7
+            return k
     info[INFO_STAGE] = 2
     # approximations at the centre (floats: they only steer)
-    Dl = 0
-    for k in range(n):
-        Dl += 2 + nmodes[k]
+    Dl = D
     cws = _ws(kw, 4)
     if not pencil.linearisation(body2[0], E, nmodes, parent, cws, kw.C, kw.Mo):
         return -1
@@ -299,86 +469,57 @@ def krein_box(body2, joint2, g2, at2, E, kappa, nmodes, free, parent, u_lo, u_hi
     w = kw.z
     nreal = 0
     order = np.argsort(w.real)
+    x = kw.bv[:n]
     for idx in order:
         z = w[idx]
         if abs(z.imag) > NEAR_REAL * (1.0 + abs(z)):
             continue
-        # Krein type: sign of theta^T Phi_1'(z) theta, theta the eigenvector of Phi_1(z) of least |eigenvalue|
+        # Krein type: sign of theta^T Phi_1'(z) theta, theta a null vector of Phi_1(z)
         pencil.float_matrices(z.real + 0.0j, body2[0], E, nmodes, cws, kw.F, kw.dF)
         for i in range(n):
             for j in range(n):
                 kw.Wm[i, j] = kw.F[i, j].real
-        if not np.all(np.isfinite(kw.Wm)):
+        if not _null_vector(kw.Wm, n, x):
             continue
-        ev, Q = np.linalg.eigh(kw.Wm)
-        kk = 0
-        for i in range(n):
-            if abs(ev[i]) < abs(ev[kk]):
-                kk = i
         tau = 0.0
         for i in range(n):
             for j in range(n):
-                tau += Q[i, kk] * kw.dF[i, j].real * Q[j, kk]
+                tau += x[i] * kw.dF[i, j].real * x[j]
         kw.feat[nreal] = z.real
         kw.ftype[nreal] = 1 if tau >= 0.0 else -1
         nreal += 1
     info[INFO_STAGE] = 3
     ns = _place_separators(kw, nreal, npole)
     info[INFO_SEPARATORS] = ns
-    # nu_H at -inf, the separators, +inf
-    cpos = 0
-    for i in range(nb):
-        if kw.bord[2, i] > 0.0:
-            cpos += 1
-    last = cpos  # nu_H(-inf) = nu(M') + #{c > 0}, nu(M') = 0
-    real = 0
-    for i in range(ns):
-        s = kw.seps[i]
-        poles = _pole_terms(s, kw, nb)
-        if poles < 0:
-            return -1
-        nu = _separator_inertia(s, body2, E, nmodes, parent, kw, n)
-        if nu < 0:
-            return -1
-        nu += poles
-        real += abs(nu - last)
-        last = nu
-    real += abs((nb - cpos) - last)  # nu_H(+inf) = #{c < 0}
+    real = _count(kw, ns, body2, E, nmodes, parent, n, nb, cpos)
+    if real < 0:
+        return -1
     real += exact
     info[INFO_REAL] = real
     info[INFO_STAGE] = 4
     if real > D or (D - real) % 2 != 0:
         return -1
     k = (D - real) // 2
-    if k == 0:
-        info[INFO_STAGE] = 6
-        return 0
-    # the k upper approximations farthest from the axis
-    info[INFO_STAGE] = 5
-    up = np.empty(Dl, np.int64)
-    nup = 0
-    for i in range(Dl):
-        if w[i].imag > NEAR_REAL * (1.0 + abs(w[i])):
-            up[nup] = i
-            nup += 1
-    if nup < k:
-        return -1
-    ims = np.empty(nup)
-    for i in range(nup):
-        ims[i] = -w[up[i]].imag
-    pick = np.argsort(ims)[:k]
-    _krawczyk_parts(kw, u_lo, u_hi, n)
-    cz = np.empty(k, np.complex128)
-    cr = np.empty(k)
-    for q in range(k):
-        ok, z, r = _krawczyk(w[up[pick[q]]], E, nmodes, kw, n)
-        if not ok:
+    if k > 0:
+        # the k upper approximations farthest from the axis
+        info[INFO_STAGE] = 5
+        up = np.empty(Dl, np.int64)
+        nup = 0
+        for i in range(Dl):
+            if w[i].imag > NEAR_REAL * (1.0 + abs(w[i])):
+                up[nup] = i
+                nup += 1
+        if nup < k:
             return -1
-        cz[q], cr[q] = z, r
-    for a in range(k):
-        for b in range(a):
-            if not abs(cz[a] - cz[b]) * ball.LOW > (cr[a] + cr[b]) * ball.INFL:
-                return -1
+        ims = np.empty(nup)
+        for i in range(nup):
+            ims[i] = -w[up[i]].imag
+        pick = np.argsort(ims)[:k]
+        for q in range(k):
+            kw.pz[q] = w[up[pick[q]]]
+        if not _pairs(kw, k, False, E, nmodes, n):
+            return -1
+    kw.prev[0], kw.prev[1], kw.prev[2] = 1, ns, k
     info[INFO_PAIRS] = k
     info[INFO_STAGE] = 6
     return k
@@ -513,72 +654,146 @@ def _matvec_ball(Am, Ar, vm, vr, n, om, or_):
 
 
 @kernel
-def _krawczyk(z0, E, nmodes, kw, n):
-    """(ok, mu~, rho_mu): a disc about mu~ in the upper half plane holding, for every point of the box, exactly one
-    eigenvalue of Phi_1 with its eigenvector in the box about v~ (module docstring)."""
+def _bound_abs(R, Am, Ar, N, B, identity):
+    """B += |I - R A| (``identity``) or |R A| (upper bounds) for the float R and the ball matrix A (N x N)."""
+    for i in range(N):
+        for j in range(N):
+            m, r = 0.0j, 0.0
+            for q in range(N):
+                t = ball.cmul(R[i, q], 0.0, Am[q, j], Ar[q, j])
+                m, r = ball.cadd(m, r, t[0], t[1])
+            if identity:
+                m = -m
+                if i == j:
+                    m, r = ball.cadd(m, r, 1.0 + 0.0j, 0.0)
+            B[i, j] = (B[i, j] + (abs(m) + r) * ball.INFL) * ball.INFL
+
+
+@kernel
+def _jacobian(z, zr, v, vr, k, which, E, nmodes, kw, n, F, Fr, dF, dFr, Jm, Jr, om, orr):
+    """Balls of [[P(Z), P'(Z) V], [e_k^T or 0, 0]] (``which`` as ``_phi_disc``) into Jm, Jr; False at a pole."""
     N = n + 1
-    F = np.empty((n, n), np.complex128)
-    dF = np.empty((n, n), np.complex128)
-    Fr = np.empty((n, n))
-    dFr = np.empty((n, n))
-    J = np.zeros((N, N), np.complex128)
+    if not _phi_disc(z, zr, which, E, nmodes, kw, n, F, Fr, dF, dFr):
+        return False
+    Jm[:, :] = 0.0
+    Jr[:, :] = 0.0
+    for a in range(n):
+        for b in range(n):
+            Jm[a, b], Jr[a, b] = F[a, b], Fr[a, b]
+    _matvec_ball(dF, dFr, v, vr, n, om, orr)
+    for a in range(n):
+        Jm[a, n], Jr[a, n] = om[a], orr[a]
+    if which == 0:
+        Jm[n, k] = 1.0
+    return True
+
+
+@kernel
+def _constant_part(q, kw, n, Jm, Jr):
+    """[[-kw.pm[q], 0], [0, 0]] as balls (Pa = -ru K0 for q = 4, Pas = -ru K1 for q = 5)."""
+    Jm[:, :] = 0.0
+    Jr[:, :] = 0.0
+    for a in range(n):
+        for b in range(n):
+            Jm[a, b], Jr[a, b] = -kw.pm[q, a, b] + 0.0j, kw.pr[q, a, b]
+
+
+@kernel
+def _krawczyk(z0, v0, warm, E, nmodes, kw, n, vout):
+    """(ok, mu~, rho_mu): a disc about mu~ in the upper half plane holding, for every point of the box, exactly one
+    eigenvalue of Phi_1 with its eigenvector in the box about v~ (module docstring).  Starts from z0 and, with
+    ``warm``, the eigenvector v0 (else the least singular vector of Phi_1(z0)); v~ into vout."""
+    N = n + 1
+    F, dF, Fr, dFr = kw.F, kw.dF, kw.Sm, kw.Sr
+    Jm, Jr, Xm, Xr, B = kw.Jm, kw.Jr, kw.Xm, kw.Xr, kw.Bm
+    om = kw.bm[:n]
+    orr = kw.br[:n]
     z = z0
-    if not _float_phi(z, E, nmodes, kw, n, F, dF):
-        return False, z, 0.0
-    # the eigenvector: the null vector of Phi_1(z) by one inverse-iteration step from the smallest singular vector
-    U, S, Vh = np.linalg.svd(F)
     v = np.empty(n, np.complex128)
-    for i in range(n):
-        v[i] = np.conj(Vh[n - 1, i])
+    if warm:
+        v[:] = v0
+    else:
+        if not _phi_disc(z, 0.0, 0, E, nmodes, kw, n, F, Fr, dF, dFr):
+            return False, z, 0.0
+        # one step of inverse iteration from ones (Phi_1(z0) is nearly singular), else the least singular vector
+        A = F.copy()
+        ones = np.ones((n, 1), np.complex128)
+        col = np.empty((n, 1), np.complex128)
+        if _csolve(A, ones, n, 1, col):
+            for i in range(n):
+                v[i] = col[i, 0]
+        else:
+            U, S, Vh = np.linalg.svd(F)
+            for i in range(n):
+                v[i] = np.conj(Vh[n - 1, i])
     k = 0
     for i in range(n):
         if abs(v[i]) > abs(v[k]):
             k = i
+    if not abs(v[k]) > 0.0:
+        return False, z, 0.0
     v = v / v[k]
     rhs = np.empty(N, np.complex128)
-    for _ in range(NEWTON_STEPS):
-        if not _float_phi(z, E, nmodes, kw, n, F, dF):
-            return False, z, 0.0
-        J[:, :] = 0.0
-        J[:n, :n] = F
-        J[:n, n] = dF @ v
-        J[n, k] = 1.0
-        rhs[:n] = F @ v
-        rhs[n] = v[k] - 1.0
-        try:
-            step = np.linalg.solve(J, rhs)
-        except Exception:  # singular in floats
-            return False, z, 0.0
-        v = v - step[:n]
-        z = z - step[n]
-        v = v / v[k]
-    v[k] = 1.0  # exactly: F's last entry v_k - 1 is then 0
-    if not (z.imag > 0.0) or not _float_phi(z, E, nmodes, kw, n, F, dF):
-        return False, z, 0.0
-    J[:, :] = 0.0
-    J[:n, :n] = F
-    J[:n, n] = dF @ v
-    J[n, k] = 1.0
-    try:
-        R = np.linalg.inv(J)
-    except Exception:
-        return False, z, 0.0
-    for i in range(N):
-        for j in range(N):
-            if not (math.isfinite(R[i, j].real) and math.isfinite(R[i, j].imag)):
-                return False, z, 0.0
+    dcol = np.empty((N, 1), np.complex128)
+    J = kw.Rm
     vr0 = np.zeros(n)
-    bm, br = kw.bm, kw.br
-    base = np.zeros(N)
-    # R F(x~) over the box: F0 + a Fa + s Fs + a s Fas, each R * part in balls before |.|
-    if not _phi_disc(z, 0.0, 0, E, nmodes, kw, n, F, Fr, dF, dFr):
+    for step in range(NEWTON_STEPS + 1):
+        if not _phi_disc(z, 0.0, 0, E, nmodes, kw, n, F, Fr, dF, dFr):
+            return False, z, 0.0
+        if step == NEWTON_STEPS:
+            break
+        J[:, :] = 0.0
+        for a in range(n):
+            for b in range(n):
+                J[a, b] = F[a, b]
+            t, w = 0.0j, 0.0j
+            for b in range(n):
+                t += dF[a, b] * v[b]
+                w += F[a, b] * v[b]
+            J[a, n] = t
+            rhs[a] = w
+        J[n, k] = 1.0
+        rhs[n] = v[k] - 1.0
+        if not _csolve(J, rhs.reshape((N, 1)), N, 1, dcol):
+            return False, z, 0.0
+        for a in range(n):
+            v[a] -= dcol[a, 0]
+        z = z - dcol[n, 0]
+        d = dcol[:, 0]
+        v = v / v[k]
+        if abs(d[n]) <= 2.0**-45 * abs(z):
+            if step >= 1:
+                if not _phi_disc(z, 0.0, 0, E, nmodes, kw, n, F, Fr, dF, dFr):
+                    return False, z, 0.0
+                break
+    v[k] = 1.0  # exactly: F's last entry v_k - 1 is then 0
+    if not z.imag > 0.0:
         return False, z, 0.0
-    om = np.empty(n, np.complex128)
-    orr = np.empty(n)
+    vout[:] = v
+    J[:, :] = 0.0
+    for a in range(n):
+        for b in range(n):
+            J[a, b] = F[a, b]
+        t = 0.0j
+        for b in range(n):
+            t += dF[a, b] * v[b]
+        J[a, n] = t
+    J[n, k] = 1.0
+    R = np.empty((N, N), np.complex128)
+    eye = np.zeros((N, N), np.complex128)
+    for i in range(N):
+        eye[i, i] = 1.0
+    if not _csolve(J, eye, N, N, R):
+        return False, z, 0.0
+    # R F(x~) over the box: F0 + a Fa + s Fs + a s Fas, each R * part in balls before |.|  (F is Phi_1(z~) in balls)
+    bm, br = kw.cr0, kw.cr1
+    vm = np.zeros(N, np.complex128)
+    base = np.zeros(N)
     _matvec_ball(F, Fr, v, vr0, n, om, orr)
-    bm[:n], br[:n] = om, orr
-    bm[n], br[n] = 0.0, 0.0
-    _rvec_abs(R, bm, br, N, base)
+    for a in range(n):
+        vm[a], bm[a] = om[a], orr[a]
+    vm[n], bm[n] = 0.0, 0.0
+    _rvec_abs(R, vm, bm, N, base)
     for part in range(3):  # Pa = -ru K0, Ps(z~), Pas = -ru K1
         if part == 1:
             _phi_disc(z, 0.0, 1, E, nmodes, kw, n, F, Fr, dF, dFr)
@@ -588,53 +803,36 @@ def _krawczyk(z0, E, nmodes, kw, n):
                 for b in range(n):
                     F[a, b], Fr[a, b] = -kw.pm[q, a, b] + 0.0j, kw.pr[q, a, b]
         _matvec_ball(F, Fr, v, vr0, n, om, orr)
-        bm[:n], br[:n] = om, orr
-        _rvec_abs(R, bm, br, N, base)
-    # epsilon-inflation
-    rho = np.empty(N)
+        for a in range(n):
+            vm[a], bm[a] = om[a], orr[a]
+        _rvec_abs(R, vm, bm, N, base)
+    # |R Ja| + |R Jas|: the same for every X
+    Bc = np.zeros((N, N))
+    for q in (4, 5):
+        _constant_part(q, kw, n, Jm, Jr)
+        _bound_abs(R, Jm, Jr, N, Bc, False)
     xa = np.empty(N)
     for i in range(n):
         xa[i] = abs(v[i])
     xa[n] = abs(z)
+    rho = np.empty(N)
     for i in range(N):
         rho[i] = 2.0 * base[i] + TINY * (1.0 + xa[i])
-    Jm, Jr, Xm, Xr, B = kw.Jm, kw.Jr, kw.Xm, kw.Xr, kw.Bm
     vb = np.empty(n)
-    for _ in range(KRAWCZYK_STEPS):
+    kr = np.empty(N)
+    for it in range(KRAWCZYK_STEPS):
         if not (rho[n] < z.imag * ball.LOW):
             return False, z, 0.0
-        zr = rho[n]
         for i in range(n):
             vb[i] = rho[i]
-        B[:, :] = 0.0
-        for part in range(4):  # J0(X), Ja, Js(X), Jas: |I - R J0| + |R Ja| + |R Js| + |R Jas|
-            Jm[:, :] = 0.0
-            Jr[:, :] = 0.0
-            if part == 0 or part == 2:
-                if not _phi_disc(z, zr, 0 if part == 0 else 1, E, nmodes, kw, n, F, Fr, dF, dFr):
-                    return False, z, 0.0
-                for a in range(n):
-                    for b in range(n):
-                        Jm[a, b], Jr[a, b] = F[a, b], Fr[a, b]
-                _matvec_ball(dF, dFr, v, vb, n, om, orr)
-                for a in range(n):
-                    Jm[a, n], Jr[a, n] = om[a], orr[a]
-                if part == 0:
-                    Jm[n, k] = 1.0
-            else:
-                q = 4 if part == 1 else 5
-                for a in range(n):
-                    for b in range(n):
-                        Jm[a, b], Jr[a, b] = -kw.pm[q, a, b] + 0.0j, kw.pr[q, a, b]
-            _rball(R, Jm, Jr, N, Xm, Xr)
-            for i in range(N):
-                for j in range(N):
-                    m = -Xm[i, j] + (1.0 if (part == 0 and i == j) else 0.0)
-                    rad = Xr[i, j] + (2.0 * ball.U * abs(m) if part == 0 and i == j else 0.0)
-                    B[i, j] = (B[i, j] + (abs(m) + rad) * ball.INFL) * ball.INFL
-        # K - x~ within base + B rho (sums of nonnegative floats, each rounded up by INFL)
+        B[:, :] = Bc
+        if not _jacobian(z, rho[n], v, vb, k, 0, E, nmodes, kw, n, F, Fr, dF, dFr, Jm, Jr, om, orr):
+            return False, z, 0.0
+        _bound_abs(R, Jm, Jr, N, B, True)
+        _jacobian(z, rho[n], v, vb, k, 1, E, nmodes, kw, n, F, Fr, dF, dFr, Jm, Jr, om, orr)
+        _bound_abs(R, Jm, Jr, N, B, False)
+        # |K - x~| <= base + B rho (sums of nonnegative floats, each rounded up by INFL)
         ok = True
-        kr = np.empty(N)
         for i in range(N):
             acc = base[i]
             for j in range(N):
@@ -644,20 +842,40 @@ def _krawczyk(z0, E, nmodes, kw, n):
                 ok = False
         if ok:
             return True, z, rho[n]
-        for i in range(N):
-            rho[i] = INFLATE * kr[i] + TINY * (1.0 + xa[i])
+        if it == 0:
+            # the next radii from the floats: rho = (I - B)^-1 base, inflated (they only choose where to test)
+            IB = np.empty((N, N), np.complex128)
+            bb = np.empty((N, 1), np.complex128)
+            gg = np.empty((N, 1), np.complex128)
+            for i in range(N):
+                bb[i, 0] = base[i]
+                for j in range(N):
+                    IB[i, j] = (1.0 if i == j else 0.0) - B[i, j]
+            good = _csolve(IB, bb, N, 1, gg)
+            guess = np.empty(N)
+            for i in range(N):
+                guess[i] = gg[i, 0].real
+                good = good and guess[i] > 0.0 and math.isfinite(guess[i])
+            for i in range(N):
+                rho[i] = (1.5 * guess[i] if good else INFLATE * kr[i]) + TINY * (1.0 + xa[i])
+        else:
+            for i in range(N):
+                rho[i] = INFLATE * kr[i] + TINY * (1.0 + xa[i])
     return False, z, 0.0
 
 
 @kernel
-def krein_box_block(body, joint, g, at, E, kappa, nmodes, free, parent, u_lo, u_hi, out_nc, out_status, out_info):
+def krein_box_block(body, joint, g, at, E, kappa, nmodes, free, parent, u_lo, u_hi, warm, out_nc, out_status, out_info):
     """N_c of each of a block of Krein boxes (``krein_box``): body[p, j], joint[p, j], g[p, j], at[p, j] the inputs
     at box p's t corner j (j = 0, 1; every spin 1, stiffness at u = 1), E[p], kappa[p] its modes, u in
-    [u_lo[p], u_hi[p]].  out_nc[p]: N_c or -1; out_status[p]: DECIDED_INERTIA (N_c = 0 by the real count alone),
-    DECIDED_DISKS (with Krawczyk pairs) or UNDECIDED; out_info[p] (NINFO columns, ``INFO_*``)."""
+    [u_lo[p], u_hi[p]].  ``warm``: each box first tries the separators and pairs that proved the box before it
+    (neighbours in a sweep; they only steer).  out_nc[p]: N_c or -1; out_status[p]: DECIDED_INERTIA (N_c = 0 by
+    the real count alone), DECIDED_DISKS (with Krawczyk pairs) or UNDECIDED; out_info[p] (NINFO columns, ``INFO_*``)."""
     npts, n = body.shape[0], body.shape[2]
     kw = allocate(n, nmodes, parent)
     for p in range(npts):
+        if not warm:
+            kw.prev[0] = 0
         nc = krein_box(body[p], joint[p], g[p], at[p], E[p], kappa[p], nmodes, free, parent, u_lo[p], u_hi[p], kw, out_info[p])
         out_nc[p] = nc
         out_status[p] = UNDECIDED if nc < 0 else (DECIDED_INERTIA if nc == 0 else DECIDED_DISKS)

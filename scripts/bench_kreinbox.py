@@ -37,7 +37,7 @@ def cell_boxes(num: int, size: int, count: int, seed: int = 0):
     return scene, {"omega": ew[i], "m_2": em[j]}, {"omega": ew[i + size], "m_2": em[j + size]}
 
 
-def run_krein(scene, lower, upper):
+def run_krein(scene, lower, upper, warm=False):
     npts = lower["omega"].size
     nc = np.full(npts, -1, dtype=np.int16)
     rows, part = krein_arrays(scene, lower, upper)
@@ -46,7 +46,7 @@ def run_krein(scene, lower, upper):
     status = np.empty(rows.size, np.int8)
     info = np.zeros((rows.size, NINFO), np.int64)
     t0 = time.perf_counter()
-    krein_box_block(*args, count, status, info)
+    krein_box_block(*args, warm, count, status, info)
     seconds = time.perf_counter() - t0
     ok = status != UNDECIDED
     nc[rows[ok]] = count[ok]

@@ -97,8 +97,9 @@ def krein_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np
     return rows, KreinBoxes(b, joint[rows], g[rows], at[rows], lo.E[rows], lo.kappa[rows], lo.nmodes, lo.free, lo.parent, u_lo, u_hi)
 
 
-def prove_krein_boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
-    """(N_c int16 with -1 where not proved, proved bool, info (npts, NINFO) int64) of each box."""
+def prove_krein_boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray], warm: bool = True):
+    """(N_c int16 with -1 where not proved, proved bool, info (npts, NINFO) int64) of each box.  ``warm``: each box
+    first tries what proved the one before it (``kernels.kreinbox.krein_box_block``)."""
     npts = int(np.prod(np.broadcast_shapes(*(np.shape(v) for v in (*lower.values(), *upper.values())))))
     nc = np.full(npts, -1, dtype=np.int16)
     info = np.full((npts, NINFO), -1, dtype=np.int64)
@@ -107,7 +108,7 @@ def prove_krein_boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[st
         count = np.empty(rows.size, dtype=np.int16)
         status = np.empty(rows.size, dtype=np.int8)
         out_info = np.zeros((rows.size, NINFO), dtype=np.int64)
-        krein_box_block(*part.kernel_args(), count, status, out_info)
+        krein_box_block(*part.kernel_args(), warm, count, status, out_info)
         good = status != UNDECIDED
         nc[rows[good]] = count[good]
         info[rows] = out_info
