@@ -564,13 +564,19 @@ def _phi_disc(z, zr, which, E, nmodes, kw, n, Fm, Fr, dFm, dFr):
     1 the t part Ps (M1, G1, uc K1, no liquid).  False if Z may hold a pole."""
     beta = kw.beta
     z2m, z2r = ball.cmul(z, zr, z, zr)
+    a2 = abs(z2m) * ball.INFL  # upper bounds of |z^2|, |z| (hypot is within an ulp)
+    az = abs(z) * ball.INFL
     im, kk = (0, 2) if which == 0 else (1, 3)
     for a in range(n):
         for b in range(n):
-            m, r = ball.cmul(z2m, z2r, kw.pm[im, a, b] + 0.0j, kw.pr[im, a, b])
-            Fm[a, b], Fr[a, b] = ball.cadd(m, r, -kw.pm[kk, a, b] + 0.0j, kw.pr[kk, a, b])
-            m, r = ball.cmul(2.0 * z, 2.0 * zr, kw.pm[im, a, b] + 0.0j, kw.pr[im, a, b])
-            dFm[a, b], dFr[a, b] = m, r
+            # z^2 M - K for the complex ball z^2 and real balls M, K: the product of a complex float by a real one
+            # rounds each part once (<= sqrt 2 u |z^2| |M|), the subtraction the real part once
+            mm, mr, km, kr = kw.pm[im, a, b], kw.pr[im, a, b], kw.pm[kk, a, b], kw.pr[kk, a, b]
+            am_ = abs(mm)
+            Fm[a, b] = z2m * mm - km
+            Fr[a, b] = (a2 * mr + z2r * (am_ + mr) + kr + 4.0 * ball.U * (a2 * am_ + abs(km)) + ball.ETA) * ball.INFL * ball.INFL
+            dFm[a, b] = (2.0 * z) * mm  # 2 z exact
+            dFr[a, b] = (2.0 * az * mr + 2.0 * zr * (am_ + mr) + 4.0 * ball.U * az * am_ + ball.ETA) * ball.INFL * ball.INFL
         gm, gr = ball.cmul(z, zr, kw.qm[which, a] + 0.0j, kw.qr[which, a])
         Fm[a, a], Fr[a, a] = ball.cadd(Fm[a, a], Fr[a, a], gm, gr)
         dFm[a, a], dFr[a, a] = ball.cadd(dFm[a, a], dFr[a, a], kw.qm[which, a] + 0.0j, kw.qr[which, a])
@@ -632,40 +638,66 @@ def _rball(R, Am, Ar, N, Om, Or):
 
 
 @kernel
-def _rvec_abs(R, vm, vr, N, out):
-    """out += |R v| (upper bounds) for the float R and the ball vector v."""
+def _gamma(N):
+    """A bound c with |fl(sum_q a_q b_q) - sum_q a_q b_q| <= c sum_q |a_q| |b_q| for N complex terms (BPZ: sqrt 5 u
+    a product, sqrt 2 u an addition of partial sums; first order, with room for the rest at these sizes)."""
+    return (4.0 * N + 8.0) * ball.U
+
+
+@kernel
+def _rvec_abs(R, aR, vm, vr, N, out):
+    """out += |R v| (upper bounds) for the float R (aR = |R| rounded up) and the ball vector v."""
+    g = _gamma(N)
     for i in range(N):
-        m, r = 0.0j, 0.0
+        m = 0.0j
+        s1, s2 = 0.0, 0.0
         for q in range(N):
-            t = ball.cmul(R[i, q], 0.0, vm[q], vr[q])
-            m, r = ball.cadd(m, r, t[0], t[1])
+            m += R[i, q] * vm[q]
+            av = abs(vm[q]) * ball.INFL
+            s1 += aR[i, q] * vr[q]
+            s2 += aR[i, q] * av
+        r = (s1 + g * s2 + ball.ETA) * (1.0 + (2.0 * N + 8.0) * ball.U)
         out[i] = (out[i] + (abs(m) + r) * ball.INFL) * ball.INFL
 
 
 @kernel
 def _matvec_ball(Am, Ar, vm, vr, n, om, or_):
     """o = A v in complex balls (n x n times n)."""
+    g = _gamma(n)
     for i in range(n):
-        m, r = 0.0j, 0.0
+        m = 0.0j
+        s1, s2 = 0.0, 0.0
         for q in range(n):
-            t = ball.cmul(Am[i, q], Ar[i, q], vm[q], vr[q])
-            m, r = ball.cadd(m, r, t[0], t[1])
-        om[i], or_[i] = m, r
+            m += Am[i, q] * vm[q]
+            aa, av = abs(Am[i, q]) * ball.INFL, abs(vm[q]) * ball.INFL
+            s1 += aa * vr[q] + Ar[i, q] * (av + vr[q])
+            s2 += aa * av
+        om[i] = m
+        or_[i] = (s1 + g * s2 + ball.ETA) * (1.0 + (2.0 * n + 8.0) * ball.U)
 
 
 @kernel
-def _bound_abs(R, Am, Ar, N, B, identity):
-    """B += |I - R A| (``identity``) or |R A| (upper bounds) for the float R and the ball matrix A (N x N)."""
+def _bound_abs(R, aR, Am, Ar, N, B, identity, aA):
+    """B += |I - R A| (``identity``) or |R A| (upper bounds) for the float R (aR = |R| rounded up) and the ball
+    matrix A (N x N); aA is scratch."""
+    g = _gamma(N + 1)
+    for q in range(N):
+        for j in range(N):
+            aA[q, j] = abs(Am[q, j]) * ball.INFL
     for i in range(N):
         for j in range(N):
-            m, r = 0.0j, 0.0
+            m = 0.0j
+            s1, s2 = 0.0, 0.0
             for q in range(N):
-                t = ball.cmul(R[i, q], 0.0, Am[q, j], Ar[q, j])
-                m, r = ball.cadd(m, r, t[0], t[1])
+                m += R[i, q] * Am[q, j]
+                s1 += aR[i, q] * Ar[q, j]
+                s2 += aR[i, q] * aA[q, j]
             if identity:
                 m = -m
                 if i == j:
-                    m, r = ball.cadd(m, r, 1.0 + 0.0j, 0.0)
+                    s2 += 1.0  # the rounding of 1 - m is within 2u (1 + |m|): inside g (s2 + 1)
+                    m = m + 1.0
+            r = (s1 + g * s2 + ball.ETA) * (1.0 + (2.0 * N + 8.0) * ball.U)
             B[i, j] = (B[i, j] + (abs(m) + r) * ball.INFL) * ball.INFL
 
 
@@ -785,6 +817,10 @@ def _krawczyk(z0, v0, warm, E, nmodes, kw, n, vout):
         eye[i, i] = 1.0
     if not _csolve(J, eye, N, N, R):
         return False, z, 0.0
+    aR = np.empty((N, N))
+    for i in range(N):
+        for j in range(N):
+            aR[i, j] = abs(R[i, j]) * ball.INFL
     # R F(x~) over the box: F0 + a Fa + s Fs + a s Fas, each R * part in balls before |.|  (F is Phi_1(z~) in balls)
     bm, br = kw.cr0, kw.cr1
     vm = np.zeros(N, np.complex128)
@@ -793,7 +829,7 @@ def _krawczyk(z0, v0, warm, E, nmodes, kw, n, vout):
     for a in range(n):
         vm[a], bm[a] = om[a], orr[a]
     vm[n], bm[n] = 0.0, 0.0
-    _rvec_abs(R, vm, bm, N, base)
+    _rvec_abs(R, aR, vm, bm, N, base)
     for part in range(3):  # Pa = -ru K0, Ps(z~), Pas = -ru K1
         if part == 1:
             _phi_disc(z, 0.0, 1, E, nmodes, kw, n, F, Fr, dF, dFr)
@@ -805,12 +841,12 @@ def _krawczyk(z0, v0, warm, E, nmodes, kw, n, vout):
         _matvec_ball(F, Fr, v, vr0, n, om, orr)
         for a in range(n):
             vm[a], bm[a] = om[a], orr[a]
-        _rvec_abs(R, vm, bm, N, base)
+        _rvec_abs(R, aR, vm, bm, N, base)
     # |R Ja| + |R Jas|: the same for every X
     Bc = np.zeros((N, N))
     for q in (4, 5):
         _constant_part(q, kw, n, Jm, Jr)
-        _bound_abs(R, Jm, Jr, N, Bc, False)
+        _bound_abs(R, aR, Jm, Jr, N, Bc, False, Xr)
     xa = np.empty(N)
     for i in range(n):
         xa[i] = abs(v[i])
@@ -828,9 +864,9 @@ def _krawczyk(z0, v0, warm, E, nmodes, kw, n, vout):
         B[:, :] = Bc
         if not _jacobian(z, rho[n], v, vb, k, 0, E, nmodes, kw, n, F, Fr, dF, dFr, Jm, Jr, om, orr):
             return False, z, 0.0
-        _bound_abs(R, Jm, Jr, N, B, True)
+        _bound_abs(R, aR, Jm, Jr, N, B, True, Xr)
         _jacobian(z, rho[n], v, vb, k, 1, E, nmodes, kw, n, F, Fr, dF, dFr, Jm, Jr, om, orr)
-        _bound_abs(R, Jm, Jr, N, B, False)
+        _bound_abs(R, aR, Jm, Jr, N, B, False, Xr)
         # |K - x~| <= base + B rho (sums of nonnegative floats, each rounded up by INFL)
         ok = True
         for i in range(N):
