@@ -65,12 +65,15 @@ TINY = 2.0**-60  # the smallest radius the Krawczyk test starts from (relative t
 INFO_SEPARATORS = 0
 INFO_PAIRS = 1
 INFO_REAL = 2  # real roots proved (inertia count plus exact roots), -1 if the separators failed
+INFO_NEWTON = 4  # float Newton steps of the Krawczyk tests
+INFO_ITERATIONS = 5  # Krawczyk iterations (each: two ball evaluations of Phi_1 and Phi_1' over the disc)
 INFO_STAGE = 3  # where it stopped: 0 inputs, 1 lc, 2 approximations, 3 separators, 4 count, 5 krawczyk, 6 proved cold, 7 proved warm
-NINFO = 4
+NINFO = 6
 
 KreinWork = namedtuple("KreinWork", "T jmk sub tmat tvec cmat cvec beta cm cr C Mo F dF Sm Sr Wm Wr V P wr wi z "
                                     "feat ftype seps bord "
-                                    "pm pr qm qr cr0 cr1 Jm Jr Xm Xr Rm bm br Bm Bv bv prev pz pv")
+                                    "pm pr qm qr cr0 cr1 Jm Jr Xm Xr Rm bm br Bm Bv bv prev pz pv "
+                                    "lbody ljoint lg lat lE lkappa stats")
 
 
 @kernel
@@ -95,7 +98,8 @@ def allocate(n, nmodes, parent):
                      np.zeros(N), np.zeros(N),
                      np.zeros((N, N), np.complex128), np.zeros((N, N)), np.zeros((N, N), np.complex128), np.zeros((N, N)),
                      np.zeros((N, N), np.complex128), np.zeros(N, np.complex128), np.zeros(N), np.zeros((N, N)), np.zeros(N),
-                     np.zeros(N), np.zeros(3, np.int64), np.zeros(D, np.complex128), np.zeros((D, n), np.complex128))
+                     np.zeros(N), np.zeros(4, np.int64), np.zeros(D, np.complex128), np.zeros((D, n), np.complex128),
+                     np.zeros((2, n, layout.NBODY)), np.zeros((2, n)), np.zeros(2), np.zeros((2, n)), np.zeros((n, L)), np.zeros((n, L)), np.zeros(2, np.int64))
 
 
 @kernel
@@ -396,6 +400,27 @@ def _pairs(kw, k, warm, E, nmodes, n):
 
 
 @kernel
+def _same_inputs(kw, body2, joint2, g2, at2, E, kappa, nmodes, n):
+    """Whether the last box prepared exactly these inputs (kw.prev[3] = 1: kw.lbody ... hold them)."""
+    if kw.prev[3] != 1:
+        return False
+    for j in range(2):
+        if g2[j] != kw.lg[j]:
+            return False
+        for k in range(n):
+            if joint2[j, k] != kw.ljoint[j, k] or at2[j, k] != kw.lat[j, k]:
+                return False
+            for c in range(layout.NBODY):
+                if body2[j, k, c] != kw.lbody[j, k, c]:
+                    return False
+    for k in range(n):
+        for l in range(nmodes[k]):
+            if E[k, l] != kw.lE[k, l] or kappa[k, l] != kw.lkappa[k, l]:
+                return False
+    return True
+
+
+@kernel
 def krein_box(body2, joint2, g2, at2, E, kappa, nmodes, free, parent, u_lo, u_hi, kw, info):
     """N_c proved on the box (module docstring), or -1.  body2[j], joint2[j], g2[j], at2[j]: the kernel inputs at the
     t corner j (every spin 1, the stiffness at u = 1); u in [u_lo, u_hi], 0 < u_lo <= u_hi.
@@ -406,6 +431,7 @@ def krein_box(body2, joint2, g2, at2, E, kappa, nmodes, free, parent, u_lo, u_hi
     n = body2.shape[1]
     info[:] = 0
     info[INFO_REAL] = -1
+    kw.stats[:] = 0
     warm = kw.prev[0] == 1
     kw.prev[0] = 0
     if not (u_lo > 0.0 and u_lo <= u_hi and u_hi < math.inf):
@@ -414,8 +440,18 @@ def krein_box(body2, joint2, g2, at2, E, kappa, nmodes, free, parent, u_lo, u_hi
         for k in range(n):
             if body2[j, k, layout.OMEGA] != 1.0:
                 return -1
-    for j in range(2):
-        pencil.prepare(body2[j], joint2[j], at2[j], g2[j], E, kappa, nmodes, parent, free, _twork(kw, j), False)
+    # M, K of the two t corners: as the last box's if its inputs were these (a sweep along omega)
+    if not _same_inputs(kw, body2, joint2, g2, at2, E, kappa, nmodes, n):
+        for j in range(2):
+            pencil.prepare(body2[j], joint2[j], at2[j], g2[j], E, kappa, nmodes, parent, free, _twork(kw, j), False)
+        kw.lbody[:] = body2
+        kw.ljoint[:] = joint2
+        kw.lg[:] = g2
+        kw.lat[:] = at2
+        for k in range(n):
+            for l in range(nmodes[k]):
+                kw.lE[k, l], kw.lkappa[k, l] = E[k, l], kappa[k, l]
+        kw.prev[3] = 1
     # the modes: exact roots (beta = 0: at 0; E = 0: at -beta) and the bordered ones with the sign of c
     D, exact, nb = 0, 0, 0
     for k in range(n):
@@ -618,11 +654,28 @@ def _phi_disc(z, zr, which, E, nmodes, kw, n, Fm, Fr, dFm, dFr):
 
 @kernel
 def _float_phi(z, E, nmodes, kw, n, F, dF):
-    """Floats of the centre's Phi_1(z), Phi_1'(z) (the midpoints of ``_phi_disc``)."""
-    Fr = np.empty((n, n))
-    dFr = np.empty((n, n))
-    ok = _phi_disc(z, 0.0, 0, E, nmodes, kw, n, F, Fr, dF, dFr)
-    return ok
+    """Floats of the centre's Phi_1(z) and Phi_1'(z) (midpoints of ``_phi_disc`` with which 0); only steers."""
+    beta = kw.beta
+    z2 = z * z
+    for a in range(n):
+        for b in range(n):
+            F[a, b] = z2 * kw.pm[0, a, b] - kw.pm[2, a, b]
+            dF[a, b] = (2.0 * z) * kw.pm[0, a, b]
+        A, Ad, e = 0.0j, 0.0j, 0.0
+        for l in range(nmodes[a]):
+            if beta[0, a, l] == 0.0 and beta[1, a, l] == 0.0:
+                e += E[a, l]
+                continue
+            q = ball.recip(z + beta[0, a, l])
+            A += E[a, l] * q
+            Ad -= E[a, l] * q * q
+        F[a, a] += z * kw.qm[0, a] - z2 * (z + 1.0) * A - z * (z + 1.0) * e
+        dF[a, a] += kw.qm[0, a] - (3.0 * z2 + 2.0 * z) * A - z2 * (z + 1.0) * Ad - (2.0 * z + 1.0) * e
+    for a in range(n):
+        for b in range(n):
+            if not (math.isfinite(F[a, b].real) and math.isfinite(F[a, b].imag) and math.isfinite(dF[a, b].real) and math.isfinite(dF[a, b].imag)):
+                return False
+    return True
 
 
 @kernel
@@ -769,11 +822,10 @@ def _krawczyk(z0, v0, warm, E, nmodes, kw, n, vout):
     dcol = np.empty((N, 1), np.complex128)
     J = kw.Rm
     vr0 = np.zeros(n)
-    for step in range(NEWTON_STEPS + 1):
-        if not _phi_disc(z, 0.0, 0, E, nmodes, kw, n, F, Fr, dF, dFr):
+    for step in range(NEWTON_STEPS):
+        if not _float_phi(z, E, nmodes, kw, n, F, dF):
             return False, z, 0.0
-        if step == NEWTON_STEPS:
-            break
+        kw.stats[0] += 1
         J[:, :] = 0.0
         for a in range(n):
             for b in range(n):
@@ -791,13 +843,12 @@ def _krawczyk(z0, v0, warm, E, nmodes, kw, n, vout):
         for a in range(n):
             v[a] -= dcol[a, 0]
         z = z - dcol[n, 0]
-        d = dcol[:, 0]
         v = v / v[k]
-        if abs(d[n]) <= 2.0**-45 * abs(z):
-            if step >= 1:
-                if not _phi_disc(z, 0.0, 0, E, nmodes, kw, n, F, Fr, dF, dFr):
-                    return False, z, 0.0
-                break
+        if abs(dcol[n, 0]) <= 2.0**-45 * abs(z) and step >= 1:
+            break
+    # Phi_1(z~) in balls (the residual below) and Phi_1'(z~): their midpoints make J(x~) for R
+    if not _phi_disc(z, 0.0, 0, E, nmodes, kw, n, F, Fr, dF, dFr):
+        return False, z, 0.0
     v[k] = 1.0  # exactly: F's last entry v_k - 1 is then 0
     if not z.imag > 0.0:
         return False, z, 0.0
@@ -857,6 +908,7 @@ def _krawczyk(z0, v0, warm, E, nmodes, kw, n, vout):
     vb = np.empty(n)
     kr = np.empty(N)
     for it in range(KRAWCZYK_STEPS):
+        kw.stats[1] += 1
         if not (rho[n] < z.imag * ball.LOW):
             return False, z, 0.0
         for i in range(n):
@@ -913,5 +965,6 @@ def krein_box_block(body, joint, g, at, E, kappa, nmodes, free, parent, u_lo, u_
         if not warm:
             kw.prev[0] = 0
         nc = krein_box(body[p], joint[p], g[p], at[p], E[p], kappa[p], nmodes, free, parent, u_lo[p], u_hi[p], kw, out_info[p])
+        out_info[p, INFO_NEWTON], out_info[p, INFO_ITERATIONS] = kw.stats[0], kw.stats[1]
         out_nc[p] = nc
         out_status[p] = UNDECIDED if nc < 0 else (DECIDED_INERTIA if nc == 0 else DECIDED_DISKS)
