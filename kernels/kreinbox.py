@@ -99,7 +99,8 @@ def allocate(n, nmodes, parent):
                      np.zeros((N, N), np.complex128), np.zeros((N, N)), np.zeros((N, N), np.complex128), np.zeros((N, N)),
                      np.zeros((N, N), np.complex128), np.zeros(N, np.complex128), np.zeros(N), np.zeros((N, N)), np.zeros(N),
                      np.zeros(N), np.zeros(4, np.int64), np.zeros(D, np.complex128), np.zeros((D, n), np.complex128),
-                     np.zeros((2, n, layout.NBODY)), np.zeros((2, n)), np.zeros(2), np.zeros((2, n)), np.zeros((n, L)), np.zeros((n, L)), np.zeros(2, np.int64))
+                     np.zeros((2, n, layout.NBODY)), np.zeros((2, n)), np.zeros(2), np.zeros((2, n)), np.zeros((n, L)), np.zeros((n, L)),
+                     np.zeros(2, np.int64))
 
 
 @kernel
@@ -177,7 +178,7 @@ def _jacobi(A, n, w, V):
     for i in range(n):
         for j in range(n):
             V[i, j] = 1.0 if i == j else 0.0
-    for sweep in range(30):
+    for _ in range(30):
         off = 0.0
         diag = 0.0
         for i in range(n):
@@ -679,18 +680,6 @@ def _float_phi(z, E, nmodes, kw, n, F, dF):
 
 
 @kernel
-def _rball(R, Am, Ar, N, Om, Or):
-    """O = R A for the float R and the ball matrix A (N x N)."""
-    for i in range(N):
-        for j in range(N):
-            m, r = 0.0j, 0.0
-            for q in range(N):
-                t = ball.cmul(R[i, q], 0.0, Am[q, j], Ar[q, j])
-                m, r = ball.cadd(m, r, t[0], t[1])
-            Om[i, j], Or[i, j] = m, r
-
-
-@kernel
 def _gamma(N):
     """A bound c with |fl(sum_q a_q b_q) - sum_q a_q b_q| <= c sum_q |a_q| |b_q| for N complex terms (BPZ: sqrt 5 u
     a product, sqrt 2 u an addition of partial sums; first order, with room for the rest at these sizes)."""
@@ -757,7 +746,6 @@ def _bound_abs(R, aR, Am, Ar, N, B, identity, aA):
 @kernel
 def _jacobian(z, zr, v, vr, k, which, E, nmodes, kw, n, F, Fr, dF, dFr, Jm, Jr, om, orr):
     """Balls of [[P(Z), P'(Z) V], [e_k^T or 0, 0]] (``which`` as ``_phi_disc``) into Jm, Jr; False at a pole."""
-    N = n + 1
     if not _phi_disc(z, zr, which, E, nmodes, kw, n, F, Fr, dF, dFr):
         return False
     Jm[:, :] = 0.0
@@ -790,7 +778,7 @@ def _krawczyk(z0, v0, warm, E, nmodes, kw, n, vout):
     ``warm``, the eigenvector v0 (else the least singular vector of Phi_1(z0)); v~ into vout."""
     N = n + 1
     F, dF, Fr, dFr = kw.F, kw.dF, kw.Sm, kw.Sr
-    Jm, Jr, Xm, Xr, B = kw.Jm, kw.Jr, kw.Xm, kw.Xr, kw.Bm
+    Jm, Jr, Xr, B = kw.Jm, kw.Jr, kw.Xr, kw.Bm
     om = kw.bm[:n]
     orr = kw.br[:n]
     z = z0
@@ -873,7 +861,7 @@ def _krawczyk(z0, v0, warm, E, nmodes, kw, n, vout):
         for j in range(N):
             aR[i, j] = abs(R[i, j]) * ball.INFL
     # R F(x~) over the box: F0 + a Fa + s Fs + a s Fas, each R * part in balls before |.|  (F is Phi_1(z~) in balls)
-    bm, br = kw.cr0, kw.cr1
+    bm = kw.cr0
     vm = np.zeros(N, np.complex128)
     base = np.zeros(N)
     _matvec_ball(F, Fr, v, vr0, n, om, orr)

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from systems import WINDOW
 
 import stabmap
 from stabmap.kernels import layout
@@ -15,7 +16,6 @@ from stabmap.systems.gyroscopes import exact
 from stabmap.systems.gyroscopes.kreinboxes import krein_arrays, krein_box, prove_krein_boxes
 from stabmap.systems.gyroscopes.points import point_arrays
 from stabmap.systems.gyroscopes.scene import from_dict
-from systems import WINDOW
 
 SQUARE = np.array([(0.0, 0.0), (0.0, 1.0), (1.0, 0.0), (1.0, 1.0)])
 
@@ -104,7 +104,7 @@ def test_boxes_straddling_a_boundary_of_the_narrow_window_are_never_proved():
         system = dict(WINDOW, bodies=[dict(b, fluid=dict(b["fluid"], E=[E])) for b in WINDOW["bodies"]])
         ds = critical(from_dict(system), "omega", rtol=1e-12, progress=False, threads=1)
         keep = np.isfinite(ds["boundary_lower"].values)
-        brackets = list(zip(ds["boundary_lower"].values[keep], ds["boundary_upper"].values[keep]))
+        brackets = list(zip(ds["boundary_lower"].values[keep], ds["boundary_upper"].values[keep], strict=True))
         assert len(brackets) >= 3
         for other, value in (("K_1", 10.0), ("m_2", 1.0)):
             scene = from_dict(dict(system, grid={"omega": {"values": [1.0]}, other: {"values": [value]}}))
@@ -155,7 +155,7 @@ def test_the_corner_inputs_are_the_models_at_unit_spin_and_lengths_are_refused()
         assert np.array_equal(part.g[:, j], pts.g) and np.array_equal(part.at[:, j], pts.at)
     assert np.all(part.body[..., layout.OMEGA] == 1.0)
     # 1 / omega^2 of every omega of the box lies in [u_lo, u_hi]
-    for i, (a, b) in enumerate(zip(lower["omega"], upper["omega"])):
+    for i, (a, b) in enumerate(zip(lower["omega"], upper["omega"], strict=True)):
         w = np.linspace(min(a, b), max(a, b), 101)
         assert np.all((part.u_lo[i] <= 1.0 / w**2) & (1.0 / w**2 <= part.u_hi[i]))
     # a length enters M quadratically: no Krein box (its Phi_1 is not bilinear)

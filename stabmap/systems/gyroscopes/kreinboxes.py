@@ -85,8 +85,7 @@ def krein_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np
         pts = point_arrays(scene, values)
         keep = _copies(pts, lo, hi, sel, {axis: np.stack([t_lo, t_hi], axis=1)}, {axis: (t_lo, t_hi)}, True)
         sel = sel[keep]
-        shape = lambda x: x.reshape((keep.size, 2) + x.shape[1:])[keep]  # noqa: E731
-        body[sel], joint[sel], g[sel], at[sel] = shape(pts.body), shape(pts.joint), shape(pts.g), shape(pts.at)
+        body[sel], joint[sel], g[sel], at[sel] = (x.reshape((keep.size, 2) + x.shape[1:])[keep] for x in (pts.body, pts.joint, pts.g, pts.at))
         ok[sel] = True
     rows = np.flatnonzero(ok)
     if rows.size == 0:
@@ -107,7 +106,7 @@ def prove_krein_boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[st
     if part is not None:
         count = np.empty(rows.size, dtype=np.int16)
         status = np.empty(rows.size, dtype=np.int8)
-        out_info = np.zeros((rows.size, NINFO), dtype=np.int64)
+        out_info: np.ndarray = np.zeros((rows.size, NINFO), dtype=np.int64)
         krein_box_block(*part.kernel_args(), warm, count, status, out_info)
         good = status != UNDECIDED
         nc[rows[good]] = count[good]
