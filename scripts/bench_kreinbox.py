@@ -30,13 +30,13 @@ from stabmap.systems.gyroscopes.kreinboxes import krein_arrays
 from stabmap.systems.gyroscopes.nodes import NodeBoxes
 
 
-def cell_boxes(num: int, size: int, count: int, seed: int = 0):
-    scene = resample(stabmap.example("paper-n3-fixed"), omega=num, m_2=num)
+def cell_boxes(num: int, size: int, count: int, seed: int = 0, example: str = "paper-n3-fixed", axis: str = "m_2"):
+    scene = resample(stabmap.example(example), **{"omega": num, axis: num})
     values = {x.name: x.array for x in scene.grid}
-    ew, em = edges(values["omega"]), edges(values["m_2"])
+    ew, em = edges(values["omega"]), edges(values[axis])
     rng = np.random.default_rng(seed + size)
     i, j = rng.integers(0, num - size + 1, count), rng.integers(0, num - size + 1, count)
-    return scene, {"omega": ew[i], "m_2": em[j]}, {"omega": ew[i + size], "m_2": em[j + size]}
+    return scene, {"omega": ew[i], axis: em[j]}, {"omega": ew[i + size], axis: em[j + size]}
 
 
 def tiles(num: int, size: int, cells: int):
@@ -89,13 +89,25 @@ def main() -> None:
     ap.add_argument("--count", type=int, default=None)
     args = ap.parse_args()
     count = args.count or (300 if args.quick else 3000)
-    warm = cell_boxes(300, 1, 4)  # compile (or load) both kernels before any clock starts
-    run_krein(*warm)
-    run_nodes(*warm)
+    for example, axis in (("paper-n3-fixed", "m_2"), ("paper-n2-fixed", "K_1")):  # compile (or load) before any clock
+        warm = cell_boxes(300, 1, 4, example=example, axis=axis)
+        run_krein(*warm)
+        run_nodes(*warm)
     print(f"paper-n3-fixed 300 x 300, omega x m_2, {count} random boxes of each size")
     print("cells    krein: proved   us/box  (N_c = 0 / pairs)   nodes_box_block: proved   us/box   both   disagree")
     for size in (1, 4, 16):
         scene, lower, upper = cell_boxes(300, size, count)
+        kn, ks, info = run_krein(scene, lower, upper)
+        nn, ns = run_nodes(scene, lower, upper)
+        both = (kn >= 0) & (nn >= 0)
+        disagree = int(np.sum(both & (kn != nn)))
+        print(f"{size:2d}x{size:<2d}   {100 * np.mean(kn >= 0):6.1f} %  {1e6 * ks / count:7.1f}   "
+              f"({int(np.sum(kn == 0))} / {int(np.sum(kn > 0))})          {100 * np.mean(nn >= 0):6.1f} %   "
+              f"{1e6 * ns / count:7.1f}   {int(both.sum()):5d}   {disagree}", flush=True)
+        assert disagree == 0, "the two box proofs disagree"
+    print(f"paper-n2-fixed 300 x 300, omega x K_1, {count} random boxes of each size (cold)")
+    for size in (1, 4, 16):
+        scene, lower, upper = cell_boxes(300, size, count, example="paper-n2-fixed", axis="K_1")
         kn, ks, info = run_krein(scene, lower, upper)
         nn, ns = run_nodes(scene, lower, upper)
         both = (kn >= 0) & (nn >= 0)
