@@ -221,3 +221,25 @@ def test_property_proved_krein_boxes_of_random_chains_hold_their_label_exactly(c
         values = {a: lower[a][i] + t[:, d] * (upper[a][i] - lower[a][i]) for d, a in enumerate(lower)}
         got = _exact(scene, values)
         assert np.all(got == nc[i]), (case, i, {a: (lower[a][i], upper[a][i]) for a in lower}, nc[i], got)
+
+
+@pytest.mark.slow
+def test_paper_n3_fixed_one_cell_tiles_swept_warm_hold_their_label_in_exact_arithmetic():
+    # the atlas's use: one-cell boxes of the 300 x 300 grid swept along omega, each warm from its predecessor's
+    # separators and pairs; two 30 x 30 patches (low spin, where the pair moves fast, and high spin), every proved
+    # box exact at its corners and one interior point
+    from stabmap.scene.grid import resample
+    from stabmap.store.dataset import edges
+
+    scene = resample(stabmap.example("paper-n3-fixed"), omega=300, m_2=300)
+    ew, em = (edges(a.array) for a in scene.grid)
+    rng = np.random.default_rng(9)
+    checked = 0
+    for i0, j0 in ((0, 40), (200, 150)):
+        j, i = (x.ravel() for x in np.meshgrid(np.arange(j0, j0 + 30), np.arange(i0, i0 + 30), indexing="ij"))
+        lower, upper = {"omega": ew[i], "m_2": em[j]}, {"omega": ew[i + 1], "m_2": em[j + 1]}
+        nc, proved, info = prove_krein_boxes(scene, lower, upper)
+        assert proved.mean() >= 0.9, proved.mean()
+        assert np.mean(info[proved, 3] == 7) >= 0.5  # most warm
+        checked += _check(scene, lower, upper, nc, rng, inside=1)
+    assert checked >= 1600
