@@ -58,6 +58,7 @@ from .status import DECIDED_DISKS, DECIDED_INERTIA, UNDECIDED
 NEAR_REAL = 1e-6  # approximations within this of the axis (relative to 1 + |mu|) are taken as real roots
 KRAWCZYK_STEPS = 16  # epsilon-inflation steps of the Krawczyk test
 INFLATE = 1.125  # each step starts from the last bound times this
+SPLIT_PAIRS = 1  # Krawczyk over the whole box, then over its 2 x 2 quarters (1), its 4 x 4 sixteenths (2) ...
 NEWTON_STEPS = 4  # float Newton steps on the bordered eigenpair system at the centre
 TINY = 2.0**-60  # the smallest radius the Krawczyk test starts from (relative to 1 + |x|)
 
@@ -382,9 +383,10 @@ def _count(kw, ns, body2, E, nmodes, parent, n, nb, cpos):
 
 
 @kernel
-def _pairs(kw, k, warm, E, nmodes, n):
-    """k pairs proved by Krawczyk tests from kw.pz[:k] (and with ``warm`` the eigenvectors kw.pv[:k]), the discs
-    pairwise disjoint and in the upper half plane; the polished approximations back into kw.pz, kw.pv."""
+def _pairs_once(kw, k, warm, E, nmodes, n):
+    """k pairs proved by Krawczyk tests over the (sub-)box of kw.pm (``_krawczyk_parts``) from kw.pz[:k] (with
+    ``warm`` also the eigenvectors kw.pv[:k]), the discs pairwise disjoint and in the upper half plane; the polished
+    approximations back into kw.pz, kw.pv."""
     cz = np.empty(k, np.complex128)
     cr = np.empty(k)
     for q in range(k):
@@ -398,6 +400,31 @@ def _pairs(kw, k, warm, E, nmodes, n):
             if not abs(cz[a] - cz[b]) * ball.LOW > (cr[a] + cr[b]) * ball.INFL:
                 return False
     return True
+
+
+@kernel
+def _pairs(kw, k, warm, E, nmodes, n, u_lo, u_hi):
+    """k non-real pairs at every point of the box: Krawczyk over the whole box, else over each of its 2 x 2
+    quarters (``SPLIT_PAIRS``; their union is the box: u at u_lo, the float midpoint, u_hi; s at -1, 0, 1).  The
+    real count holds on the whole box already, so k pairs on each quarter give N_c = k on the box."""
+    for depth in range(SPLIT_PAIRS + 1):
+        m = 1 << depth
+        ok = True
+        for iu in range(m):
+            a = u_lo if iu == 0 else u_lo + (u_hi - u_lo) * (iu / m)
+            b = u_hi if iu == m - 1 else u_lo + (u_hi - u_lo) * ((iu + 1) / m)
+            if not (u_lo <= a <= b <= u_hi):
+                return False
+            for js in range(m):
+                _krawczyk_parts(kw, a, b, n, -1.0 + (2.0 * js + 1.0) / m, 1.0 / m)
+                if not _pairs_once(kw, k, warm or depth > 0 or iu + js > 0, E, nmodes, n):
+                    ok = False
+                    break
+            if not ok:
+                break
+        if ok:
+            return True
+    return False
 
 
 @kernel
@@ -482,12 +509,11 @@ def krein_box(body2, joint2, g2, at2, E, kappa, nmodes, free, parent, u_lo, u_hi
     if not _lc_positive(kw, n):
         return -1
     _corners(kw, u_lo, u_hi, n)
-    _krawczyk_parts(kw, u_lo, u_hi, n)
     # a neighbour's separators and pairs first
     if warm:
         ns, k = kw.prev[1], kw.prev[2]
         real = _count(kw, ns, body2, E, nmodes, parent, n, nb, cpos)
-        if real >= 0 and real + exact + 2 * k == D and (k == 0 or _pairs(kw, k, True, E, nmodes, n)):
+        if real >= 0 and real + exact + 2 * k == D and (k == 0 or _pairs(kw, k, True, E, nmodes, n, u_lo, u_hi)):
             kw.prev[0] = 1
             info[INFO_SEPARATORS], info[INFO_PAIRS], info[INFO_REAL], info[INFO_STAGE] = ns, k, real + exact, 7
             return k
@@ -554,7 +580,7 @@ def krein_box(body2, joint2, g2, at2, E, kappa, nmodes, free, parent, u_lo, u_hi
         pick = np.argsort(ims)[:k]
         for q in range(k):
             kw.pz[q] = w[up[pick[q]]]
-        if not _pairs(kw, k, False, E, nmodes, n):
+        if not _pairs(kw, k, False, E, nmodes, n, u_lo, u_hi):
             return -1
     kw.prev[0], kw.prev[1], kw.prev[2] = 1, ns, k
     info[INFO_PAIRS] = k
@@ -574,25 +600,37 @@ def _half(am, ar, bm, br, sign):
 
 
 @kernel
-def _krawczyk_parts(kw, u_lo, u_hi, n):
-    """kw.pm, kw.pr: 0 M0, 1 M1, 2 uc K0, 3 uc K1, 4 ru K0, 5 ru K1 (real balls, M0 = (M(t_lo) + M(t_hi)) / 2,
-    M1 = (M(t_hi) - M(t_lo)) / 2, K at u = 1); kw.qm, kw.qr: G0, G1.  [u_lo, u_hi] lies in [uc - ru, uc + ru]."""
+def _centred(am, ar, bm, br, sc, hs):
+    """For X(s) = A + s B (balls A, B), s = sc + hs sigma: the balls of A + sc B and hs B (sc, hs dyadic floats)."""
+    t = ball.rmul(sc, 0.0, bm, br)
+    c = ball.radd(am, ar, t[0], t[1])
+    return c[0], c[1], hs * bm, hs * br + ball.ETA
+
+
+@kernel
+def _krawczyk_parts(kw, u_lo, u_hi, n, sc, hs):
+    """The centred parts over the sub-box u in [u_lo, u_hi], s in [sc - hs, sc + hs] (s in [-1, 1] the box's t):
+    kw.pm, kw.pr: 0 M0, 1 M1, 2 uc K0, 3 uc K1, 4 ru K0, 5 ru K1 (real balls; M0 and M1 the middle and half change of
+    M over the sub-box's t, from M(s) = (M(t_lo) + M(t_hi)) / 2 + s (M(t_hi) - M(t_lo)) / 2; K at u = 1); kw.qm,
+    kw.qr: G0, G1.  [u_lo, u_hi] lies in [uc - ru, uc + ru]."""
     uc = 0.5 * u_lo + 0.5 * u_hi
     ru = np.nextafter(max(u_hi - uc, uc - u_lo), np.inf)
     t = kw.tmat
     for a in range(n):
         for b in range(n):
-            for q in range(2):
-                sign = 1.0 if q == 0 else -1.0
-                mm, mr = _half(t[1, layout.M_MID, a, b], t[1, layout.M_RAD, a, b], t[0, layout.M_MID, a, b], t[0, layout.M_RAD, a, b], sign)
-                kw.pm[q, a, b], kw.pr[q, a, b] = mm, mr
-                km, kr = _half(t[1, layout.K_MID, a, b], t[1, layout.K_RAD, a, b], t[0, layout.K_MID, a, b], t[0, layout.K_RAD, a, b], sign)
-                kw.pm[2 + q, a, b], kw.pr[2 + q, a, b] = ball.rmul(uc, 0.0, km, kr)
-                kw.pm[4 + q, a, b], kw.pr[4 + q, a, b] = ball.rmul(ru, 0.0, km, kr)
-        for q in range(2):
-            sign = 1.0 if q == 0 else -1.0
-            kw.qm[q, a], kw.qr[q, a] = _half(kw.tvec[1, layout.G_MID, a], kw.tvec[1, layout.G_RAD, a],
-                                             kw.tvec[0, layout.G_MID, a], kw.tvec[0, layout.G_RAD, a], sign)
+            m0, r0 = _half(t[1, layout.M_MID, a, b], t[1, layout.M_RAD, a, b], t[0, layout.M_MID, a, b], t[0, layout.M_RAD, a, b], 1.0)
+            m1, r1 = _half(t[1, layout.M_MID, a, b], t[1, layout.M_RAD, a, b], t[0, layout.M_MID, a, b], t[0, layout.M_RAD, a, b], -1.0)
+            kw.pm[0, a, b], kw.pr[0, a, b], kw.pm[1, a, b], kw.pr[1, a, b] = _centred(m0, r0, m1, r1, sc, hs)
+            m0, r0 = _half(t[1, layout.K_MID, a, b], t[1, layout.K_RAD, a, b], t[0, layout.K_MID, a, b], t[0, layout.K_RAD, a, b], 1.0)
+            m1, r1 = _half(t[1, layout.K_MID, a, b], t[1, layout.K_RAD, a, b], t[0, layout.K_MID, a, b], t[0, layout.K_RAD, a, b], -1.0)
+            k0m, k0r, k1m, k1r = _centred(m0, r0, m1, r1, sc, hs)
+            kw.pm[2, a, b], kw.pr[2, a, b] = ball.rmul(uc, 0.0, k0m, k0r)
+            kw.pm[3, a, b], kw.pr[3, a, b] = ball.rmul(uc, 0.0, k1m, k1r)
+            kw.pm[4, a, b], kw.pr[4, a, b] = ball.rmul(ru, 0.0, k0m, k0r)
+            kw.pm[5, a, b], kw.pr[5, a, b] = ball.rmul(ru, 0.0, k1m, k1r)
+        g0, gr0 = _half(kw.tvec[1, layout.G_MID, a], kw.tvec[1, layout.G_RAD, a], kw.tvec[0, layout.G_MID, a], kw.tvec[0, layout.G_RAD, a], 1.0)
+        g1, gr1 = _half(kw.tvec[1, layout.G_MID, a], kw.tvec[1, layout.G_RAD, a], kw.tvec[0, layout.G_MID, a], kw.tvec[0, layout.G_RAD, a], -1.0)
+        kw.qm[0, a], kw.qr[0, a], kw.qm[1, a], kw.qr[1, a] = _centred(g0, gr0, g1, gr1, sc, hs)
 
 
 @kernel
