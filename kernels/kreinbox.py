@@ -38,7 +38,12 @@ parts and each product R * part is formed in balls before its absolute value (th
 form loses the cancellation in w^T K v, KREIN.md).  |K - x~| < rho componentwise proves a unique zero in X for
 every point of the box (Krawczyk, complex discs are convex), so an eigenvalue of Phi_1, not a pole since the disc
 lies in the upper half plane: a non-real root of p_1.  k discs pairwise disjoint, clear of the real axis: 2k
-distinct non-real roots at every point, R + 2k = D, and N_c = k on the whole box.
+distinct non-real roots at every point, R + 2k = D, and N_c = k on the whole box.  Where the test fails over the
+whole box it is made over each of its 2 x 2 quarters (``SPLIT_PAIRS``): R holds on the whole box, so k pairs on
+every quarter are k pairs on the box.
+
+Approximations come from the box before it in the block (a sweep's neighbour: its separators and polished pairs),
+else from the eigenvalues of the float linearisation at the box's centre (dgeev).
 
 Everything that decides is balls with outward rounding (``ball.py``); floats only choose separators, the
 vectors V-, V+, the approximations and R.
