@@ -243,3 +243,22 @@ def test_paper_n3_fixed_one_cell_tiles_swept_warm_hold_their_label_in_exact_arit
         assert np.mean(info[proved, 3] == 7) >= 0.5  # most warm
         checked += _check(scene, lower, upper, nc, rng, inside=1)
     assert checked >= 1600
+
+
+def test_the_kernel_refuses_inputs_outside_its_model():
+    # every spin must be 1 (the spin-scaled model) and 0 < u_lo <= u_hi: anything else is left undecided
+    from stabmap.kernels import UNDECIDED
+    from stabmap.kernels.kreinbox import NINFO, krein_box_block
+
+    scene = stabmap.example("paper-n3-fixed")
+    rows, part = krein_arrays(scene, {"omega": np.array([60.0] * 4), "m_2": np.array([0.1] * 4)},
+                              {"omega": np.array([60.5] * 4), "m_2": np.array([0.101] * 4)})
+    body, joint, g, at, E, kappa, nmodes, free, parent, u_lo, u_hi = part.kernel_args()
+    body[1, 0, 0, layout.OMEGA] = 2.0
+    u_lo[2] = 0.0
+    u_lo[3], u_hi[3] = u_hi[3], u_lo[3]
+    nc = np.empty(4, np.int16)
+    status = np.empty(4, np.int8)
+    info = np.zeros((4, NINFO), np.int64)
+    krein_box_block(body, joint, g, at, E, kappa, nmodes, free, parent, u_lo, u_hi, True, nc, status, info)
+    assert nc.tolist() == [0, -1, -1, -1] and status[1:].tolist() == [UNDECIDED] * 3
