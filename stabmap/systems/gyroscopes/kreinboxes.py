@@ -1,0 +1,121 @@
+"""Krein boxes (``kernels.kreinbox``): N_c on a whole box of (omega, t) from definite compressions at its corners.
+
+A box qualifies when every body spins at the one rate omega of one grid axis, which the box moves, not through 0,
+and at most one other axis moves: a mechanical axis (``boxes._mechanical``) that is not a length (lengths enter M
+quadratically), whose kernel inputs are copies of its value at both corners (``nodes._copies``), so that M, C and K
+are affine in it.  The kernel gets the inputs at the axis's two ends with every spin 1 and the stiffness at u = 1
+(it multiplies by u in balls), and the interval of u = 1 / omega^2 rounded outward.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...kernels import layout
+from ...kernels.kreinbox import NINFO, krein_box_block
+from ...kernels.status import UNDECIDED
+from .boxes import _corners, _is_spin, _mechanical, _spin_rows
+from .nodes import LENGTHS, _copies, _u_interval
+from .parameters import parse_name
+from .points import point_arrays
+from .scene import Scene
+
+__all__ = ["KreinBoxes", "krein_arrays", "krein_box", "prove_krein_boxes"]
+
+
+@dataclass
+class KreinBoxes:
+    """Arguments of ``kernels.kreinbox.krein_box_block``: inputs at the two ends (axis 1) of the box's t interval."""
+
+    body: np.ndarray  # (npts, 2, n, 6), every spin 1
+    joint: np.ndarray  # (npts, 2, n), at u = 1
+    g: np.ndarray  # (npts, 2), at u = 1
+    at: np.ndarray  # (npts, 2, n)
+    E: np.ndarray
+    kappa: np.ndarray
+    nmodes: np.ndarray
+    free: bool
+    parent: np.ndarray
+    u_lo: np.ndarray
+    u_hi: np.ndarray
+
+    def kernel_args(self):
+        args = (self.body, self.joint, self.g, self.at, self.E, self.kappa, self.nmodes, self.free, self.parent, self.u_lo, self.u_hi)
+        return tuple(np.require(a, requirements=("C", "W")) if isinstance(a, np.ndarray) else a for a in args)
+
+
+def _affine_axis(scene: Scene, key: str) -> bool:
+    """A mechanical axis whose every entry of Phi is affine in it: not a length, not a free system's mass."""
+    return _mechanical(scene, key) and parse_name(key, scene.n, scene.support).symbol not in LENGTHS
+
+
+def krein_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> tuple[np.ndarray, KreinBoxes | None]:
+    """(rows, boxes): the boxes with corners ``lower``, ``upper`` that qualify (module docstring), as kernel inputs."""
+    lo, hi = _corners(scene, lower, upper)
+    npts = lo.body.shape[0]
+    lower = {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,)) for k, v in lower.items()}
+    upper = {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,)) for k, v in upper.items()}
+    moves = {k: lower[k] != upper[k] for k in lower}
+    spin = _spin_rows(scene, lo, hi, moves)
+    others = [k for k in lower if not _is_spin(scene, k)]
+    n = scene.n
+    body = np.empty((npts, 2, n, layout.NBODY))
+    joint = np.empty((npts, 2, n))
+    g = np.empty((npts, 2))
+    at = np.empty((npts, 2, n))
+    ok = np.zeros(npts, dtype=bool)
+    count = sum((moves[k].astype(int) for k in others), np.zeros(npts, dtype=int))
+    # boxes along the spin alone: both ends are the corner inputs
+    sel = spin[count[spin] == 0]
+    if sel.size:
+        for j in range(2):
+            body[sel, j], joint[sel, j], g[sel, j], at[sel, j] = lo.body[sel], lo.joint[sel], lo.g[sel], lo.at[sel]
+        ok[sel] = True
+    for axis in others:
+        if not _affine_axis(scene, axis):
+            continue
+        sel = spin[(count[spin] == 1) & moves[axis][spin]]
+        if sel.size == 0:
+            continue
+        t_lo, t_hi = np.minimum(lower[axis][sel], upper[axis][sel]), np.maximum(lower[axis][sel], upper[axis][sel])
+        values = {k: np.repeat(lower[k][sel], 2) for k in lower}
+        values[axis] = np.stack([t_lo, t_hi], axis=1).ravel()
+        pts = point_arrays(scene, values)
+        keep = _copies(pts, lo, hi, sel, {axis: np.stack([t_lo, t_hi], axis=1)}, {axis: (t_lo, t_hi)}, True)
+        sel = sel[keep]
+        body[sel], joint[sel], g[sel], at[sel] = (x.reshape((keep.size, 2) + x.shape[1:])[keep] for x in (pts.body, pts.joint, pts.g, pts.at))
+        ok[sel] = True
+    rows = np.flatnonzero(ok)
+    if rows.size == 0:
+        return rows, None
+    u_lo, u_hi = _u_interval(lo.body[rows, 0, layout.OMEGA], hi.body[rows, 0, layout.OMEGA])
+    b = body[rows]
+    b[..., layout.OMEGA] = 1.0
+    return rows, KreinBoxes(b, joint[rows], g[rows], at[rows], lo.E[rows], lo.kappa[rows], lo.nmodes, lo.free, lo.parent, u_lo, u_hi)
+
+
+def prove_krein_boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray], warm: bool = True):
+    """(N_c int16 with -1 where not proved, proved bool, info (npts, NINFO) int64) of each box.  ``warm``: each box
+    first tries what proved the one before it (``kernels.kreinbox.krein_box_block``)."""
+    npts = int(np.prod(np.broadcast_shapes(*(np.shape(v) for v in (*lower.values(), *upper.values())))))
+    nc = np.full(npts, -1, dtype=np.int16)
+    info = np.full((npts, NINFO), -1, dtype=np.int64)
+    rows, part = krein_arrays(scene, lower, upper)
+    if part is not None:
+        count = np.empty(rows.size, dtype=np.int16)
+        status = np.empty(rows.size, dtype=np.int8)
+        out_info: np.ndarray = np.zeros((rows.size, NINFO), dtype=np.int64)
+        krein_box_block(*part.kernel_args(), warm, count, status, out_info)
+        good = status != UNDECIDED
+        nc[rows[good]] = count[good]
+        info[rows] = out_info
+    return nc, nc >= 0, info
+
+
+def krein_box(scene: Scene, intervals: dict[str, tuple[float, float]]) -> int:
+    """N_c proved on the box ``{axis: (lo, hi)}`` (the spin axis and at most one more), or -1."""
+    lower = {k: np.array([float(v[0])]) for k, v in intervals.items()}
+    upper = {k: np.array([float(v[1])]) for k, v in intervals.items()}
+    return int(prove_krein_boxes(scene, lower, upper)[0][0])
