@@ -76,7 +76,7 @@ INFO_ITERATIONS = 5  # Krawczyk iterations (each: two ball evaluations of Phi_1 
 INFO_STAGE = 3  # where it stopped: 0 inputs, 1 lc, 2 approximations, 3 separators, 4 count, 5 krawczyk, 6 proved cold, 7 proved warm
 NINFO = 6
 
-KreinWork = namedtuple("KreinWork", "T jmk sub tmat tvec cmat cvec beta cm cr C Mo F dF Sm Sr Wm Wr V P wr wi z "
+KreinWork = namedtuple("KreinWork", "T jmk sub tmat tvec cmat cvec beta krein cm cr C Mo F dF Sm Sr Wm Wr V P wr wi z "
                                     "feat ftype seps bord "
                                     "pm pr qm qr cr0 cr1 Jm Jr Xm Xr Rm bm br Bm Bv bv prev pz pv "
                                     "lbody ljoint lg lat lE lkappa stats")
@@ -94,7 +94,7 @@ def allocate(n, nmodes, parent):
     tvec = np.zeros((2, layout.PENCIL_VEC, n))
     cmat = np.zeros((5, layout.PENCIL_MAT, n, n))  # corners (u_i, t_j) at 2 i + j; 4: the centre (floats)
     cvec = np.zeros((5, layout.PENCIL_VEC, n))
-    return KreinWork(pw.T, pw.jmk, pw.sub, tmat, tvec, cmat, cvec, pw.beta, pw.cm, pw.cr,
+    return KreinWork(pw.T, pw.jmk, pw.sub, tmat, tvec, cmat, cvec, pw.beta, pw.krein, pw.cm, pw.cr,
                      np.zeros((D, D)), np.zeros((n, n)), np.zeros((n, n), np.complex128), np.zeros((n, n), np.complex128),
                      np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
                      np.zeros(D), np.zeros(D), np.zeros(D, np.complex128),
@@ -112,12 +112,12 @@ def allocate(n, nmodes, parent):
 @kernel
 def _ws(kw, c):
     """A ``pencil`` workspace whose matrices are those of slot c of ``kw.cmat`` (a corner, or 4 the centre)."""
-    return layout.PencilWork(kw.T, kw.jmk, kw.sub, kw.cmat[c], kw.cvec[c], kw.beta, kw.cm, kw.cr)
+    return layout.PencilWork(kw.T, kw.jmk, kw.sub, kw.cmat[c], kw.cvec[c], kw.beta, kw.krein, kw.cm, kw.cr)
 
 
 @kernel
 def _twork(kw, j):
-    return layout.PencilWork(kw.T, kw.jmk, kw.sub, kw.tmat[j], kw.tvec[j], kw.beta, kw.cm, kw.cr)
+    return layout.PencilWork(kw.T, kw.jmk, kw.sub, kw.tmat[j], kw.tvec[j], kw.beta, kw.krein, kw.cm, kw.cr)
 
 
 @kernel

@@ -22,12 +22,13 @@ import numpy as np
 from . import options
 from .block import box_block, decide_block, linearise_block, nodes_box_block
 from .firstorder import first_order_block
+from .kreinbox import NINFO, krein_box_block
 from .roots import roots_block
 
 
 def signatures() -> list[tuple]:
     """Argument types of every (kernel, signature) the labelled layer calls on C arrays: ``decide_block`` for
-    points, ``box_block`` and ``nodes_box_block`` for boxes (critical values), ``roots_block`` for growth rates
+    points, ``box_block``, ``nodes_box_block`` and ``krein_box_block`` for boxes (cells, critical values), ``roots_block`` for growth rates
     and frequencies, ``linearise_block`` for the roots' origin (``stabmap query --roots``)."""
     npts, n, lmax = 1, 1, 1
     body, joint, g = np.empty((npts, n, 6)), np.empty((npts, n)), np.empty(npts)
@@ -47,7 +48,12 @@ def signatures() -> list[tuple]:
     # first_order_block: the viscous cavities' bodies, eps and its radius, the roots of roots_block, and its outputs
     first = args[:9] + (np.empty(1, np.int64), np.empty((npts, 1)), np.empty((npts, 1))) + roots[9:12] + (
         np.empty((npts, 2)), np.empty((npts, 2)), np.empty((npts, 2), np.int8))
+    # krein_box_block: the inputs at the two ends of the box's mechanical axis, u's interval, warm starts, N_c,
+    # status and the info columns
+    krein = (b4.repeat(2, 1), j3.repeat(2, 1), g2.repeat(2, 1), a3.repeat(2, 1), E, kappa, nmodes, False, parent, g.copy(), g.copy(),
+             True) + out + (np.empty((npts, NINFO), np.int64),)
     return [(decide_block, tuple(numba.typeof(a) for a in args)), (box_block, tuple(numba.typeof(a) for a in box)),
+            (krein_box_block, tuple(numba.typeof(a) for a in krein)),
             (nodes_box_block, tuple(numba.typeof(a) for a in nodes)), (roots_block, tuple(numba.typeof(a) for a in roots)),
             (linearise_block, tuple(numba.typeof(a) for a in linear)), (first_order_block, tuple(numba.typeof(a) for a in first))]
 

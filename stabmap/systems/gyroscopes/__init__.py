@@ -137,6 +137,16 @@ class Gyroscopes(System[Scene]):
 
         return box_cost(scene)
 
+    def prove_boxes_cheaply(self, scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+        from .kreinboxes import prove_boxes_cheaply
+
+        return prove_boxes_cheaply(scene, lower, upper)
+
+    def cheap_box_cost(self, scene: Scene) -> float:
+        from .kreinboxes import cheap_box_cost
+
+        return cheap_box_cost(scene)
+
     def prove_boxes(self, scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
         from .decide import prove_boxes
 

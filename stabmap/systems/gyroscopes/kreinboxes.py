@@ -16,13 +16,13 @@ import numpy as np
 from ...kernels import layout
 from ...kernels.kreinbox import NINFO, krein_box_block
 from ...kernels.status import UNDECIDED
-from .boxes import _corners, _is_spin, _mechanical, _spin_rows
+from .boxes import _corners, _is_spin, _mechanical, _spin_rows, unenclosed
 from .nodes import LENGTHS, _copies, _u_interval
 from .parameters import parse_name
 from .points import point_arrays
 from .scene import Scene
 
-__all__ = ["KreinBoxes", "krein_arrays", "krein_box", "prove_krein_boxes"]
+__all__ = ["KreinBoxes", "cheap_box_cost", "krein_arrays", "krein_box", "prove_boxes_cheaply", "prove_krein_boxes", "qualifies"]
 
 
 @dataclass
@@ -112,6 +112,40 @@ def prove_krein_boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[st
         nc[rows[good]] = count[good]
         info[rows] = out_info
     return nc, nc >= 0, info
+
+
+def prove_boxes_cheaply(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+    """(N_c, proved) of each box by the Krein test alone (``System.prove_boxes_cheaply``): boxes that span an axis
+    outside ``box_axes``, or that do not qualify (module docstring), are left unproved."""
+    npts = int(np.prod(np.broadcast_shapes(*(np.shape(v) for v in (*lower.values(), *upper.values())))))
+    nc = np.full(npts, -1, dtype=np.int16)
+    spans = np.zeros(npts, dtype=bool)
+    for outside in unenclosed(scene, lower, upper).values():
+        spans |= np.broadcast_to(outside, (npts,))
+    todo = np.flatnonzero(~spans)
+    if todo.size:
+        sub = {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,))[todo] for k, v in lower.items()}
+        got = prove_krein_boxes(scene, sub, {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,))[todo]
+                                             for k, v in upper.items()})[0]
+        nc[todo] = got
+    return nc, nc >= 0
+
+
+def qualifies(scene: Scene) -> bool:
+    """Whether an atlas of ``scene`` has boxes the Krein test can take: its continuous grid axes are one spin axis
+    and at most one affine mechanical axis (module docstring), so that its tiles and their parts move no more."""
+    names = [a.name for a in scene.grid if a.continuous]
+    spins = [k for k in names if _is_spin(scene, k)]
+    return len(spins) == 1 and len(names) <= 2 and all(_is_spin(scene, k) or _affine_axis(scene, k) for k in names)
+
+
+# A Krein box in point proofs: its cost, about 40-110 us on 2-3 bodies (scripts/bench_kreinbox.py), over a point's
+# (6-20 us), grows with the D x D eigenvalue problem of its cold start and the n x n corner compressions
+def cheap_box_cost(scene: Scene) -> float:
+    """What one Krein box costs, in point proofs (0 where the scene has none to take: ``qualifies``)."""
+    if not qualifies(scene):
+        return 0.0
+    return 2.0 + 0.5 * scene.degree
 
 
 def krein_box(scene: Scene, intervals: dict[str, tuple[float, float]]) -> int:
