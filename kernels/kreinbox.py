@@ -741,7 +741,7 @@ def _rvec_abs(R, aR, vm, vr, N, out):
             av = abs(vm[q]) * ball.INFL
             s1 += aR[i, q] * vr[q]
             s2 += aR[i, q] * av
-        r = (s1 + g * s2 + ball.ETA) * (1.0 + (2.0 * N + 8.0) * ball.U)
+        r = (s1 + g * s2 + (4.0 * N + 4.0) * ball.ETA) * (1.0 + (2.0 * N + 8.0) * ball.U)
         out[i] = (out[i] + (abs(m) + r) * ball.INFL) * ball.INFL
 
 
@@ -758,7 +758,7 @@ def _matvec_ball(Am, Ar, vm, vr, n, om, or_):
             s1 += aa * vr[q] + Ar[i, q] * (av + vr[q])
             s2 += aa * av
         om[i] = m
-        or_[i] = (s1 + g * s2 + ball.ETA) * (1.0 + (2.0 * n + 8.0) * ball.U)
+        or_[i] = (s1 + g * s2 + (4.0 * n + 4.0) * ball.ETA) * (1.0 + (2.0 * n + 8.0) * ball.U)
 
 
 @kernel
@@ -782,7 +782,7 @@ def _bound_abs(R, aR, Am, Ar, N, B, identity, aA):
                 if i == j:
                     s2 += 1.0  # the rounding of 1 - m is within 2u (1 + |m|): inside g (s2 + 1)
                     m = m + 1.0
-            r = (s1 + g * s2 + ball.ETA) * (1.0 + (2.0 * N + 8.0) * ball.U)
+            r = (s1 + g * s2 + (4.0 * N + 4.0) * ball.ETA) * (1.0 + (2.0 * N + 8.0) * ball.U)
             B[i, j] = (B[i, j] + (abs(m) + r) * ball.INFL) * ball.INFL
 
 
