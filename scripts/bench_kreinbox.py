@@ -2,6 +2,8 @@
 
     python scripts/bench_kreinbox.py            # 3000 random boxes of each size, then every tile of the grid
     python scripts/bench_kreinbox.py --quick    # 300 random boxes of each size, then the tiles of a 64 x 64-cell patch
+    python scripts/bench_kreinbox.py --atlas    # whole atlases, the default (Krein boxes first) against no Krein boxes
+    python scripts/bench_kreinbox.py --atlas --quick   # the same on small grids; run once by the test suite
 
 paper-n3-fixed regridded to 300 x 300 (omega 1-200 x m_2 0.1-10, log), cell edges midway between grid values
 (``store.dataset.edges``, as scripts/bench_cell_boxes.py).  Boxes of 1 x 1, 4 x 4 and 16 x 16 cells at random
@@ -10,6 +12,11 @@ each size, swept along omega row by row of m_2, where each Krein box first tries
 pairs (``warm=True``, as an atlas would).  For each kernel: the share proved and the microseconds per box of the
 kernel call alone (inputs formed before the clock starts; each kernel called once first, so compilation is not
 timed).  Where both prove a box they must agree on N_c (checked).
+
+``--atlas``: ``compute_atlas()`` (the default, cells proved) on paper-n3-fixed and paper-n2-fixed (240 x 160) and
+random fixed chains of bench_cells.py's ladder (omega x K_1, 200 x 200), with the Krein boxes (the default) and
+without them (``cheap_box_cost`` 0: the cells' boxes go to the tensor-grid proof alone), alternating, minimum of two;
+the labels of both must be equal (checked), and the shares of whole cells are counted.
 """
 
 from __future__ import annotations
@@ -83,11 +90,58 @@ def run_nodes(scene, lower, upper):
     return nc, seconds
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--count", type=int, default=None)
-    args = ap.parse_args()
+def atlases(quick: bool) -> list[dict]:
+    """The ``--atlas`` rows (module docstring)."""
+    import sys
+    from pathlib import Path
+
+    from stabmap.systems.gyroscopes import kreinboxes
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from bench_cells import random_scene
+
+    price = kreinboxes.cheap_box_cost
+    num = 40 if quick else 200
+    w, t = (40, 40) if quick else (240, 160)
+    scenes = [(name, resample(stabmap.example(name), omega=w, **{axis: t})) for name, axis in (("paper-n3-fixed", "m_2"), ("paper-n2-fixed", "K_1"))]
+    scenes += [(f"random n={n}, {m} modes", random_scene(n, m, num, seed=10 + n)) for n, m in ((2, 2), (3, 2), (4, 2))[: 1 if quick else 3]]
+    print("| scene | points | seconds: Krein first / without | ratio | whole cells %: Krein first / without | change % |")
+    print("|---|---|---|---|---|---|")
+    rows = []
+    try:
+        for way in ("krein", "without"):  # compile (or load) the kernels before any clock
+            kreinboxes.cheap_box_cost = price if way == "krein" else (lambda scene: 0.0)
+            stabmap.compute_atlas(resample(scenes[0][1], omega=8, m_2=8))
+        for name, scene in scenes:
+            best, cells, labels = {}, {}, {}
+            for repeat in range(1 if quick else 2):
+                for way in ("krein", "without"):
+                    kreinboxes.cheap_box_cost = price if way == "krein" else (lambda scene: 0.0)
+                    t = time.perf_counter()
+                    ds = stabmap.compute_atlas(scene)
+                    best[way] = min(best.get(way, np.inf), time.perf_counter() - t)
+                    cells[way] = ds["cell"].values
+                    labels[way] = ds["n_complex_pairs"].values
+            assert np.array_equal(labels["krein"], labels["without"]), f"{name}: the labels differ"
+            whole = {w: 100.0 * float(np.mean(c == 1)) for w, c in cells.items()}
+            row = {"scene": name, "points": int(labels["krein"].size), "seconds": best, "whole_pct": whole,
+                   "change_pct": 100.0 * float(np.mean(cells["krein"] == 2))}
+            rows.append(row)
+            print(f"| {name} | {row['points']} | {best['krein']:.2f} / {best['without']:.2f} | {best['krein'] / best['without']:.2f} "
+                  f"| {whole['krein']:.1f} / {whole['without']:.1f} | {row['change_pct']:.1f} |", flush=True)
+    finally:
+        kreinboxes.cheap_box_cost = price
+    return rows
+
+
+def main(argv=None) -> list:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="small sizes (the test suite runs --atlas --quick)")
+    ap.add_argument("--count", type=int, default=None, help="random boxes of each size")
+    ap.add_argument("--atlas", action="store_true", help="whole atlases with and without the Krein boxes")
+    args = ap.parse_args(argv)
+    if args.atlas:
+        return atlases(args.quick)
     count = args.count or (300 if args.quick else 3000)
     for example, axis in (("paper-n3-fixed", "m_2"), ("paper-n2-fixed", "K_1")):  # compile (or load) before any clock
         warm = cell_boxes(300, 1, 4, example=example, axis=axis)
@@ -129,6 +183,7 @@ def main() -> None:
         print(f"{size:2d}x{size:<2d}  {nb:6d}   {100 * np.mean(kn >= 0):6.1f} %  {1e6 * ks / nb:7.1f}  ({int(np.sum(info[:, 3] == 7))})"
               f"          {100 * np.mean(nn >= 0):6.1f} %   {1e6 * ns / nb:7.1f}   {disagree}", flush=True)
         assert disagree == 0, "the two box proofs disagree"
+    return []
 
 
 if __name__ == "__main__":

@@ -33,6 +33,13 @@ def test_bench_krein_quick(capsys):
     assert timed and timed[0]["us"] > 0
 
 
+def test_bench_kreinbox_atlas_quick(capsys):
+    rows = runpy.run_path(str(SCRIPTS / "bench_kreinbox.py"))["main"](["--atlas", "--quick"])
+    assert rows  # the script checks that both ways give the same labels
+    assert all(r["whole_pct"]["krein"] >= 0.0 for r in rows)
+    assert "Krein first / without" in capsys.readouterr().out
+
+
 def test_bench_kernel_density_quick():
     """The same chain at two spacings: only the number of points along the line changes."""
     rows = runpy.run_path(str(SCRIPTS / "bench_kernel.py"))["main"](["--density", "--quick"])
