@@ -4,6 +4,7 @@
                                               # the narrow-band stress set (about 40 minutes)
     python scripts/bench_cells.py --quick     # seconds (two ladder rungs on 24 x 24, one stress E); run once by the test suite
     python scripts/bench_cells.py --size 400  # the degree ladder on another grid, no 4000 x 4000 run
+    python scripts/bench_cells.py --end-to-end  # only paper-n3-fixed end to end on 4000 x 4000 (minutes)
 
 Three ways over the same grid, all cores, kernels loaded before any timing:
   float peer     scripts/float_peer.py: float64 coefficients and a plain float Sturm count at every node (what a
@@ -203,10 +204,13 @@ def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="tiny sizes, for the test suite")
     ap.add_argument("--size", type=int, help="grid points per axis of the degree ladder (default 1000; quick 24)")
+    ap.add_argument("--end-to-end", action="store_true", help="only paper-n3-fixed end to end on 4000 x 4000")
     args = ap.parse_args(argv)
     num = args.size or (24 if args.quick else 1000)
     print(f"# machine: {os.cpu_count()} cores, {platform.processor() or platform.machine()}, python {platform.python_version()}")
     out = {"ladder": []}
+    if args.end_to_end:
+        return {"end_to_end": _end_to_end_row()}
     print("\n| scene | degree | points | float peer s | node by node s | cells s | cells / peer | cells / node by node "
           "| node proofs per cell | box proofs per cell | cells (%) | peer wrong labels |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -237,13 +241,17 @@ def main(argv=None) -> dict:
         print(f"| {E:g} | {r['boundaries']} | {r['narrowest']:.3g} | {r['false_whole']} | {r['checked']} | {r['wrong_interior']} "
               f"| {_shares(r['shares'])} |", flush=True)
     if not args.quick and args.size is None:
-        with tempfile.TemporaryDirectory() as work:
-            r = end_to_end("paper-n3-fixed", 4000, work)
-        out["end_to_end"] = r
-        print(f"\nend to end, paper-n3-fixed on 4000 x 4000 = {r['points']:,} points: cells (file written, {r['file_mb']:.1f} MB) "
-              f"{r['cells_s']:.1f} s, float peer (in memory) {r['peer_s']:.1f} s: peer / cells = {r['peer_s'] / r['cells_s']:.2f}; "
-              f"cells: {_shares(r['shares'])}; peer wrong labels {r['peer_wrong']:,}")
+        out["end_to_end"] = _end_to_end_row()
     return out
+
+
+def _end_to_end_row() -> dict:
+    with tempfile.TemporaryDirectory() as work:
+        r = end_to_end("paper-n3-fixed", 4000, work)
+    print(f"\nend to end, paper-n3-fixed on 4000 x 4000 = {r['points']:,} points: cells (file written, {r['file_mb']:.1f} MB) "
+          f"{r['cells_s']:.1f} s, float peer (in memory) {r['peer_s']:.1f} s: peer / cells = {r['peer_s'] / r['cells_s']:.2f}; "
+          f"cells: {_shares(r['shares'])}; peer wrong labels {r['peer_wrong']:,}", flush=True)
+    return r
 
 
 if __name__ == "__main__":
