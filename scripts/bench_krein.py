@@ -29,11 +29,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import bench_kernel as bk  # noqa: E402
+import bench_kernel as bk
 
-import stabmap  # noqa: E402
-from stabmap.kernels import approximations, certify, disks, pencil  # noqa: E402
-from stabmap.systems.gyroscopes.points import PointArrays, point_arrays  # noqa: E402
+import stabmap
+from stabmap.kernels import approximations, certify, disks, pencil
+from stabmap.systems.gyroscopes.points import PointArrays, point_arrays
 
 PLACEMENTS = (("coarse", certify.COARSE), ("fine", certify.FINE), ("poles", certify.POLES))
 

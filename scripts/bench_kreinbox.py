@@ -114,7 +114,7 @@ def atlases(quick: bool) -> list[dict]:
             stabmap.compute_atlas(resample(scenes[0][1], omega=8, m_2=8))
         for name, scene in scenes:
             best, cells, labels = {}, {}, {}
-            for repeat in range(1 if quick else 2):
+            for _ in range(1 if quick else 2):
                 for way in ("krein", "without"):
                     kreinboxes.cheap_box_cost = price if way == "krein" else (lambda scene: 0.0)
                     t = time.perf_counter()
