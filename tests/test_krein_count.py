@@ -80,13 +80,14 @@ def _exact_roots_in(p: flint.fmpq_poly, a: Fraction, b: Fraction) -> int:
                 break
             chain.append(r)
 
-        def changes(x):
-            x = flint.fmpq(x.numerator, x.denominator)
-            signs = [v > 0 for v in (c(x) for c in chain) if v != 0]
-            return sum(1 for s, t in zip(signs, signs[1:]) if s != t)
-
-        total += mult * (changes(a) - changes(b))
+        total += mult * (_sign_changes(chain, a) - _sign_changes(chain, b))
     return total
+
+
+def _sign_changes(chain: list, x: Fraction) -> int:
+    q = flint.fmpq(x.numerator, x.denominator)
+    signs = [v > 0 for v in (c(q) for c in chain) if v != 0]
+    return sum(1 for s, t in zip(signs, signs[1:], strict=False) if s != t)
 
 
 def _value(p: flint.fmpq_poly, x: Fraction):
@@ -148,7 +149,7 @@ def _separators(rng, p: flint.fmpq_poly, pen, scale: float) -> list[float]:
         if root.imag.is_zero():
             r = float(root.real.mid())
             near += [r * (1 - 1e-12) - 1e-300, r * (1 + 1e-12) + 1e-300]
-    for k, modes in enumerate(pen[3]):
+    for modes in pen[3]:
         for beta, _ in modes:
             if beta != 0:
                 near += [float(-beta) * (1 + s) for s in (1e-9, -1e-9, 1e-3, -1e-3)]
@@ -171,7 +172,7 @@ def test_count_across_an_interval_never_exceeds_its_exact_real_roots(kind):
         bound = 10 ** 9  # beyond every root: the ends +-inf take their nu_H from the leading matrix
         d = ws.C.shape[0] - m  # deg p less the exact zero roots: the sign of p at -inf depends on it
         z = np.full(d, 1j)  # no approximations near the axis (they only mark suspects)
-        for a, b in zip(seps, seps[1:]):
+        for a, b in zip(seps, seps[1:], strict=False):
             fa, fb = F(max(a, -bound)), F(min(b, bound))
             if _value(p, fa) == 0 or _value(p, fb) == 0 or not a < b:
                 continue
@@ -198,15 +199,14 @@ def test_a_cluster_of_one_type_is_counted_whole_at_low_spin():
     """paper-n3-fixed at omega in [1, 10]: its three liquid roots lie about 1e-6 apart (relative) with their triple
     pole.  Separators between groups of approximations alone (COARSE) prove every real root at nearly every point,
     and never more than the exact count."""
-    from stabmap.systems.gyroscopes.points import point_arrays
-
     import stabmap
+    from stabmap.systems.gyroscopes.points import point_arrays
 
     scene = stabmap.example("paper-n3-fixed")
     rng = np.random.default_rng(seed_of("low spin"))
     omegas, masses = rng.uniform(1, 10, 30), 10 ** rng.uniform(-1, 1, 30)
     whole = evaluations = 0
-    for om, m2 in zip(omegas, masses):
+    for om, m2 in zip(omegas, masses, strict=True):
         pts = point_arrays(scene, {"omega": np.array([om]), "m_2": np.array([m2])})
         ws, m, (body, E, nmodes, parent) = _workspace(pts)
         d = _approximations(pts, ws, m)
