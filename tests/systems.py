@@ -86,3 +86,31 @@ WINDOW = {
     "grid": {"omega": {"start": 0.5, "stop": 99.5, "num": 100}},
 }
 EXACT_BOUNDARIES = (11.909452, 12.017778, 13.838770)
+
+
+def window_straddling_boxes():
+    """Boxes of ``WINDOW`` (its liquid's E at 5e-4 and 1e-6) in omega x K_1 and omega x m_2 that hold points on both
+    sides of a boundary of the stable window or a liquid band, 1e-9 to 1 rad/s wider than the boundary's bracket:
+    yields (scene, the other axis, its value, lower, upper, sides), ``sides`` (boxes, 2) two spins of each box at
+    that value, just beside the bracket, one on each side of the boundary (every box holds both)."""
+    from stabmap.run.critical import critical
+
+    for E in (5e-4, 1e-6):
+        system = dict(WINDOW, bodies=[dict(b, fluid=dict(b["fluid"], E=[E])) for b in WINDOW["bodies"]])
+        ds = critical(from_dict(system), "omega", rtol=1e-12, progress=False, threads=1)
+        keep = np.isfinite(ds["boundary_lower"].values)
+        brackets = list(zip(ds["boundary_lower"].values[keep], ds["boundary_upper"].values[keep], strict=True))
+        assert len(brackets) >= 3
+        for other, value in (("K_1", 10.0), ("m_2", 1.0)):
+            scene = from_dict(dict(system, grid={"omega": {"values": [1.0]}, other: {"values": [value]}}))
+            lower: dict[str, list] = {"omega": [], other: []}
+            upper: dict[str, list] = {"omega": [], other: []}
+            sides = []
+            for a, b in brackets:
+                for w in (1e-9, 1e-6, 1e-3, 1.0):
+                    for h in (1e-6, 1e-2, 0.5):
+                        lower["omega"].append(a - w), upper["omega"].append(b + w)
+                        lower[other].append(value - h * value), upper[other].append(value + h * value)
+                        sides.append((a - 1e-10, b + 1e-10))
+            yield (scene, other, value, {k: np.array(v) for k, v in lower.items()}, {k: np.array(v) for k, v in upper.items()},
+                   np.array(sides))

@@ -19,7 +19,7 @@ from stabmap.systems.gyroscopes.decide import kernel_args
 from stabmap.systems.gyroscopes.nodes import degree, spin_scaled
 from stabmap.systems.gyroscopes.points import point_arrays
 from stabmap.systems.gyroscopes.scene import from_dict
-from systems import EXACT_BOUNDARIES, WINDOW
+from systems import EXACT_BOUNDARIES, WINDOW, window_straddling_boxes
 
 
 
@@ -343,31 +343,14 @@ def test_the_tensor_grid_proves_boxes_that_the_plain_and_spin_scaled_enclosures_
 def test_a_two_axis_box_across_a_boundary_is_never_proved():
     # WINDOW's stable window 0.108 rad/s wide at K_1 = 10, and narrower liquid bands with smaller E: boxes in omega x K_1
     # and in omega x m_2 that hold points on both sides of a boundary, from 1e-9 to 1 rad/s wide
-    for E in (5e-4, 1e-6):
-        system = dict(WINDOW, bodies=[dict(b, fluid=dict(b["fluid"], E=[E])) for b in WINDOW["bodies"]])
-        ds = critical(from_dict(system), "omega", rtol=1e-12, progress=False, threads=1)
-        keep = np.isfinite(ds["boundary_lower"].values)
-        brackets = list(zip(ds["boundary_lower"].values[keep], ds["boundary_upper"].values[keep]))
-        assert len(brackets) >= 3
-        for other, value in (("K_1", 10.0), ("m_2", 1.0)):
-            scene = from_dict(dict(system, grid={"omega": {"values": [1.0]}, other: {"values": [value]}}))
-            lower, upper, sides = {"omega": [], other: []}, {"omega": [], other: []}, []
-            for a, b in brackets:
-                for w in (1e-9, 1e-6, 1e-3, 1.0):
-                    for h in (1e-6, 1e-2, 0.5):
-                        lower["omega"].append(a - w), upper["omega"].append(b + w)
-                        lower[other].append(value - h * value), upper[other].append(value + h * value)
-                        sides.append((a - 1e-10, b + 1e-10))  # just beside the bracket, inside every box
-            lower = {k: np.array(v) for k, v in lower.items()}
-            upper = {k: np.array(v) for k, v in upper.items()}
-            x = np.array(sides)
-            # two points of each box, at the scene's value of the other axis, on the two sides of the boundary
-            left = _exact(scene, {"omega": x[:, 0], other: np.full(len(x), value)})
-            right = _exact(scene, {"omega": x[:, 1], other: np.full(len(x), value)})
-            assert np.all(left != right)
-            assert {_kind(scene, lower, upper, i) for i in range(len(x))} == {"spin and axis"}
-            nc, proved = prove_boxes(scene, lower, upper)
-            assert not proved.any(), (E, other, np.flatnonzero(proved))
+    for scene, other, value, lower, upper, x in window_straddling_boxes():
+        # two points of each box, at the scene's value of the other axis, on the two sides of the boundary
+        left = _exact(scene, {"omega": x[:, 0], other: np.full(len(x), value)})
+        right = _exact(scene, {"omega": x[:, 1], other: np.full(len(x), value)})
+        assert np.all(left != right)
+        assert {_kind(scene, lower, upper, i) for i in range(len(x))} == {"spin and axis"}
+        nc, proved = prove_boxes(scene, lower, upper)
+        assert not proved.any(), ([b.E for b in scene.bodies], other, np.flatnonzero(proved))
 
 
 @pytest.mark.parametrize("support, symbol", [("fixed", s) for s in ("u", "m_1", "m_2", "A_2", "C_1", "c_1", "c_2", "s_1", "K_0", "K_1", "g", "c", "m", "A", "K")]

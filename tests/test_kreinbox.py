@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from systems import WINDOW
+from systems import WINDOW, window_straddling_boxes
 
 import stabmap
 from stabmap.kernels import layout
@@ -100,31 +100,14 @@ def test_boxes_whose_samples_differ_are_never_proved_and_proved_ones_agree_with_
 def test_boxes_straddling_a_boundary_of_the_narrow_window_are_never_proved():
     # WINDOW's stable window (0.108 rad/s wide at K_1 = 10) and narrower liquid bands (E = 1e-6): omega x K_1 and
     # omega x m_2 boxes holding points on both sides of a boundary, 1e-9 to 1 rad/s wider than the bracket
-    for E in (5e-4, 1e-6):
-        system = dict(WINDOW, bodies=[dict(b, fluid=dict(b["fluid"], E=[E])) for b in WINDOW["bodies"]])
-        ds = critical(from_dict(system), "omega", rtol=1e-12, progress=False, threads=1)
-        keep = np.isfinite(ds["boundary_lower"].values)
-        brackets = list(zip(ds["boundary_lower"].values[keep], ds["boundary_upper"].values[keep], strict=True))
-        assert len(brackets) >= 3
-        for other, value in (("K_1", 10.0), ("m_2", 1.0)):
-            scene = from_dict(dict(system, grid={"omega": {"values": [1.0]}, other: {"values": [value]}}))
-            lower, upper, sides = {"omega": [], other: []}, {"omega": [], other: []}, []
-            for a, b in brackets:
-                for w in (1e-9, 1e-6, 1e-3, 1.0):
-                    for h in (1e-6, 1e-2, 0.5):
-                        lower["omega"].append(a - w), upper["omega"].append(b + w)
-                        lower[other].append(value - h * value), upper[other].append(value + h * value)
-                        sides.append((a - 1e-10, b + 1e-10))
-            lower = {k: np.array(v) for k, v in lower.items()}
-            upper = {k: np.array(v) for k, v in upper.items()}
-            x = np.array(sides)
-            left = _exact(scene, {"omega": x[:, 0], other: np.full(len(x), value)})
-            right = _exact(scene, {"omega": x[:, 1], other: np.full(len(x), value)})
-            assert np.all(left != right)
-            rows, part = krein_arrays(scene, lower, upper)
-            assert rows.size == len(x)  # every one is a Krein box: the kernel is what refuses them
-            nc, proved, _ = prove_krein_boxes(scene, lower, upper)
-            assert not proved.any(), (E, other, np.flatnonzero(proved))
+    for scene, other, value, lower, upper, x in window_straddling_boxes():
+        left = _exact(scene, {"omega": x[:, 0], other: np.full(len(x), value)})
+        right = _exact(scene, {"omega": x[:, 1], other: np.full(len(x), value)})
+        assert np.all(left != right)
+        rows, part = krein_arrays(scene, lower, upper)
+        assert rows.size == len(x)  # every one is a Krein box: the kernel is what refuses them
+        nc, proved, _ = prove_krein_boxes(scene, lower, upper)
+        assert not proved.any(), ([b.E for b in scene.bodies], other, np.flatnonzero(proved))
 
 
 def test_paper_n2_fixed_spin_by_joint_stiffness_boxes_hold_their_label_in_exact_arithmetic():
