@@ -147,29 +147,19 @@ def main(argv=None) -> list:
         warm = cell_boxes(300, 1, 4, example=example, axis=axis)
         run_krein(*warm)
         run_nodes(*warm)
-    print(f"paper-n3-fixed 300 x 300, omega x m_2, {count} random boxes of each size")
-    print("cells    krein: proved   us/box  (N_c = 0 / pairs)   nodes_box_block: proved   us/box   both   disagree")
-    for size in (1, 4, 16):
-        scene, lower, upper = cell_boxes(300, size, count)
-        kn, ks, info = run_krein(scene, lower, upper)
-        nn, ns = run_nodes(scene, lower, upper)
-        both = (kn >= 0) & (nn >= 0)
-        disagree = int(np.sum(both & (kn != nn)))
-        print(f"{size:2d}x{size:<2d}   {100 * np.mean(kn >= 0):6.1f} %  {1e6 * ks / count:7.1f}   "
-              f"({int(np.sum(kn == 0))} / {int(np.sum(kn > 0))})          {100 * np.mean(nn >= 0):6.1f} %   "
-              f"{1e6 * ns / count:7.1f}   {int(both.sum()):5d}   {disagree}", flush=True)
-        assert disagree == 0, "the two box proofs disagree"
-    print(f"paper-n2-fixed 300 x 300, omega x K_1, {count} random boxes of each size (cold)")
-    for size in (1, 4, 16):
-        scene, lower, upper = cell_boxes(300, size, count, example="paper-n2-fixed", axis="K_1")
-        kn, ks, info = run_krein(scene, lower, upper)
-        nn, ns = run_nodes(scene, lower, upper)
-        both = (kn >= 0) & (nn >= 0)
-        disagree = int(np.sum(both & (kn != nn)))
-        print(f"{size:2d}x{size:<2d}   {100 * np.mean(kn >= 0):6.1f} %  {1e6 * ks / count:7.1f}   "
-              f"({int(np.sum(kn == 0))} / {int(np.sum(kn > 0))})          {100 * np.mean(nn >= 0):6.1f} %   "
-              f"{1e6 * ns / count:7.1f}   {int(both.sum()):5d}   {disagree}", flush=True)
-        assert disagree == 0, "the two box proofs disagree"
+    for example, axis in (("paper-n3-fixed", "m_2"), ("paper-n2-fixed", "K_1")):
+        print(f"{example} 300 x 300, omega x {axis}, {count} random boxes of each size (cold)")
+        print("cells    krein: proved   us/box  (N_c = 0 / pairs)   nodes_box_block: proved   us/box   both   disagree")
+        for size in (1, 4, 16):
+            scene, lower, upper = cell_boxes(300, size, count, example=example, axis=axis)
+            kn, ks, info = run_krein(scene, lower, upper)
+            nn, ns = run_nodes(scene, lower, upper)
+            both = (kn >= 0) & (nn >= 0)
+            disagree = int(np.sum(both & (kn != nn)))
+            print(f"{size:2d}x{size:<2d}   {100 * np.mean(kn >= 0):6.1f} %  {1e6 * ks / count:7.1f}   "
+                  f"({int(np.sum(kn == 0))} / {int(np.sum(kn > 0))})          {100 * np.mean(nn >= 0):6.1f} %   "
+                  f"{1e6 * ns / count:7.1f}   {int(both.sum()):5d}   {disagree}", flush=True)
+            assert disagree == 0, "the two box proofs disagree"
     cells = 64 if args.quick else 300
     print(f"tiles of the first {cells} x {cells} cells, swept along omega; Krein boxes warm from their predecessor")
     print("cells   boxes   krein: proved   us/box  (warm)         nodes_box_block: proved   us/box   disagree")
