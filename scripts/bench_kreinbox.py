@@ -14,7 +14,7 @@ kernel call alone (inputs formed before the clock starts; each kernel called onc
 timed).  Where both prove a box they must agree on N_c (checked).
 
 ``--atlas``: ``compute_atlas()`` (the default, cells proved) on paper-n3-fixed and paper-n2-fixed (240 x 160) and
-random fixed chains of bench_cells.py's ladder (omega x K_1, 200 x 200), with the Krein boxes (the default) and
+random fixed chains of bench_cells.py's ladder (omega x K_1, 200 x 200 up to 4 bodies, 100 x 100 beyond), with the Krein boxes (the default) and
 without them (``cheap_box_cost`` 0: the cells' boxes go to the tensor-grid proof alone), alternating, minimum of two;
 the labels of both must be equal (checked), and the shares of whole cells are counted.
 """
@@ -104,7 +104,8 @@ def atlases(quick: bool) -> list[dict]:
     num = 40 if quick else 200
     w, t = (40, 40) if quick else (240, 160)
     scenes = [(name, resample(stabmap.example(name), omega=w, **{axis: t})) for name, axis in (("paper-n3-fixed", "m_2"), ("paper-n2-fixed", "K_1"))]
-    scenes += [(f"random n={n}, {m} modes", random_scene(n, m, num, seed=10 + n)) for n, m in ((2, 2), (3, 2), (4, 2))[: 1 if quick else 3]]
+    ladder = ((2, 2, num),) if quick else ((2, 2, num), (3, 2, num), (4, 2, num), (6, 2, num // 2), (8, 4, num // 2))
+    scenes += [(f"random n={n}, {m} modes, {k} x {k}", random_scene(n, m, k, seed=10 + n)) for n, m, k in ladder]
     print("| scene | points | seconds: Krein first / without | ratio | whole cells %: Krein first / without | change % |")
     print("|---|---|---|---|---|---|")
     rows = []
