@@ -139,13 +139,14 @@ def qualifies(scene: Scene) -> bool:
     return len(spins) == 1 and len(names) <= 2 and all(_is_spin(scene, k) or _affine_axis(scene, k) for k in names)
 
 
-# A Krein box in point proofs: its cost, about 40-110 us on 2-3 bodies (scripts/bench_kreinbox.py), over a point's
-# (6-20 us), grows with the D x D eigenvalue problem of its cold start and the n x n corner compressions
+# A Krein box in point proofs: 40-110 us on 2-3 bodies (scripts/bench_kreinbox.py) over a point's 10-25 us, growing
+# with the D x D eigenvalue problem of its cold start.  paper-n3-fixed at 240 x 160 (scripts/bench_kreinbox.py
+# --atlas): whole cells 60.5 % at 2 + D/2 = 8, 62.5 % at 4 and 66.3 % at 2, in the same time
 def cheap_box_cost(scene: Scene) -> float:
     """What one Krein box costs, in point proofs (0 where the scene has none to take: ``qualifies``)."""
     if not qualifies(scene):
         return 0.0
-    return 2.0 + 0.5 * scene.degree
+    return 1.0 + 0.25 * scene.degree
 
 
 def krein_box(scene: Scene, intervals: dict[str, tuple[float, float]]) -> int:
