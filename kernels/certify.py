@@ -47,7 +47,7 @@ SMOOTH = 0.1  # weight of the newest point in those running means
 LOOSE_TOL = 2.0**-26  # enough for separators; the disks polish their own roots further
 MERGE = 2.0**-40  # features closer than this share of their size get no separator between them (FINE)
 # ... and in the first, COARSE, placement: a cluster of roots of one Krein type needs no separator inside it (the
-# low-spin liquid roots of a chain lie 1e-6 apart, relative); KREIN.md measured 1e-3
+# low-spin liquid roots of a chain lie 1e-6 apart, relative); a float study of paper-n3-fixed grouped at 1e-3
 GROUP = 2.0**-10
 COARSE, FINE, POLES = 0, 1, 2  # placements of ``_real_roots_at_least``
 UNTRIED = -2  # a candidate separator not evaluated (-1: evaluated, Phi not proved nonsingular there)

@@ -1,4 +1,4 @@
-"""Krein boxes: N_c proved on a whole box of the spin-scaled model from a few definite compressions (KREIN.md, 2).
+"""Krein boxes: N_c proved on a whole box of the spin-scaled model from a few definite compressions.
 
 A box moves the one spin rate omega of every body (not through 0) and at most one mechanical axis t whose kernel
 inputs are copies of its value and enter M, C and K affinely (a mass, an inertia A or C, a joint's stiffness, g;
@@ -9,7 +9,7 @@ not a length, whose entries are quadratic).  In mu = lambda / omega (docs/certif
 the poles mu = -beta_kl (unit spin) are fixed and Phi_1 is bilinear in (u, t): on the rectangle
 [u_lo, u_hi] x [t_lo, t_hi] it is a convex combination of its four corner values.
 
-**Real roots, sign-aware (KREIN.md, 1).**  Border the polynomial part of Phi_1 with one row per liquid mode with
+**Real roots, sign-aware (docs/certification.md, section 4).**  Border the polynomial part of Phi_1 with one row per liquid mode with
 E != 0 and beta != 0: H(mu) = [[A(mu), C], [C^T, diag(c (mu + beta))]], c = E beta^2 (1 - beta), whose Schur
 complement is Phi_1.  H is a real symmetric matrix polynomial, det H = prod c * p_1 / (the exact factors below),
 and by Haynsworth nu_H(mu) = nu(Phi_1(mu)) + #{c (mu + beta) < 0} off the poles, with sign(c) = sign(E kappa)
@@ -35,7 +35,7 @@ matrix, Pa = -ru K0, Ps = mu^2 M1 + mu diag(C1) - uc K1, Pas = -ru K1 (M0, M1 th
 M at t_lo, t_hi, and so on).  F(v, mu) = [Phi_1(mu) v; v_k - 1].  With x~ = (v~, mu~) and R ~ J(x~)^-1 floats,
 K = x~ - R F(x~) + (I - R J(X)) (X - x~) over X = x~ + discs(rho) and the box; R F and R J are expanded in the four
 parts and each product R * part is formed in balls before its absolute value (the centred form: the plain ball
-form loses the cancellation in w^T K v, KREIN.md).  |K - x~| < rho componentwise proves a unique zero in X for
+form loses the cancellation in w^T K v: Neumaier 1990, centred forms).  |K - x~| < rho componentwise proves a unique zero in X for
 every point of the box (Krawczyk, complex discs are convex), so an eigenvalue of Phi_1, not a pole since the disc
 lies in the upper half plane: a non-real root of p_1.  k discs pairwise disjoint, clear of the real axis: 2k
 distinct non-real roots at every point, R + 2k = D, and N_c = k on the whole box.  Where the test fails over the

@@ -62,8 +62,8 @@ def _way(way: str):
         with mock.patch.object(type(stabmap.systems.of(stabmap.example("paper-n1-fixed"))), "box_axes", lambda self, scene: set()):
             yield
     elif way == "plain boxes":
-        with mock.patch.object(boxes, "_spin_rows", lambda *args: np.zeros(0, dtype=np.int64)), \
-             mock.patch.object(boxes, "_mechanical", lambda scene, key: False):
+        with mock.patch.object(boxes, "spin_rows", lambda *args: np.zeros(0, dtype=np.int64)), \
+             mock.patch.object(boxes, "is_mechanical", lambda scene, key: False):
             yield
     else:
         yield

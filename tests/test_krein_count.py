@@ -10,7 +10,7 @@ nu_H(x) = nu(Phi(x)) + #{kl : c_kl (x + beta_kl) < 0} is the inertia of the pole
   on chains whose Krein types interleave (kappa = 2, identical bodies, halves of identical bodies), free chains,
   omega -> 0, E -> 0 and modes with E exactly 0;
 - that a cluster of real roots of one type is counted whole from plain float approximations (the low-spin roots
-  of paper-n3-fixed, KREIN.md: no separator inside the cluster).
+  of paper-n3-fixed: no separator inside the cluster).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Krein boxes (kernels/kreinbox.py, KREIN.md section 2): N_c on a whole omega x t box, every proved box checked in
+"""Krein boxes (kernels/kreinbox.py; docs/certification.md, section 6): N_c on a whole omega x t box, every proved box checked in
 exact rational arithmetic (python-flint, ``exact.decide_points``) at its four corners and at random interior points."""
 
 from __future__ import annotations

@@ -106,7 +106,7 @@ def _hull(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return mid, rad
 
 
-def _corners(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> tuple[PointArrays, PointArrays]:
+def box_corners(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> tuple[PointArrays, PointArrays]:
     """The kernel inputs at the two corners of the boxes; ValueError for a box that spans an axis outside box_axes."""
     if set(lower) != set(upper):
         raise ValueError("lower and upper must name the same axes")
@@ -133,20 +133,20 @@ def box_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
     """The plain enclosure of boxes with corners ``lower`` and ``upper`` (grid-axis values, arrays that broadcast
     together).  Axes missing from both are fixed at the scene's values; an axis with lower == upper is a point.
     Raises ValueError for an axis outside ``box_axes`` whose two corners differ."""
-    return _plain(*_corners(scene, lower, upper))
+    return _plain(*box_corners(scene, lower, upper))
 
 
-def _spin_rows(scene: Scene, lo: PointArrays, hi: PointArrays, moves: dict[str, np.ndarray]) -> np.ndarray:
+def spin_rows(scene: Scene, lo: PointArrays, hi: PointArrays, moves: dict[str, np.ndarray]) -> np.ndarray:
     """Boxes that every body spins through at one rate omega, not through 0: one spin axis moves, and every body's
     spin column with it (two spin axes over the same interval hold points where the bodies spin apart)."""
-    spins = sum(moves[k].astype(int) for k in moves if _is_spin(scene, k))
+    spins = sum(moves[k].astype(int) for k in moves if is_spin(scene, k))
     w_lo = np.minimum(lo.body[..., layout.OMEGA], hi.body[..., layout.OMEGA])
     w_hi = np.maximum(lo.body[..., layout.OMEGA], hi.body[..., layout.OMEGA])
     one_rate = np.all(w_lo == w_lo[:, :1], axis=1) & np.all(w_hi == w_hi[:, :1], axis=1) & (spins == 1)
     return np.flatnonzero(one_rate & (w_lo[:, 0] != w_hi[:, 0]) & ((w_lo[:, 0] > 0.0) | (w_hi[:, 0] < 0.0)))
 
 
-def _is_spin(scene: Scene, key: str) -> bool:
+def is_spin(scene: Scene, key: str) -> bool:
     """omega, omega_k, and S_g where it moves the spin (``ratios``)."""
     symbol = parse_name(key, scene.n, scene.support).symbol
     return symbol == "omega" or (symbol == "S_g" and scene.hold.S_g == "M_alpha")
@@ -170,7 +170,7 @@ def _spin_margin(scene: Scene, lower: dict, upper: dict, lo: PointArrays, hi: Po
     lo.body[..., layout.OMEGA], hi.body[..., layout.OMEGA] = np.where(moving, a, w_lo), np.where(moving, b, w_hi)
 
 
-def _mechanical(scene: Scene, key: str) -> bool:
+def is_mechanical(scene: Scene, key: str) -> bool:
     """An axis whose inputs enter every row of P polynomially, with degree <= 2 (``nodes``)."""
     name = parse_name(key, scene.n, scene.support)
     kinds = ("body", "every_body", "joint", "every_joint", "position", "global")
@@ -180,19 +180,19 @@ def _mechanical(scene: Scene, key: str) -> bool:
 def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> list[tuple[np.ndarray, BoxArrays | NodeBoxes]]:
     """Every box with corners ``lower`` and ``upper`` in its narrowest enclosure (module docstring): (rows, boxes)
     pairs that together hold each box once.  Raises ValueError as ``box_arrays``."""
-    lo, hi = _corners(scene, lower, upper)
+    lo, hi = box_corners(scene, lower, upper)
     npts = lo.body.shape[0]
     lower = {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,)) for k, v in lower.items()}
     upper = {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,)) for k, v in upper.items()}
     moves = {k: lower[k] != upper[k] for k in lower}
-    others = sum((m.astype(int) for k, m in moves.items() if not _is_spin(scene, k)), np.zeros(npts, dtype=int))
-    mech = [k for k in lower if _mechanical(scene, k)]
+    others = sum((m.astype(int) for k, m in moves.items() if not is_spin(scene, k)), np.zeros(npts, dtype=int))
+    mech = [k for k in lower if is_mechanical(scene, k)]
     plain = _plain(lo, hi)
     out: list[tuple[np.ndarray, BoxArrays | NodeBoxes]] = []
 
     spin_names = np.full(npts, None, dtype=object)  # the spin axis a box moves
     for k in lower:
-        if _is_spin(scene, k):
+        if is_spin(scene, k):
             spin_names[moves[k]] = k
 
     def route(rows: np.ndarray, axes: tuple[str, ...], spin: bool) -> np.ndarray:
@@ -203,7 +203,7 @@ def boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarra
             out.append((kept, nodes))
         return np.setdiff1d(rows, kept)
 
-    spin = _spin_rows(scene, lo, hi, moves)
+    spin = spin_rows(scene, lo, hi, moves)
     rest = spin
     for axis in mech:
         rest = route(rest, (axis,), True)
@@ -227,7 +227,7 @@ def box_cost(scene: Scene) -> float:
     point reuses its neighbour's work or proves without coefficients.  1 + n/3 + 2^n/64, fitted to
     scripts/bench_cells.py (a box of two bodies costs about 23 points, of six about 270, of eight about 1400)."""
     n = scene.n
-    per_axis = [n + 1 if _is_spin(scene, a.name) else degree(scene, a.name) + 1 if _mechanical(scene, a.name) else 1
+    per_axis = [n + 1 if is_spin(scene, a.name) else degree(scene, a.name) + 1 if is_mechanical(scene, a.name) else 1
                 for a in scene.grid if a.continuous]
     nodes = float(np.prod(per_axis)) if len(per_axis) <= 2 else 1.0
     return nodes * (1.0 + n / 3.0 + 2.0**n / 64.0)

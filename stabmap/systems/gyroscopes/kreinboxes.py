@@ -1,8 +1,8 @@
 """Krein boxes (``kernels.kreinbox``): N_c on a whole box of (omega, t) from definite compressions at its corners.
 
 A box qualifies when every body spins at the one rate omega of one grid axis, which the box moves, not through 0,
-and at most one other axis moves: a mechanical axis (``boxes._mechanical``) that is not a length (lengths enter M
-quadratically), whose kernel inputs are copies of its value at both corners (``nodes._copies``), so that M, C and K
+and at most one other axis moves: a mechanical axis (``boxes.is_mechanical``) that is not a length (lengths enter M
+quadratically), whose kernel inputs are copies of its value at both corners (``nodes.copies``), so that M, C and K
 are affine in it.  The kernel gets the inputs at the axis's two ends with every spin 1 and the stiffness at u = 1
 (it multiplies by u in balls), and the interval of u = 1 / omega^2 rounded outward.
 """
@@ -16,8 +16,8 @@ import numpy as np
 from ...kernels import layout
 from ...kernels.kreinbox import NINFO, krein_box_block
 from ...kernels.status import UNDECIDED
-from .boxes import _corners, _is_spin, _mechanical, _spin_rows, unenclosed
-from .nodes import LENGTHS, _copies, _u_interval
+from .boxes import box_corners, is_mechanical, is_spin, spin_rows, unenclosed
+from .nodes import LENGTHS, copies, u_interval
 from .parameters import parse_name
 from .points import point_arrays
 from .scene import Scene
@@ -48,18 +48,18 @@ class KreinBoxes:
 
 def _affine_axis(scene: Scene, key: str) -> bool:
     """A mechanical axis whose every entry of Phi is affine in it: not a length, not a free system's mass."""
-    return _mechanical(scene, key) and parse_name(key, scene.n, scene.support).symbol not in LENGTHS
+    return is_mechanical(scene, key) and parse_name(key, scene.n, scene.support).symbol not in LENGTHS
 
 
 def krein_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]) -> tuple[np.ndarray, KreinBoxes | None]:
     """(rows, boxes): the boxes with corners ``lower``, ``upper`` that qualify (module docstring), as kernel inputs."""
-    lo, hi = _corners(scene, lower, upper)
+    lo, hi = box_corners(scene, lower, upper)
     npts = lo.body.shape[0]
     lower = {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,)) for k, v in lower.items()}
     upper = {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,)) for k, v in upper.items()}
     moves = {k: lower[k] != upper[k] for k in lower}
-    spin = _spin_rows(scene, lo, hi, moves)
-    others = [k for k in lower if not _is_spin(scene, k)]
+    spin = spin_rows(scene, lo, hi, moves)
+    others = [k for k in lower if not is_spin(scene, k)]
     n = scene.n
     body = np.empty((npts, 2, n, layout.NBODY))
     joint = np.empty((npts, 2, n))
@@ -83,14 +83,14 @@ def krein_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np
         values = {k: np.repeat(lower[k][sel], 2) for k in lower}
         values[axis] = np.stack([t_lo, t_hi], axis=1).ravel()
         pts = point_arrays(scene, values)
-        keep = _copies(pts, lo, hi, sel, {axis: np.stack([t_lo, t_hi], axis=1)}, {axis: (t_lo, t_hi)}, True)
+        keep = copies(pts, lo, hi, sel, {axis: np.stack([t_lo, t_hi], axis=1)}, {axis: (t_lo, t_hi)}, True)
         sel = sel[keep]
         body[sel], joint[sel], g[sel], at[sel] = (x.reshape((keep.size, 2) + x.shape[1:])[keep] for x in (pts.body, pts.joint, pts.g, pts.at))
         ok[sel] = True
     rows = np.flatnonzero(ok)
     if rows.size == 0:
         return rows, None
-    u_lo, u_hi = _u_interval(lo.body[rows, 0, layout.OMEGA], hi.body[rows, 0, layout.OMEGA])
+    u_lo, u_hi = u_interval(lo.body[rows, 0, layout.OMEGA], hi.body[rows, 0, layout.OMEGA])
     b = body[rows]
     b[..., layout.OMEGA] = 1.0
     return rows, KreinBoxes(b, joint[rows], g[rows], at[rows], lo.E[rows], lo.kappa[rows], lo.nmodes, lo.free, lo.parent, u_lo, u_hi)
@@ -135,8 +135,8 @@ def qualifies(scene: Scene) -> bool:
     """Whether an atlas of ``scene`` has boxes the Krein test can take: its continuous grid axes are one spin axis
     and at most one affine mechanical axis (module docstring), so that its tiles and their parts move no more."""
     names = [a.name for a in scene.grid if a.continuous]
-    spins = [k for k in names if _is_spin(scene, k)]
-    return len(spins) == 1 and len(names) <= 2 and all(_is_spin(scene, k) or _affine_axis(scene, k) for k in names)
+    spins = [k for k in names if is_spin(scene, k)]
+    return len(spins) == 1 and len(names) <= 2 and all(is_spin(scene, k) or _affine_axis(scene, k) for k in names)
 
 
 # A Krein box in point proofs: 40-110 us on 2-3 bodies (scripts/bench_kreinbox.py) over a point's 10-25 us, growing

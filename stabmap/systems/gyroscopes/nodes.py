@@ -24,7 +24,7 @@ Hence the node counts:
 
 p is then of degree < N1 in the first parameter and < N2 in the second, so its tensor interpolant through the
 grid is p itself, and ``boxcount.over_grid`` encloses every value the count needs over the whole box.  A node is
-exact only if every input that moves is the axis value itself (``_copies``): an input formed from it with a
+exact only if every input that moves is the axis value itself (``copies``): an input formed from it with a
 rounding (A less a cavity's tail) is not a polynomial in it, and such boxes take the plain enclosure.
 """
 
@@ -85,7 +85,7 @@ def chebyshev(lo: np.ndarray, hi: np.ndarray, N: int) -> np.ndarray:
     return np.clip(t, lo[:, None], hi[:, None])
 
 
-def _u_interval(w1: np.ndarray, w2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def u_interval(w1: np.ndarray, w2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """[u_lo, u_hi] holding 1 / omega^2 for omega between w1 and w2 (one sign), rounded outward."""
     near, far = np.minimum(np.abs(w1), np.abs(w2)), np.maximum(np.abs(w1), np.abs(w2))
     return _outward(1.0 / (far * far), -np.inf, 3), _outward(1.0 / (near * near), np.inf, 3)
@@ -108,7 +108,7 @@ def spin_scaled(box, w1: np.ndarray, w2: np.ndarray, names: np.ndarray | None = 
     other parameters within their radii at every node.  omega runs between the corners' w1 and w2 (one sign).
     The stiffness is handed over at u = 1: the kernel forms its products with the nodes exactly (``spin``)."""
     m = box.mid
-    u_lo, u_hi = _u_interval(w1, w2)
+    u_lo, u_hi = u_interval(w1, w2)
     n = m.body.shape[1]
     u = chebyshev(u_lo, u_hi, n + 1)
 
@@ -137,7 +137,7 @@ def degree(scene: Scene, key: str) -> int:
     return scene.n
 
 
-def _copies(pts: PointArrays, lo: PointArrays, hi: PointArrays, sel: np.ndarray, grid: dict[str, np.ndarray],
+def copies(pts: PointArrays, lo: PointArrays, hi: PointArrays, sel: np.ndarray, grid: dict[str, np.ndarray],
             ranges: dict[str, tuple[np.ndarray, np.ndarray]], spin: bool) -> np.ndarray:
     """Which boxes ``sel`` have every input that moves equal to one axis's value, at both corners and at every node.
 
@@ -164,7 +164,7 @@ def mechanical(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
                sel: np.ndarray, axes: tuple[str, ...], spin: bool = False, spin_names: np.ndarray | None = None
                ) -> tuple[np.ndarray, NodeBoxes | None]:
     """Node boxes of the boxes ``sel`` that move the mechanical ``axes`` (one or two) and nothing else but, with
-    ``spin``, the one spin rate of every body: those among them whose moving inputs are copies (``_copies``).
+    ``spin``, the one spin rate of every body: those among them whose moving inputs are copies (``copies``).
 
     ``degree(axis) + 1`` nodes per mechanical axis; with ``spin`` the first grid axis is u = 1 / omega^2 at n + 1
     nodes (module docstring); ``spin_names``: the spin axis each box of ``sel`` moves.  Returns the rows kept and
@@ -184,7 +184,7 @@ def mechanical(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
     values = {k: np.repeat(lower[k][sel], count) for k in lower}
     values.update({k: v.ravel() for k, v in grid.items()})
     pts = point_arrays(scene, values)
-    keep = _copies(pts, lo, hi, sel, grid, ranges, spin)
+    keep = copies(pts, lo, hi, sel, grid, ranges, spin)
     if not keep.any():
         return sel[:0], None
 
@@ -203,7 +203,7 @@ def mechanical(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.n
                               *second, axis1=names[0], axis2=names[1] if len(axes) == 2 else None)
     # spin-scaled: at node (u_i, t_j) the inputs at t_j with every spin 1 and the stiffness (joints, g) times u_i,
     # the product formed by the kernel (``spin``)
-    u_lo, u_hi = _u_interval(lo.body[sel, 0, layout.OMEGA], hi.body[sel, 0, layout.OMEGA])
+    u_lo, u_hi = u_interval(lo.body[sel, 0, layout.OMEGA], hi.body[sel, 0, layout.OMEGA])
     n = scene.n
     u = chebyshev(u_lo, u_hi, n + 1)
 
