@@ -12,6 +12,7 @@ arrays by the same names (docs/speed.md, "Named layouts, at no cost").
 """
 
 from .block import allatonce_block, box_block, charpoly_block, count_block, decide_block, linearise_block, nodes_box_block
+from .rates import RATE_ALL_ROOTS, RATE_FAILED, RATE_PAIRS, rate_block
 from .roots import NONREAL, REAL, ROOTS_FAILED, UNSEPARATED, roots_block
 from .status import DECIDED_ALLATONCE, DECIDED_DISKS, DECIDED_FLOAT, DECIDED_INCLUSION, DECIDED_INERTIA, UNDECIDED, ZERO_POLYNOMIAL
 
@@ -24,6 +25,10 @@ __all__ = [
     "decide_block",
     "linearise_block",
     "nodes_box_block",
+    "rate_block",
+    "RATE_ALL_ROOTS",
+    "RATE_FAILED",
+    "RATE_PAIRS",
     "roots_block",
     "NONREAL",
     "REAL",

@@ -42,7 +42,7 @@ STEP_TOL = 2.0**-50  # a step below this share of |z| means z has all the digits
 
 
 @kernel
-def _start(a, d, z):
+def bini_start(a, d, z):
     """Initial approximations from the Newton polygon of |a_k| (Bini): circles of the right radii."""
     # Upper convex hull of (k, log2 |a_k|) over the nonzero coefficients.
     hull = np.empty(d + 1, np.int64)
@@ -150,7 +150,7 @@ def _polish(X, d, z, sweeps):
 
 
 @kernel
-def _aberth(a, d, z, done):
+def float_aberth(a, d, z, done):
     """Aberth-Ehrlich iteration on the float polynomial a (ascending, degree d), in place."""
     done[:d] = False
     for _ in range(MAX_ITER):
@@ -267,8 +267,8 @@ def approximate(X, d, a, z, flags):
         a[k] = X[k, 0]
     if a[0] == 0.0 or a[d] == 0.0:
         return False
-    _start(a, d, z)
-    _aberth(a, d, z, flags)
+    bini_start(a, d, z)
+    float_aberth(a, d, z, flags)
     for i in range(d):
         if not (math.isfinite(z[i].real) and math.isfinite(z[i].imag)):
             return False

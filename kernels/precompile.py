@@ -23,13 +23,14 @@ from . import options
 from .block import box_block, decide_block, linearise_block, nodes_box_block
 from .firstorder import first_order_block
 from .kreinbox import NINFO, krein_box_block
+from .rates import rate_block
 from .roots import roots_block
 
 
 def signatures() -> list[tuple]:
     """Argument types of every (kernel, signature) the labelled layer calls on C arrays: ``decide_block`` for
-    points, ``box_block``, ``nodes_box_block`` and ``krein_box_block`` for boxes (cells, critical values), ``roots_block`` for growth rates
-    and frequencies, ``linearise_block`` for the roots' origin (``stabmap query --roots``)."""
+    points, ``box_block``, ``nodes_box_block`` and ``krein_box_block`` for boxes (cells, critical values), ``rate_block`` for growth rates,
+    ``roots_block`` for frequencies, ``linearise_block`` for the roots' origin (``stabmap query --roots``)."""
     npts, n, lmax = 1, 1, 1
     body, joint, g = np.empty((npts, n, 6)), np.empty((npts, n)), np.empty(npts)
     E, kappa, nmodes = np.empty((npts, n, lmax)), np.empty((npts, n, lmax)), np.empty(n, np.int64)
@@ -45,6 +46,7 @@ def signatures() -> list[tuple]:
     roots = args[:9] + (np.empty((npts, 2), np.complex128), np.empty((npts, 2)), np.empty((npts, 2), np.int8), np.empty((npts, 3)),
                         np.empty(npts, np.int8))
     linear = args[:9] + (np.empty((npts, 2, 2)),)
+    rate = args[:9] + (np.empty(npts, np.int64), np.empty((npts, 3)), np.empty(npts, np.int8))
     # first_order_block: the viscous cavities' bodies, eps and its radius, the roots of roots_block, and its outputs
     first = args[:9] + (np.empty(1, np.int64), np.empty((npts, 1)), np.empty((npts, 1))) + roots[9:12] + (
         np.empty((npts, 2)), np.empty((npts, 2)), np.empty((npts, 2), np.int8))
@@ -55,6 +57,7 @@ def signatures() -> list[tuple]:
     return [(decide_block, tuple(numba.typeof(a) for a in args)), (box_block, tuple(numba.typeof(a) for a in box)),
             (krein_box_block, tuple(numba.typeof(a) for a in krein)),
             (nodes_box_block, tuple(numba.typeof(a) for a in nodes)), (roots_block, tuple(numba.typeof(a) for a in roots)),
+            (rate_block, tuple(numba.typeof(a) for a in rate)),
             (linearise_block, tuple(numba.typeof(a) for a in linear)), (first_order_block, tuple(numba.typeof(a) for a in first))]
 
 

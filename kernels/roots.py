@@ -69,11 +69,11 @@ def roots_block(body, joint, g, E, kappa, nmodes, free, parent, at, out_z, out_r
         if not laplace:
             continue
         charpoly_point(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, rowdeg, free, ws, c, same_structure(body, joint, at, g, p))
-        out_status[p] = _point(c, X, a, z, R, group, flags, out_z[p], out_r[p], out_kind[p], out_rate[p])
+        out_status[p] = point_roots(c, X, a, z, R, group, flags, out_z[p], out_r[p], out_kind[p], out_rate[p])
 
 
 @kernel
-def _point(c, X, a, z, R, group, flags, oz, orad, okind, orate):
+def point_roots(c, X, a, z, R, group, flags, oz, orad, okind, orate):
     """One point's roots from its coefficient enclosure c (ascending, (hi, lo, rad)); see ``roots_block``."""
     oz[:] = complex(np.nan, np.nan)
     orad[:] = np.nan

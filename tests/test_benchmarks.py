@@ -220,3 +220,12 @@ def test_bench_allatonce_lines_quick():
     rows = runpy.run_path(str(SCRIPTS / "bench_allatonce.py"), run_name="bench")["main"](["--lines", "12:0:mixed:6"])
     assert [(r["spec"], r["points"]) for r in rows] == [("12:0:mixed:6", 12)]
     assert 2 <= rows[0]["cold"] <= 12 and rows[0]["ratio"] > 0
+
+
+def test_bench_rate_price_quick(capsys):
+    out = runpy.run_path(str(SCRIPTS / "bench_rate_price.py"))["main"](["--quick"])
+    assert [r["scene"] for r in out["scenes"]][0] == "paper-n3-fixed" and out["ladder"]
+    for r in out["scenes"] + out["ladder"]:
+        assert r["width"] <= 1e-6  # every rate enclosed to the documented width, whatever the path
+        assert sum(r["methods"].values()) == r["unstable"]
+    assert "growth_rate = false s" in capsys.readouterr().out

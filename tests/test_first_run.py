@@ -143,8 +143,10 @@ def test_atlas_refine_and_critical_call_only_the_precompiled_signatures():
         stabmap.compute_atlas(resample(viscous, **{a.name: 9 for a in viscous.grid}), progress=False, threads=1)
         from stabmap.kernels.firstorder import first_order_block
         from stabmap.kernels.kreinbox import krein_box_block  # the cells' Krein boxes (omega x m_2)
+        from stabmap.kernels.rates import rate_block  # growth rates from the pairs
         called = (decide_block.signatures + box_block.signatures + nodes_box_block.signatures + roots_block.signatures
-                  + linearise_block.signatures + first_order_block.signatures + krein_box_block.signatures)
+                  + linearise_block.signatures + first_order_block.signatures + krein_box_block.signatures
+                  + rate_block.signatures)
         print(json.dumps({"called": sorted(map(str, called)),
                           "precompiled": sorted(str(sig) for _, sig in precompile.signatures())}))
     """

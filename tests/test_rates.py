@@ -223,7 +223,7 @@ def test_box_proved_nodes_are_computed_and_inferred_ones_flagged():
     assert np.all(ds.growth_rate.values[box & (nc == 0)] == 0)
     assert np.all(ds.growth_rate_method.values[box & (nc == 0)] == rates.ALL_REAL)
     # a box-proved unstable node has its roots computed at the node, as a decided one
-    assert np.all(np.isin(ds.growth_rate_method.values[nc > 0], [rates.DISKS, rates.EXACT]))
+    assert np.all(np.isin(ds.growth_rate_method.values[nc > 0], [rates.PAIRS, rates.DISKS, rates.EXACT]))
     for w, lo, hi in zip(ds.omega.values[nc > 0], ds.growth_rate_lower.values[nc > 0], ds.growth_rate_upper.values[nc > 0]):
         assert lo <= max(abs(mpmath.im(z)) for z in top_roots(w)) <= hi
     refined = stabmap.compute_refined(loads_scene(TOP.format(extra="").replace("num = 33", "num = 65")), coarse_stride=8, margin=0,

@@ -106,8 +106,11 @@ GROWTH_RATE_METHOD = Variable(
     "exact_arb_roots: the exact rational polynomial's roots isolated by FLINT/Arb (where the disks were too wide); "
     "not_computed: the point was inferred (--refine), not computed; a point proved over a box has its rate computed "
     "at the node from its proved label; "
-    "degenerate: p is identically zero",
-    flags=((0, "all_roots_real"), (1, "inclusion_disks"), (2, "exact_arb_roots"), (3, "not_computed"), (4, "degenerate")),
+    "degenerate: p is identically zero; "
+    "newton_pairs: disjoint Newton disks around the n_complex_pairs roots in the upper half plane, which the proved "
+    "label says are all the non-real roots (the real roots contribute exactly 0)",
+    flags=((0, "all_roots_real"), (1, "inclusion_disks"), (2, "exact_arb_roots"), (3, "not_computed"), (4, "degenerate"),
+           (5, "newton_pairs")),
 )
 FREQUENCY = Variable(
     "frequency",

@@ -1,7 +1,9 @@
 """Growth rates, e-folding times and mode frequencies of a block of points, with proved enclosures (docs/rates.md).
 
-The kernel ``roots_block`` encloses every root by inclusion disks; where they are too wide to bound the growth rate
-to ``REL`` (repeated or clustered roots) the point's exact rational polynomial is solved by FLINT/Arb instead
+A growth rate alone needs the non-real roots only: ``rate_block`` encloses the N_c pairs the label has proved by
+disjoint Newton disks, so clustered or repeated real roots never widen it.  Where that falls short it takes the
+all-roots enclosure of ``roots_block`` (inclusion disks around every root), which is also what the frequencies
+use.  Where either is wider than ``REL`` the point's exact rational polynomial is solved by FLINT/Arb instead
 (``growth_rate_method`` = exact_arb_roots says where, and so how often).  Labels are taken as given: a point whose
 N_c = 0 is proved has growth rate exactly 0, and no root of it is computed unless its frequencies are asked for.
 """
@@ -11,15 +13,16 @@ from __future__ import annotations
 import flint
 import numpy as np
 
-from ...kernels import NONREAL, REAL, roots_block
+from ...kernels import NONREAL, RATE_FAILED, RATE_PAIRS, REAL, rate_block, roots_block
 from . import exact
 from .decide import kernel_args
 from .outputs import EFOLDING_TIME, FREQUENCY, FREQUENCY_RADIUS, GROWTH_RATE, GROWTH_RATE_LOWER, GROWTH_RATE_METHOD, GROWTH_RATE_UPPER, ROOT_KIND
 from .points import PointArrays
 
 REL = 1e-6  # a disk enclosure of the growth rate wider than this, relative, goes to exact arithmetic
-ALL_REAL, DISKS, EXACT, NOT_COMPUTED, DEGENERATE = (
-    GROWTH_RATE_METHOD.value(m) for m in ("all_roots_real", "inclusion_disks", "exact_arb_roots", "not_computed", "degenerate"))
+ALL_REAL, DISKS, EXACT, NOT_COMPUTED, DEGENERATE, PAIRS = (
+    GROWTH_RATE_METHOD.value(m) for m in ("all_roots_real", "inclusion_disks", "exact_arb_roots", "not_computed", "degenerate",
+                                          "newton_pairs"))
 
 
 def rates(points: PointArrays, nc: np.ndarray, growth: bool = True, frequencies: bool = False) -> dict[str, np.ndarray]:
@@ -37,7 +40,13 @@ def rates(points: PointArrays, nc: np.ndarray, growth: bool = True, frequencies:
     lower[nc == 0] = upper[nc == 0] = best[nc == 0] = 0.0
     freq, radius = np.full((npts, D), np.nan), np.full((npts, D), np.nan)
     kind = np.full((npts, D), -1, dtype=np.int8)
-    todo = np.flatnonzero(nc >= 0 if frequencies else (nc > 0 if growth else np.zeros(npts, bool)))
+    if growth and not frequencies:
+        at = np.flatnonzero(nc > 0)
+        if at.size:
+            lower[at], upper[at], best[at], method[at] = growth_only(points, at, nc[at], D)
+        todo = at[:0]
+    else:
+        todo = np.flatnonzero(nc >= 0 if frequencies else np.zeros(npts, bool))
     if todo.size:
         z, r, k, rate, status = _roots(points.take(todo), D)
         unstable = nc[todo] > 0
@@ -64,6 +73,19 @@ def rates(points: PointArrays, nc: np.ndarray, growth: bool = True, frequencies:
     if frequencies:
         out.update({FREQUENCY.name: freq, FREQUENCY_RADIUS.name: radius, ROOT_KIND.name: kind})
     return out
+
+
+def growth_only(points: PointArrays, at: np.ndarray, nc: np.ndarray, D: int):
+    """(lower, upper, estimate, method) of the growth rate at the points ``at`` (N_c = ``nc`` > 0, proved)."""
+    rate = np.empty((at.size, 3))
+    status = np.empty(at.size, np.int8)
+    rate_block(*kernel_args(points.take(at)), nc.astype(np.int64), rate, status)
+    method = np.where(status == RATE_PAIRS, PAIRS, DISKS).astype(np.int8)
+    wide = (status == RATE_FAILED) | (rate[:, 1] <= 0.0) | (rate[:, 2] - rate[:, 1] > REL * rate[:, 2])
+    for i in np.flatnonzero(wide):
+        rate[i] = exact_roots(points, at[i], D)[3]
+    method[wide] = EXACT
+    return rate[:, 1], rate[:, 2], rate[:, 0], method
 
 
 def not_computed(label: np.ndarray, proved: bool) -> dict[str, np.ndarray]:
@@ -144,4 +166,4 @@ def _roots(points: PointArrays, D: int):
     return z, r, k, rate, status
 
 
-__all__ = ["rates", "not_computed", "exact_roots", "up", "down", "outward_float32"]
+__all__ = ["rates", "growth_only", "not_computed", "exact_roots", "up", "down", "outward_float32"]
