@@ -14,6 +14,7 @@ from __future__ import annotations
 import mpmath
 import numpy as np
 import pytest
+from test_rates import CHAINS
 
 from stabmap.kernels import rates as kernel_rates
 from stabmap.systems import loads_scene, of
@@ -22,32 +23,7 @@ from stabmap.systems.gyroscopes.points import point_arrays
 
 mpmath.mp.dps = 60
 
-CHAIN = """
-title = "three tops with liquid"
-g = 9.81
-joints = [120.0, 80.0]
-[[bodies]]
-m = 1.0
-A = 0.02
-C = 0.03
-c = 0.10
-s = 0.25
-fluid = { E = [1e-4, 2e-5], kappa = [1.31, 2.7] }
-[[bodies]]
-m = 0.8
-A = 0.015
-C = 0.02
-c = 0.12
-s = 0.2
-[[bodies]]
-m = 0.6
-A = 0.01
-C = 0.02
-c = 0.05
-fluid = { E = [3e-4], kappa = [1.5] }
-[grid]
-omega = { start = 0.0, stop = 100.0, num = 3 }
-"""
+CHAIN = CHAINS[3].replace("frequencies = true\n", "")  # three tops with liquid, growth rate only
 
 # Identical bodies on equal elastic joints: the liquid roots of the three cavities coincide to about 1e-6 (relative),
 # the real roots cluster, the pairs stay simple.
