@@ -291,7 +291,7 @@ def test_info_gives_the_largest_growth_rate_and_queries_take_rpm(tmp_path, capsy
     line = next(s for s in capsys.readouterr().out.splitlines() if "growth rate:" in s)
     shown = float(line.split("largest ")[1].split()[0])
     assert abs(shown - want) <= 1e-5 * want
-    assert "all roots real" in line and "inclusion disks" in line
+    assert "all roots real" in line and "newton pairs" in line  # the pairs' disks, not every root's
     # a spin rate in rpm reaches the point itself: 5 rad/s = 150/pi rpm
     assert main(["query", str(path), f"omega={5 * 60 / (2 * np.pi)!r} rpm", "--roots"]) == 0
     z = top_roots(5.0)[1]
