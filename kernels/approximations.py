@@ -54,7 +54,7 @@ def eigenvalues(C, wr, wi, vdummy, z, degree, m):
 
 
 @kernel
-def _newton_step(z, m, body, E, nmodes, pws, F, dF):
+def newton_ratio(z, m, body, E, nmodes, pws, F, dF):
     """p~(z) / p~'(z) in floats (the trace formula); NaN where it is not finite."""
     logq = pencil.float_matrices(z, body, E, nmodes, pws, F, dF)
     t = elimination.trace_solve(F, dF, body.shape[0]) + logq - m * ball.recip(z)
@@ -78,7 +78,7 @@ def aberth(z, d, m, sweeps, body, E, nmodes, pws, F, dF, done, tol):
                 continue
             zi = z[i]
             solves += 1
-            ratio = _newton_step(zi, m, body, E, nmodes, pws, F, dF)
+            ratio = newton_ratio(zi, m, body, E, nmodes, pws, F, dF)
             if not (math.isfinite(ratio.real) and math.isfinite(ratio.imag)):
                 done[i] = True
                 continue
@@ -157,7 +157,7 @@ def aberth_nonreal(z, d, m, sweeps, body, E, nmodes, pws, F, dF, idx):
                 continue
             zi = z[i]
             solves += 1
-            ratio = _newton_step(zi, m, body, E, nmodes, pws, F, dF)
+            ratio = newton_ratio(zi, m, body, E, nmodes, pws, F, dF)
             if not (math.isfinite(ratio.real) and math.isfinite(ratio.imag)):
                 idx[a] = -1 - i
                 continue

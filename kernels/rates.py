@@ -10,7 +10,9 @@ however clustered or repeated they are.  With approximations z_1..z_Nc in the up
 - N_c such disks, pairwise disjoint and clear of the real axis, hold N_c distinct roots in the upper half plane;
   there are only N_c there, so they are all, one in each.
 
-Then max_i (Im z_i - R_i) <= growth rate <= max_i (Im z_i + R_i), every bound rounded outward.  The disks of the
+Then max_i (Im z_i - R_i) <= growth rate <= max_i (Im z_i + R_i), every bound rounded outward.  Where the
+coefficients' enclosure, amplified by Horner's cancellation beside a cluster of real roots, gives no narrow disk,
+the pair takes the Newton disk of ``disks.newton_disk`` instead (p~'/p~ from Phi(z) itself, in balls).  The disks of the
 real roots, which are what clusters and repeated roots widen, never enter.  Where this falls short (approximations
 that do not show N_c pairs, a pair closer to the axis or to another than its disks, no coefficients) the point
 takes the all-roots enclosure of ``roots`` (status ``RATE_ALL_ROOTS``), and the caller exact arithmetic after it.
@@ -22,8 +24,9 @@ import math
 
 import numpy as np
 
-from . import dd
+from . import approximations, dd, disks, pencil
 from .block import LAPLACE_MAX
+from .certify import moderate
 from .charpoly import allocate, charpoly_point, same_structure
 from .inclusion import approximate, bini_start, horner_dd
 from .options import kernel
@@ -32,6 +35,9 @@ from .scaling import nonzero_span, rescale, root_scale
 
 RATE_PAIRS, RATE_ALL_ROOTS, RATE_FAILED = 0, 1, 2  # statuses of ``rate_block``
 WARM, COLD, POLISHED = 0, 1, 2  # starts of ``_pairs``
+NARROW = 2.0**-22  # a disk wider than this share of Im z is not taken (the rate's relative width stays below 1e-6)
+PHI_NEWTON = 4  # float Newton steps on det Phi before a disk from Phi
+PHI_SHIFTS = (2.0**-44, 2.0**-36, 2.0**-28)  # a disk from Phi is centred this far (relative) above its root
 UPPER_SHARE = 2.0**-30  # an approximation this far above the axis (relative) is taken for a non-real root
 MAX_SWEEPS = 120  # float Aberth sweeps at most
 FLOAT_TOL = 2.0**-40  # a float approximation this close (relative) is left to the double-double Newton steps
@@ -69,6 +75,12 @@ def rate_block(body, joint, g, E, kappa, nmodes, free, parent, at, nc, out_rate,
     okind = np.empty(D, np.int8)
     prev = np.empty(D, np.complex128)  # the previous point's proved pairs [rad/s]: this one's start, if it has as many
     nprev = 0
+    info = np.zeros(3, np.int64)  # the last approximations' scale exponent, number of candidates, and the degree
+    pws = pencil.allocate(n, max(1, nmodes.max()), parent)
+    F = np.empty((n, n), np.complex128)
+    dF = np.empty((n, n), np.complex128)
+    dm = np.empty((n, n), np.complex128)
+    dr = np.empty((n, n))
     for p in range(npts):
         out_status[p] = RATE_FAILED
         if not laplace:
@@ -77,11 +89,20 @@ def rate_block(body, joint, g, E, kappa, nmodes, free, parent, at, nc, out_rate,
         k = nc[p]
         warm = k == nprev
         nprev = 0
-        done = warm and _pairs(c, X, a, z, R, up, flags, k, out_rate[p], prev, WARM, oz)
+        done = warm and _pairs(c, X, a, z, R, up, flags, k, out_rate[p], prev, WARM, oz, info)
         if not done:
-            done = _pairs(c, X, a, z, R, up, flags, k, out_rate[p], prev, COLD, oz)
+            done = _pairs(c, X, a, z, R, up, flags, k, out_rate[p], prev, COLD, oz, info)
         if not done:
-            done = _pairs(c, X, a, z, R, up, flags, k, out_rate[p], prev, POLISHED, oz)
+            done = _pairs(c, X, a, z, R, up, flags, k, out_rate[p], prev, POLISHED, oz, info)
+        if not done and info[1] >= k and moderate(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes):
+            # the polished approximations again, their disks now from Phi(z) itself: next to a cluster of real roots
+            # the coefficients' enclosure, amplified by Horner's cancellation, is what made the disks too wide
+            m = pencil.prepare(body[p], joint[p], at[p], g[p], E[p], kappa[p], nmodes, parent, free, pws, False)
+            done = _pairs_from_phi(X, z, up, info, k, D - m, m, body[p], E[p], nmodes, pws, F, dF, dm, dr, oz, R, out_rate[p])
+            nprev = 0  # these pairs stay out of the next point's warm start: it starts from the coefficients
+            if done:
+                out_status[p] = RATE_PAIRS
+                continue
         if done:
             out_status[p] = RATE_PAIRS
             nprev = k
@@ -90,16 +111,17 @@ def rate_block(body, joint, g, E, kappa, nmodes, free, parent, at, nc, out_rate,
 
 
 @kernel
-def _pairs(c, X, a, z, R, up, flags, nc, orate, prev, start, centre):
+def _pairs(c, X, a, z, R, up, flags, nc, orate, prev, start, centre, info):
     """Rate of one point from Newton disks around its nc non-real roots in the upper half plane; False if not proved.
 
     ``start``: WARM from ``prev`` (the previous point's nc pairs, usually a grid neighbour's), COLD from float Aberth
     on every root, or POLISHED (every root polished in double-double as well: a cluster of nearly repeated real
     roots, which float Aberth resolves to u^(1/k) only, then no longer poses as pairs).  Whatever the start, the
     disks prove what they prove; a start only decides whether they are found.  On success ``prev`` holds this
-    point's pairs.
+    point's pairs.  ``info`` gets the scale exponent and the number of candidates (in ``up``) of the approximations.
     """
     warm = start == WARM
+    info[1] = 0
     low, top = nonzero_span(c)
     d = top - low
     if nc <= 0 or 2 * nc > d or not dd.certain_nonzero(c[top, 0], c[top, 1], c[top, 2]):
@@ -122,6 +144,7 @@ def _pairs(c, X, a, z, R, up, flags, nc, orate, prev, start, centre):
         candidates = _aberth_pairs(a, d, z, flags, R, up, nc)
     else:
         candidates = _farthest(z, d, R, up) if approximate(X, d, a, z, flags) else 0
+    info[0], info[1], info[2] = shift, candidates, d
     # candidates farthest above the axis first; one whose disk is not clear of the axis, or meets an accepted one,
     # is passed over (a real cluster's approximations posing as pairs): any nc accepted disks hold all nc pairs
     best, lower, upper = 0.0, 0.0, 0.0
@@ -131,7 +154,7 @@ def _pairs(c, X, a, z, R, up, flags, nc, orate, prev, start, centre):
             break
         zi = _polish(X, d, z[up[j]])
         r = newton_radius(X, d, zi)
-        if not (r < zi.imag * (WARM_WIDTH if warm else DOWN)):  # a warm start that polished badly: try cold
+        if not (r < zi.imag * (WARM_WIDTH if warm else NARROW)):  # a warm start that polished badly: try cold
             if warm:
                 return False
             continue
@@ -157,6 +180,64 @@ def _pairs(c, X, a, z, R, up, flags, nc, orate, prev, start, centre):
         prev[j] = complex(math.ldexp(centre[j].real, shift), math.ldexp(centre[j].imag, shift))
     orate[0], orate[1], orate[2] = min(max(best, lower), upper), lower, upper
     return True
+
+
+@kernel
+def _pairs_from_phi(X, z, up, info, nc, d, m, body, E, nmodes, pws, F, dF, dm, dr, centre, R, orate):
+    """The rate from the candidates ``z[up[:info[1]]]`` (scaled by 2**info[0]) of ``_pairs``, each with its disk from
+    the coefficients X where that is narrow, else with a Newton disk of ``disks.newton_disk`` (p~'/p~ from Phi(z)
+    and Phi'(z) in balls; ``pws`` prepared for the point).  As ``_pairs``: nc disjoint disks clear of the axis hold
+    all nc pairs.  For Phi's disk the candidate is first polished by Newton steps on det Phi in floats, and the disk
+    is centred a little above it (Phi is singular at a root): the least of ``PHI_SHIFTS`` that gives a narrow disk."""
+    shift = info[0]
+    best, lower, upper = 0.0, 0.0, 0.0
+    k = 0
+    for j in range(info[1]):
+        if k == nc:
+            break
+        zs = _polish(X, info[2], z[up[j]])
+        zi = complex(math.ldexp(zs.real, shift), math.ldexp(zs.imag, shift))
+        r, zc = math.ldexp(newton_radius(X, info[2], zs), shift) * UP, zi
+        if not (r < zi.imag * NARROW):
+            r, zi = _phi_disk(zi, d, m, body, E, nmodes, pws, F, dF, dm, dr)
+            zc = zi
+        if not (r * UP < zc.imag * NARROW):
+            continue
+        alone = True
+        for i in range(k):
+            alone = alone and abs(zc - centre[i]) * DOWN > (r + R[i]) * UP
+        if not alone:
+            continue
+        centre[k], R[k] = zc, r
+        k += 1
+        best = max(best, zi.imag)
+        upper = max(upper, (zc.imag + r) * UP)
+        lower = max(lower, (zc.imag - r) * DOWN)
+    if k < nc:
+        return False
+    orate[0], orate[1], orate[2] = min(max(best, lower), upper), lower, upper
+    return True
+
+
+@kernel
+def _phi_disk(zi, d, m, body, E, nmodes, pws, F, dF, dm, dr):
+    """(radius, centre) of a Newton disk from Phi around zi polished on det Phi: the first of ``PHI_SHIFTS`` whose
+    disk is narrow; (inf, zi) if none."""
+    for _ in range(PHI_NEWTON):
+        step = approximations.newton_ratio(zi, m, body, E, nmodes, pws, F, dF)
+        if not (math.isfinite(step.real) and math.isfinite(step.imag)):
+            break
+        zi = zi - step
+        if abs(step) <= STEP_TOL * abs(zi):
+            break
+    if not zi.imag > 0.0:
+        return np.inf, zi
+    for s in PHI_SHIFTS:
+        zc = complex(zi.real, zi.imag + s * abs(zi))
+        r = disks.newton_disk(zc, d, m, body, E, nmodes, pws, dm, dr)
+        if r * UP < zc.imag * NARROW:
+            return r, zc
+    return np.inf, zi
 
 
 @kernel
