@@ -121,7 +121,7 @@ def maievskii_values(dims: list[str], grid: dict[str, np.ndarray], fixed: dict[s
         "growth_rate_upper": np.where(rate32 > 0, np.nextafter(rate32, np.float32(np.inf)), zero).astype(np.float32),
         "efolding_time": efold,
         "growth_rate_method": np.where(stable, flags["growth_rate_method"]["all_roots_real"],
-                                       flags["growth_rate_method"]["inclusion_disks"]).astype(np.int8),
+                                       flags["growth_rate_method"]["newton_pairs"]).astype(np.int8),
         "cell": np.where(change, flags["cell"]["contains_change"], flags["cell"]["whole_cell"]).astype(np.int8),
     }
 
