@@ -44,13 +44,11 @@ def rates(points: PointArrays, nc: np.ndarray, growth: bool = True, frequencies:
         at = np.flatnonzero(nc > 0)
         if at.size:
             lower[at], upper[at], best[at], method[at] = growth_only(points, at, nc[at], D)
-        todo = at[:0]
-    else:
-        todo = np.flatnonzero(nc >= 0 if frequencies else np.zeros(npts, bool))
+    todo = np.flatnonzero(nc >= 0) if frequencies else np.zeros(0, np.int64)
     if todo.size:
         z, r, k, rate, status = _roots(points.take(todo), D)
         unstable = nc[todo] > 0
-        wide = (status != 0) | (unstable & ((rate[:, 1] <= 0.0) | (rate[:, 2] - rate[:, 1] > REL * rate[:, 2])))
+        wide = (status != 0) | (unstable & _too_wide(rate))
         for i in np.flatnonzero(wide):
             z[i], r[i], k[i], rate[i] = exact_roots(points, todo[i], D)
         k[~unstable] = np.where(k[~unstable] >= 0, REAL, -1)  # N_c = 0 is proved: every root is real
@@ -81,11 +79,17 @@ def growth_only(points: PointArrays, at: np.ndarray, nc: np.ndarray, D: int):
     status = np.empty(at.size, np.int8)
     rate_block(*kernel_args(points.take(at)), nc.astype(np.int64), rate, status)
     method = np.where(status == RATE_PAIRS, PAIRS, DISKS).astype(np.int8)
-    wide = (status == RATE_FAILED) | (rate[:, 1] <= 0.0) | (rate[:, 2] - rate[:, 1] > REL * rate[:, 2])
+    wide = (status == RATE_FAILED) | _too_wide(rate)
     for i in np.flatnonzero(wide):
         rate[i] = exact_roots(points, at[i], D)[3]
     method[wide] = EXACT
     return rate[:, 1], rate[:, 2], rate[:, 0], method
+
+
+def _too_wide(rate: np.ndarray) -> np.ndarray:
+    """Rows (estimate, lower, upper) whose enclosure of a nonzero rate proves no positive lower bound or is wider than
+    ``REL``: those go to exact arithmetic."""
+    return (rate[:, 1] <= 0.0) | (rate[:, 2] - rate[:, 1] > REL * rate[:, 2])
 
 
 def not_computed(label: np.ndarray, proved: bool) -> dict[str, np.ndarray]:
