@@ -325,15 +325,16 @@ def plot(
     max_panels: int | None = None,
     max_mb: float | None = None,
     overwrite: bool = False,
+    campbell: bool = False,
 ) -> Done:
     """``stabmap plot``: draw an atlas (or critical values) to a PNG or PDF file, or write its interactive page (.html);
-    an existing output only if ``overwrite``."""
+    an existing output only if ``overwrite``.  ``campbell``: the Campbell diagram of an atlas with frequencies."""
     from .read import plot as figures
-    from .read.query import parse_selection
-    from .scene.units import in_si
     from .store.dataset import is_critical
     from .store.files import check_new_output, open_atlas
 
+    if campbell:
+        return _campbell(path, output, x=x, y=y, sel=sel, facet=facet, max_panels=max_panels, max_mb=max_mb, overwrite=overwrite)
     page = Path(output).suffix.lower() in (".html", ".htm")
     if page:
         from .read import explore
@@ -349,9 +350,7 @@ def plot(
             raise StabmapError(f"{param('max_mb')} applies to .html pages; {output} is a figure (use a .html name for a page)")
     check_new_output(output, overwrite)
     ds = open_atlas(path, lazy=True)  # read chunk by chunk: bounded memory at any size
-    chosen = parse_selection(list(sel), ranges=False, option="--sel")
-    # A spin rate given with its unit (--sel omega="14000 rpm") in the file's units, rad/s.
-    chosen = {k: in_si(f"--sel {k}", v, str(ds[k].attrs.get("units", ""))) if k in ds.coords else v for k, v in chosen.items()}
+    chosen = _selection(ds, sel)
     if page:
         if is_critical(ds) and x is not None:
             raise StabmapError(f"{param('x')} applies to atlases; along x a critical-values page shows the scanned axis")
@@ -380,6 +379,36 @@ def plot(
     figures.plot_atlas(ds, output, x=x, y=y, sel=chosen, facet=facet, max_panels=panels)
     plan = figures.plan_figure(ds, x=x, y=y, sel=chosen, facet=facet, max_panels=panels)
     return Done([f"note: {note}" for note in plan.notes] + [f"wrote {output}"])
+
+
+def _campbell(path, output, *, x, y, sel, facet, max_panels, max_mb, overwrite) -> Done:
+    """``stabmap plot --campbell``: the checks, then the figure or page (``plot``)."""
+    from .read import plot as figures
+    from .store.dataset import is_critical
+    from .store.files import check_new_output, open_atlas
+
+    extra = [name for name, v in (("y", y), ("facet", facet), ("max_panels", max_panels), ("max_mb", max_mb)) if v is not None]
+    if extra:
+        raise StabmapError(f"{param(extra[0])} does not apply to {param('campbell')}: a Campbell diagram draws frequencies "
+                           f"against one spin axis ({param('x')}), other axes fixed with {param('sel')}")
+    if Path(output).suffix.lower() not in (".html", ".htm"):
+        figures.check_figure_path(output)
+    check_new_output(output, overwrite)
+    ds = open_atlas(path, lazy=True)
+    if is_critical(ds):
+        raise StabmapError(f"{param('campbell')} needs an atlas computed with frequencies = true; {path} holds critical values")
+    figures.plot_campbell(ds, output, x=x, sel=_selection(ds, sel))
+    return Done([f"wrote {output}"])
+
+
+def _selection(ds, sel: Sequence[str]) -> dict:
+    """``--sel NAME=VALUE`` items as numbers, a spin rate given with its unit (``omega="14000 rpm"``) in the file's
+    units, rad/s."""
+    from .read.query import parse_selection
+    from .scene.units import in_si
+
+    chosen = parse_selection(list(sel), ranges=False, option="--sel")
+    return {k: in_si(f"--sel {k}", v, str(ds[k].attrs.get("units", ""))) if k in ds.coords else v for k, v in chosen.items()}
 
 
 def examples(show: str | None = None) -> list[str]:

@@ -229,3 +229,10 @@ def test_bench_rate_price_quick(capsys):
         assert r["width"] <= 1e-6  # every rate enclosed to the documented width, whatever the path
         assert sum(r["methods"].values()) == r["unstable"]
     assert "growth_rate = false s" in capsys.readouterr().out
+
+
+def test_bench_campbell_quick(capsys):
+    out = runpy.run_path(str(SCRIPTS / "bench_campbell.py"))["main"](["--quick"])
+    assert out["num"] == 200 and out["plot_png_s"] > 0 and out["png_kB"] > 0
+    assert out["followed"] + out["ambiguous"] > 0
+    assert "stabmap plot --campbell" in capsys.readouterr().out

@@ -238,7 +238,7 @@ def test_outputs_follow_the_scene_keys():
     ds = stabmap.compute_atlas(top('growth_rate = false'), progress=False, threads=1)
     assert "growth_rate" not in ds and "frequency" not in ds
     ds = stabmap.compute_atlas(top("frequencies = true"), progress=False, threads=1)
-    assert ds.frequency.dims == ("omega", "root") and ds.growth_rate.attrs["units"] == "s-1"
+    assert ds.frequency.dims == ("omega", "mode") and ds.growth_rate.attrs["units"] == "s-1"
     assert ds.frequency.attrs["units"] == "rad s-1" and ds.efolding_time.attrs["units"] == "s"
     with pytest.raises(StabmapError, match="frequencies must be true or false"):
         top('frequencies = "yes"')

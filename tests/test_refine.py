@@ -20,7 +20,9 @@ from stabmap.scene.grid import Axis, resample
 from scenes import top_toml
 
 # Every bundled example of a system that can be refined (reactions, say, cannot: its label is no stability class).
-ALL_EXAMPLES = [n for n in stabmap.example_names() if systems.of(stabmap.example(n)).inferred(np.zeros(0, dtype=np.int16)) is not None]
+# refinement infers points from the corners of cells of a map: examples of two axes or more
+ALL_EXAMPLES = [n for n in stabmap.example_names() if systems.of(stabmap.example(n)).inferred(np.zeros(0, dtype=np.int16)) is not None
+                and len(stabmap.example(n).grid) >= 2]
 
 
 def regrid(scene, *nums: int):

@@ -19,7 +19,7 @@ import numpy as np
 from .. import systems
 from ..errors import StabmapError
 from ..store.checkpoint import Checkpoint, partial_dir
-from ..store.dataset import atlas_dataset, empty_arrays
+from ..store.dataset import empty_arrays, finished_atlas
 from ..store.files import check_writable, write_streamed
 from ..systems.base import SceneBase
 from . import cells, runner
@@ -74,7 +74,7 @@ def compute(
     chunk_points = check_chunk_points(chunk_points)
     with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run:
         arrays = decide_grid(run, scene, progress=progress, chunk_points=chunk_points, prove_cells=prove_cells)
-    return atlas_dataset(systems.of(scene), scene, arrays)
+    return finished_atlas(systems.of(scene), scene, arrays)
 
 
 def decide_grid(run: runner.Runner, scene: SceneBase, *, progress: bool | None = None, chunk_points: int | None = None,
@@ -273,7 +273,7 @@ def compute_to_file(
         ) from None
     arrays, store = checkpoint.arrays()
     with store:
-        write_streamed(atlas_dataset(system, scene, arrays), path)
+        write_streamed(finished_atlas(system, scene, arrays), path)
     checkpoint.remove()
     return FileReport(path, len(layout.locations), len(todo), len(done))
 

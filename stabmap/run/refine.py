@@ -33,7 +33,7 @@ import numpy as np
 
 from .. import systems
 from ..errors import StabmapError, given
-from ..store.dataset import atlas_dataset, empty_arrays
+from ..store.dataset import empty_arrays, finished_atlas
 from ..store.variables import CELL
 from ..systems.base import SceneBase
 from . import runner
@@ -368,7 +368,7 @@ def compute_refined(
                 ev.evaluate_point()
     finally:
         bar.close()
-    ds = atlas_dataset(system, scene, ev.finish())
+    ds = finished_atlas(system, scene, ev.finish())
     ds.attrs["history"] += (
         f"; adaptive refinement (coarse stride {list(strides)}, margin {margin}): "
         f"{ev.evaluated} of {total} points evaluated in {time.perf_counter() - t0:.1f} s"

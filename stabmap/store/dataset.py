@@ -92,6 +92,12 @@ def atlas_dataset(system, scene, arrays: dict) -> xr.Dataset:
     return xr.Dataset(data, coords=coords, attrs=global_attrs(system, scene, "stabmap atlas"))
 
 
+def finished_atlas(system, scene, arrays: dict) -> xr.Dataset:
+    """``atlas_dataset`` once every point is computed, with what the system derives from whole lines of the grid
+    (``System.finish``)."""
+    return system.finish(scene, atlas_dataset(system, scene, arrays))
+
+
 def empty_arrays(system, scene, shape: tuple[int, ...] | None = None) -> dict[str, np.ndarray]:
     """Uninitialised arrays of every variable for ``shape`` (default: the grid's)."""
     shape = scene.shape if shape is None else shape

@@ -326,6 +326,11 @@ class System(ABC, Generic[SceneT]):
         of grid-axis ``values``), over ``proved_box``'s.  None (the default): ``proved_box`` says all."""
         return None
 
+    def finish(self, scene: SceneT, ds):
+        """The atlas Dataset ``ds`` of ``scene``, once every point is in, with what needs whole lines of the grid
+        (modes followed along an axis, say); lazy where ``ds`` is.  Default: ``ds`` as it is."""
+        return ds
+
     def inferred(self, label: np.ndarray) -> dict[str, np.ndarray] | None:
         """The other variables of points given ``label`` without being computed (adaptive refinement).
 

@@ -39,12 +39,14 @@ One module an idea:
 - :mod:`.paint`: cells painted onto axes (classes, hatches, fills);
 - :mod:`.atlas`: the atlas figure (plan -> reduce -> draw -> legend and title);
 - :mod:`.critical`: the figure of critical values;
+- :mod:`.campbell`, :mod:`.campbell_page`: the Campbell diagram of an atlas with frequencies (a figure, an .html page);
 - :mod:`.saving`: figure files (:func:`check_figure_path`, :func:`save_figure`, :func:`plot_atlas`, :func:`plot_critical`).
 """
 
 from __future__ import annotations
 
 from .atlas import atlas_figure
+from .campbell import campbell_figure
 from .captions import captioned_figure, fixed_caption
 from .critical import critical_figure
 from .geometry import block_classes, boundary_widths, cell_edge_boundaries
@@ -61,12 +63,12 @@ from .palette import (
     colour,
 )
 from .reduce import reduce_panels
-from .saving import check_figure_path, plot_atlas, plot_critical, save_figure
+from .saving import check_figure_path, plot_atlas, plot_campbell, plot_critical, save_figure
 
 __all__ = [
     "ABSENT_COLOUR", "DEGENERATE_COLOUR", "MAX_PANELS", "STABLE_COLOUR", "UNDECIDED_COLOUR", "UNSTABLE_COLOUR",
     "FigurePlan", "atlas_figure", "axis_label", "block_classes", "boundary_widths", "captioned_figure",
     "cell_edge_boundaries", "check_figure_path", "class_label", "class_patch", "colour", "critical_figure",
     "display_ticks", "fixed_caption", "log_ticks", "panel_pixels", "panel_points", "plan_figure", "plot_atlas",
-    "plot_critical", "reduce_panels", "save_figure",
+    "plot_critical", "reduce_panels", "save_figure", "campbell_figure", "plot_campbell",
 ]

@@ -10,6 +10,7 @@ import xarray as xr
 from ...errors import StabmapError
 from ...store.files import check_writable
 from .atlas import atlas_figure
+from .campbell import campbell_figure
 from .critical import critical_figure
 from .layout import DPI, MAX_PANELS
 
@@ -59,3 +60,15 @@ def plot_critical(ds: xr.Dataset, path: str | Path, *, sel: dict[str, float] | N
     """Draw a critical-values Dataset to a file (:func:`critical_figure`): PNG or PDF, written atomically."""
     path = check_figure_path(path)
     return save_figure(critical_figure(ds, sel=sel), path)
+
+
+def plot_campbell(ds: xr.Dataset, path: str | Path, *, x: str | None = None, sel: dict[str, float] | None = None) -> Path:
+    """Draw the Campbell diagram of ``ds`` (:func:`campbell_figure`) to ``path``: a PNG or PDF, or an .html page with
+    tooltips (:mod:`.campbell_page`), written atomically."""
+    if Path(path).suffix.lower() in (".html", ".htm"):
+        from ...store.files import write_text
+        from .campbell_page import campbell_page
+
+        return write_text(campbell_page(ds, x=x, sel=sel), check_writable(path))
+    path = check_figure_path(path)
+    return save_figure(campbell_figure(ds, x=x, sel=sel), path)

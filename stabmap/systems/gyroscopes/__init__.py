@@ -92,13 +92,24 @@ class Gyroscopes(System[Scene]):
         return dataclasses.replace(scene, growth_rate=False, frequencies=False)
 
     def dims(self, scene: Scene) -> dict[str, int]:
-        return {"root": scene.degree}
+        return {"mode": scene.degree}
 
     def dim_coords(self, scene: Scene) -> dict:
         if not scene.frequencies:
             return {}
-        return {"root": (np.arange(scene.degree, dtype=np.int32),
-                         {"long_name": "characteristic root, by ascending real part (multiplicity counted)", "units": "1"})}
+        along = tracking_axis(scene)
+        how = (f"followed along {along} by continuity (mode_tracking)" if along else
+               "numbered by ascending real part (the grid has no spin axis to follow the modes along)")
+        attrs = {"long_name": f"mode: one characteristic root (multiplicity counted), {how}", "units": "1"}
+        return {"mode": (np.arange(scene.degree, dtype=np.int32), {**attrs, **({"followed_along": along} if along else {})})}
+
+    def finish(self, scene: Scene, ds):
+        along = tracking_axis(scene) if scene.frequencies else None
+        if along is None:
+            return ds
+        from .tracking import follow_atlas
+
+        return follow_atlas(ds, along)
 
     def fastest_axes(self, scene: Scene) -> tuple[int, ...]:
         # The kernels rebuild the inertia and stiffness matrices only when a point's masses, lengths or
@@ -198,6 +209,13 @@ class Gyroscopes(System[Scene]):
         for unit in ("kg m2", "m7"):  # what notes() writes after numbers: a liquid's E, a viscous liquid's tensor
             text = text.replace(f" {unit}", f" {units(unit)}")
         return text
+
+
+def tracking_axis(scene: Scene) -> str | None:
+    """The grid axis the modes are followed along: ``omega``, else the first body's own spin rate; None without."""
+    names = [a.name for a in scene.grid if a.continuous]  # listed cases are not a line to follow a mode along
+    spins = [n for n in names if n == "omega"] + [n for n in names if n.startswith("omega_")]
+    return spins[0] if spins else None
 
 
 SYSTEM = Gyroscopes()

@@ -117,11 +117,12 @@ FREQUENCY = Variable(
     "float64",
     "real part of each characteristic root: the frequency of its mode in the non-spinning frame",
     units="rad s-1",
-    comment="every root of p(lambda) with multiplicity, ascending; a real root is a mode's frequency (lambda < 0: "
-    "prograde), a complex pair's two roots share their real part. For one top without liquid the two roots are the "
-    "nutation (larger |lambda|) and precession frequencies. NaN beyond the degree of p and where not computed "
-    "(inferred or degenerate points). Opt-in: the scene key frequencies = true",
-    dims=("root",),
+    comment="every root of p(lambda) with multiplicity, one a mode: along the spin axis each mode is followed from point "
+    "to point by continuity (mode_tracking says how surely), elsewhere ascending; a real root is a mode's frequency "
+    "(lambda < 0: prograde), a complex pair's two roots share their real part. For one top without liquid the two "
+    "roots are the nutation (larger |lambda|) and precession frequencies. NaN beyond the degree of p and where not "
+    "computed (inferred or degenerate points). Opt-in: the scene key frequencies = true",
+    dims=("mode",),
     fill=float("nan"),
 )
 FREQUENCY_RADIUS = Variable(
@@ -132,7 +133,7 @@ FREQUENCY_RADIUS = Variable(
     comment="the root lies within this distance of frequency + i Im(lambda) in the complex plane, so its real part "
     "lies in [frequency - frequency_radius, frequency + frequency_radius]; where disks overlap, every root of the "
     "group lies in each member's disk. Opt-in with frequency",
-    dims=("root",),
+    dims=("mode",),
     fill=float("nan"),
 )
 ROOT_KIND = Variable(
@@ -141,9 +142,22 @@ ROOT_KIND = Variable(
     "what is proved about each characteristic root",
     comment="real: proved real; complex: proved non-real (one of a conjugate pair); not_separated: its inclusion disks "
     "meet the real axis without proving it real; none: padding beyond the degree of p, or not computed. Opt-in with frequency",
-    dims=("root",),
+    dims=("mode",),
     flags=((-1, "none"), (0, "real"), (1, "complex"), (2, "not_separated")),
 )
+MODE_TRACKING = Variable(
+    "mode_tracking",
+    "int8",
+    "how each mode's root was matched to the mode's root at the previous point along the spin axis",
+    comment="ascending: the first point of a line along the spin axis (or after a point not computed, or an atlas "
+    "without spin axis): modes numbered by ascending real part; followed: the order that keeps the real parts' "
+    "order and the order of the values extrapolated from the mode's last two points agree on this root, and its "
+    "proved enclosure here and at the previous point meets no other mode's (a conjugate excepted); ambiguous: "
+    "continued by the better of the two orders, through a crossing or past enclosures that meet, identity not "
+    "proved; none: padding or not computed. Opt-in with frequency",
+    dims=("mode",),
+    flags=((-1, "none"), (0, "ascending"), (1, "followed"), (2, "ambiguous")),
+)
 GROWTH_VARIABLES = (GROWTH_RATE, GROWTH_RATE_LOWER, GROWTH_RATE_UPPER, EFOLDING_TIME, GROWTH_RATE_METHOD)
-FREQUENCY_VARIABLES = (FREQUENCY, FREQUENCY_RADIUS, ROOT_KIND)
+FREQUENCY_VARIABLES = (FREQUENCY, FREQUENCY_RADIUS, ROOT_KIND, MODE_TRACKING)
 ALL_VARIABLES = VARIABLES + GROWTH_VARIABLES + FREQUENCY_VARIABLES

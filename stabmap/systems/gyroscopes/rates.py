@@ -16,7 +16,17 @@ import numpy as np
 from ...kernels import NONREAL, RATE_FAILED, RATE_PAIRS, REAL, rate_block, roots_block
 from . import exact
 from .decide import kernel_args
-from .outputs import EFOLDING_TIME, FREQUENCY, FREQUENCY_RADIUS, GROWTH_RATE, GROWTH_RATE_LOWER, GROWTH_RATE_METHOD, GROWTH_RATE_UPPER, ROOT_KIND
+from .outputs import (
+    EFOLDING_TIME,
+    FREQUENCY,
+    FREQUENCY_RADIUS,
+    GROWTH_RATE,
+    GROWTH_RATE_LOWER,
+    GROWTH_RATE_METHOD,
+    GROWTH_RATE_UPPER,
+    MODE_TRACKING,
+    ROOT_KIND,
+)
 from .points import PointArrays
 
 REL = 1e-6  # a disk enclosure of the growth rate wider than this, relative, goes to exact arithmetic
@@ -69,7 +79,9 @@ def rates(points: PointArrays, nc: np.ndarray, growth: bool = True, frequencies:
         out.update({GROWTH_RATE.name: rate32, GROWTH_RATE_LOWER.name: lo32, GROWTH_RATE_UPPER.name: hi32,
                     EFOLDING_TIME.name: efold, GROWTH_RATE_METHOD.name: method})
     if frequencies:
-        out.update({FREQUENCY.name: freq, FREQUENCY_RADIUS.name: radius, ROOT_KIND.name: kind})
+        # numbered by ascending real part here; the finished atlas follows them along the spin axis (tracking.py)
+        order = np.where(kind >= 0, MODE_TRACKING.value("ascending"), MODE_TRACKING.value("none")).astype(np.int8)
+        out.update({FREQUENCY.name: freq, FREQUENCY_RADIUS.name: radius, ROOT_KIND.name: kind, MODE_TRACKING.name: order})
     return out
 
 
@@ -97,7 +109,7 @@ def not_computed(label: np.ndarray, proved: bool) -> dict[str, np.ndarray]:
     (inferred points; a box-proved node's NaN are then replaced by ``rates`` at the node: ``at_proved_nodes``).
 
     Each has the label's shape; the frequency variables come as the label's shape plus a last axis of 1, a fill that
-    broadcasts over the ``root`` dimension.
+    broadcasts over the ``mode`` dimension.
     """
     label = np.asarray(label)
     zero = (label == 0) if proved else np.zeros(label.shape, bool)
@@ -107,7 +119,8 @@ def not_computed(label: np.ndarray, proved: bool) -> dict[str, np.ndarray]:
     column = np.full(label.shape + (1,), np.nan)
     return {GROWTH_RATE.name: rate, GROWTH_RATE_LOWER.name: rate.copy(), GROWTH_RATE_UPPER.name: rate.copy(),
             EFOLDING_TIME.name: efold, GROWTH_RATE_METHOD.name: method,
-            FREQUENCY.name: column, FREQUENCY_RADIUS.name: column.copy(), ROOT_KIND.name: np.full(label.shape + (1,), -1, np.int8)}
+            FREQUENCY.name: column, FREQUENCY_RADIUS.name: column.copy(), ROOT_KIND.name: np.full(label.shape + (1,), -1, np.int8),
+            MODE_TRACKING.name: np.full(label.shape + (1,), -1, np.int8)}
 
 
 def exact_roots(points: PointArrays, p: int, D: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
