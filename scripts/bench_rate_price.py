@@ -14,7 +14,9 @@ Each row gives both times, their ratio, the rate methods (growth_rate_method) ov
 of them that went to exact arithmetic and the largest relative enclosure width (upper - lower) / upper.
 
 Point sets (``--ladder``; on by default): the sets of bench_kernel.py, one thread, CPU seconds: ``decide_block``
-(the label) against the label plus ``rates.growth_only`` on the unstable points, and the same widths and shares.
+(the label) against the label plus ``rates.growth_only`` on the unstable points, and the same widths and shares;
+and at every unstable point an independent float solver (numpy's eigenvalues of the first-order linearisation)
+against the proved bounds (``peer_check``).
 """
 
 from __future__ import annotations
@@ -112,11 +114,32 @@ def ladder_row(n: int, modes: int, kind: str, lines: int, per_line: int, rng) ->
     (lower, upper, _, method), t_rate = bench_kernel.timed(rates.growth_only, pts, at, nc[at].astype(np.int64), D,
                                                             clock=time.process_time)
     npts = nc.size
+    outside, off = peer_check(bench_kernel._subset(pts, at), lower, upper)
     return {"n": n, "modes": modes, "degree": D, "kind": kind, "points": npts, "unstable": int(at.size),
+            "peer_outside": outside, "peer_off": off,
             "label_us": 1e6 * t_label / npts, "rate_us": 1e6 * t_rate / npts, "ratio": (t_label + t_rate) / t_label,
             "methods": {m: int((method == v).sum()) for m, v in METHODS.items() if (method == v).any()},
             "exact_pct": 100.0 * float((method == rates.EXACT).mean()) if at.size else 0.0,
             "width": float(np.max((upper - lower) / upper)) if at.size else 0.0}
+
+
+def peer_check(pts, lower: np.ndarray, upper: np.ndarray) -> tuple[int, float]:
+    """An independent float solver against the proved bounds: max |Im z| over the eigenvalues (numpy's LAPACK dgeev) of
+    the first-order linearisation, at every unstable point.  Returns the points where it lies outside [lower, upper]
+    by more than PEER_RTOL relative, and the largest such distance (relative): the float solver's own error on a
+    simple eigenvalue is about its condition number times 1e-16, so a point counted is either an ill-conditioned
+    float answer or a wrong bound, and is to be looked at."""
+    if not lower.size:
+        return 0, 0.0
+    D = int((pts.nmodes + 2).sum())
+    C = np.empty((lower.size, D, D))
+    stabmap.kernels.linearise_block(*pts.kernel_args(), C)
+    peer = np.abs(np.linalg.eigvals(C).imag).max(axis=1)
+    off = np.maximum(lower - peer, peer - upper) / np.maximum(upper, 1e-300)
+    return int((off > PEER_RTOL).sum()), float(max(0.0, off.max()))
+
+
+PEER_RTOL = 1e-8
 
 
 def _methods(m: dict) -> str:
@@ -149,15 +172,15 @@ def main(argv=None) -> dict:
     if args.no_ladder:
         return out
     print("\n| n | modes | degree | kind | points | unstable | label us/pt | rate us/pt | (label + rate) / label "
-          "| rate methods | exact % | widest enclosure |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "| rate methods | exact % | widest enclosure | float eigvals outside the bounds (largest, relative) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     rng = np.random.default_rng(2026)
     for case in bench_kernel.cases(q, args.max_degree):
         r = ladder_row(*case, rng)
         out["ladder"].append(r)
         print(f"| {r['n']} | {r['modes']} | {r['degree']} | {r['kind']} | {r['points']:,} | {r['unstable']:,} "
               f"| {r['label_us']:.1f} | {r['rate_us']:.1f} | {r['ratio']:.2f} | {_methods(r['methods'])} "
-              f"| {r['exact_pct']:.2f} | {r['width']:.1e} |", flush=True)
+              f"| {r['exact_pct']:.2f} | {r['width']:.1e} | {r['peer_outside']} ({r['peer_off']:.0e}) |", flush=True)
     return out
 
 
