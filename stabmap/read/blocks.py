@@ -164,31 +164,43 @@ def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -
     by one task, so every chunk is read once and dropped at once: one pass, a few chunks in memory. With
     factors (1, 1) the blocks are the points.
     """
+    dtype = as_dask(values).dtype
+    done = block_tasks([values, flags], factors, _reduce_block, stable=stable)
+    low, high, mixed_stable, flagged = (np.block([[p[0][k] for p in row] for row in done]) for k in range(4))
+    return Blocks((int(factors[0]), int(factors[1])), low.astype(dtype), high.astype(dtype), mixed_stable.astype(bool),
+                  None if flags is None else flagged, _merge(counted for row in done for _, counted in row))
+
+
+def block_tasks(arrays: list, factors: tuple[int, int], reduce, **options) -> list[list]:
+    """``reduce(*chunks, valid, start, factors=..., **options)`` of every chunk of the 2-D ``arrays`` (one shape; an
+    entry None is passed as None), as a grid of results (rows of chunks), one task a chunk.
+
+    The arrays are padded at their far ends by repeating their last row and column (``valid``: the chunk's size
+    without the padding; ``start``: its first point's index in the map) and cut into chunks holding whole blocks
+    of ``factors``, the same for every array, so that each chunk is read once and dropped at once.
+    """
     factors = (int(factors[0]), int(factors[1]))
-    v = as_dask(values)
-    f = None if flags is None else as_dask(flags)
-    shape = v.shape
+    given = [None if a is None else as_dask(a) for a in arrays]
+    first = next(a for a in given if a is not None)
+    shape = first.shape
     pad = [(0, -n % k) for n, k in zip(shape, factors, strict=True)]
     if any(p for _, p in pad):
-        v = da.pad(v, pad, mode="edge")
-        f = None if f is None else da.pad(f, pad, mode="edge")
-    chunks = tuple(_multiple(c, k, n) for c, k, n in zip(v.chunksize, factors, v.shape, strict=True))
-    v = v.rechunk(chunks)
-    f = None if f is None else f.rechunk(chunks)
-    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in v.chunks]
-    grid = v.numblocks
-    vs, fs = v.to_delayed(), None if f is None else f.to_delayed()
+        given = [None if a is None else da.pad(a, pad, mode="edge") for a in given]
+        first = next(a for a in given if a is not None)
+    chunks = tuple(_multiple(c, k, n) for c, k, n in zip(first.chunksize, factors, first.shape, strict=True))
+    given = [None if a is None else a.rechunk(chunks) for a in given]
+    first = next(a for a in given if a is not None)
+    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in first.chunks]
+    delayed = [None if a is None else a.to_delayed() for a in given]
     tasks = []
-    for block in np.ndindex(*grid):
-        valid = tuple(int(min(c[b], n - s[b])) for c, s, b, n in zip(v.chunks, starts, block, shape, strict=True))
-        tasks.append(dask.delayed(_reduce_block)(vs[block], None if fs is None else fs[block], valid, stable=stable, factors=factors))
+    for block in np.ndindex(*first.numblocks):
+        valid = tuple(int(min(c[b], n - s[b])) for c, s, b, n in zip(first.chunks, starts, block, shape, strict=True))
+        start = tuple(int(s[b]) for s, b in zip(starts, block, strict=True))
+        parts = [None if d is None else d[block] for d in delayed]
+        tasks.append(dask.delayed(reduce)(*parts, valid, start, factors=factors, **options))
     done = compute(*tasks)
-    parts = np.empty(grid, dtype=object)
-    for block, (reduced, _) in zip(np.ndindex(*grid), done, strict=True):
-        parts[block] = reduced
-    low, high, mixed_stable, flagged = (np.block([[p[k] for p in row] for row in parts]) for k in range(4))
-    return Blocks(factors, low.astype(v.dtype), high.astype(v.dtype), mixed_stable.astype(bool), None if flags is None else flagged,
-                  _merge(counted for _, counted in done))
+    ncols = first.numblocks[1]
+    return [list(done[r * ncols : (r + 1) * ncols]) for r in range(first.numblocks[0])]
 
 
 def _multiple(chunk: int, k: int, n: int) -> int:
@@ -196,7 +208,7 @@ def _multiple(chunk: int, k: int, n: int) -> int:
     return min(n, max(k, round(chunk / k) * k))
 
 
-def _reduce_block(v: np.ndarray, f: np.ndarray | None, valid: tuple[int, int], *, stable, factors) -> tuple[np.ndarray, tuple]:
+def _reduce_block(v: np.ndarray, f: np.ndarray | None, valid: tuple[int, int], start: tuple[int, int], *, stable, factors) -> tuple[np.ndarray, tuple]:
     """One chunk's blocks (low, high, mixed stability, any flag), and the counts of its labels but for padding."""
     fy, fx = factors
     ny, nx = v.shape[0] // fy, v.shape[1] // fx
