@@ -121,7 +121,8 @@ def values_text(da: xr.DataArray, low: float, high: float) -> str:
 
 def value_label(da: xr.DataArray, width: int) -> str:
     """A colour bar's or y axis's label: the variable's long_name (λ written as such) and units, in lines of ``width``."""
-    name = re.sub(r"\blambda\b", "\u03bb", str(da.attrs.get("long_name", da.name)))
+    name = re.sub(r"\bIm lambda\b", "Im\u00a0\u03bb", str(da.attrs.get("long_name", da.name)))  # never broken apart
+    name = re.sub(r"\blambda\b", "\u03bb", name)
     units = units_text(str(da.attrs.get("units", "")))
     text = textwrap.fill(name, width, break_on_hyphens=False)
     return text + (f" [{units}]" if units else "")
