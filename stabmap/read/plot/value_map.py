@@ -291,7 +291,7 @@ def value_title(ds: xr.Dataset, plan: FigurePlan, da: xr.DataArray, system, bloc
         parts.append(f"{100 * n / s.points:.1f} % of {grid} {system.stable_word}{said}")
     if s.nan:
         parts.append(f"{s.nan:,} without a value (NaN)")
-    headline = ";\n".join(fill_mathtext(part, min(chars, 60)) for part in parts)  # mathtext counted as it shows
+    headline = ";\n".join(fill_mathtext(part, chars) for part in parts)  # mathtext counted as it shows
     title = atlas_title(ds, plan, headline, chars, filled=True)
     if blocks.reduced:
         title += "\n" + textwrap.fill(reduction_note(ds, plan, da, system, blocks), chars)
