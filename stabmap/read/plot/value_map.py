@@ -41,7 +41,7 @@ CMAP = "YlOrRd"  # light to dark, warm as the unstable classes: no sky blue (sta
 LINE = "#8C1A0F"  # the line of values: the dark end of the colour map
 STABLE_SHADE = "#BBE1F6"  # the stable colour, lightened: a line plot's stable stretches behind the line
 MARKED = 80  # a line of at most this many points marks each
-LEGEND_COLUMNS = 2  # of the legend under a map
+LEGEND_CHARS = 64  # two columns of the legend under a map fit under it when their entries are this short together
 WIDTH = 7.5  # [inch], as the class map
 # The least room the layout leaves the drawing [inch], which sets its pixels and so its blocks (checked against the
 # drawn figure in tests/test_plot_variable.py): a map's width less its y label, colour bar and margins, and its
@@ -98,7 +98,8 @@ def variable_figure(ds: xr.Dataset, var: str, *, x: str | None = None, y: str | 
     drawn = marks(blocks, scale, strip)
     handles = legend_handles(system, da, blocks, scale, drawn, strip)
     lines = title.count("\n") + 1
-    rows = 0 if strip else -(-len(handles) // LEGEND_COLUMNS)  # a map's legend under it, in rows of two
+    columns = legend_columns(handles)
+    rows = 0 if strip else -(-len(handles) // columns)  # a map's legend under it
     fig = captioned_figure(ds, (WIDTH, (LINE_HEIGHT + 1.0 if strip else MAP_HEIGHT + 1.2 + 0.2 * rows) + 0.17 * lines))
     ax = fig.subplots()
     if strip:
@@ -123,7 +124,7 @@ def variable_figure(ds: xr.Dataset, var: str, *, x: str | None = None, y: str | 
     if handles and strip:
         fig.legend(handles=handles, loc="outside right upper", alignment="left", frameon=False, fontsize=9)
     elif handles:  # under the map's x label (the layout makes room for it), clear of the caption under the figure
-        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncols=LEGEND_COLUMNS, frameon=False, fontsize=9)
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncols=columns, frameon=False, fontsize=9)
     ax.set_title(title, fontsize=10)
     return fig
 
@@ -308,6 +309,13 @@ def reduction_note(ds: xr.Dataset, plan: FigurePlan, da: xr.DataArray, system, b
         return text
     return (text + f", {system.stable_word} only where each of its points with a value is"
             + (", black if it holds stable and unstable points" if plan.y else ""))
+
+
+def legend_columns(handles: list) -> int:
+    """Columns of the legend under a map: two where the longest entries of both fit under the map side by side, else
+    one (a legend wider than the map would push its colour bar away from it)."""
+    longest = sorted((len(h.get_label()) for h in handles), reverse=True)[:2]
+    return 2 if sum(longest) <= LEGEND_CHARS else 1
 
 
 def legend_handles(system, da: xr.DataArray, blocks: ValueBlocks, scale: str, drawn: dict[str, bool], strip: bool) -> list:
