@@ -355,3 +355,18 @@ def test_python_errors_name_the_parameters_as_python_spells_them(tops, tmp_path)
     with pytest.raises(stabmap.StabmapError, match=r"^x='nope': not an axis of this atlas"):
         variable_figure(tops, "growth_rate", x="nope")
     assert os.listdir(tmp_path) == []
+
+
+def test_a_map_or_line_with_no_rate_to_colour_draws_stable_and_says_so(tops, tmp_path):
+    """Every point stable (rate 0): no colour bar, no maximum in the title, a line plot with an empty y axis; every
+    point without a value: grey, and no point drawn stable."""
+    stable = tops.sel(omega=slice(45.0, 60.0))
+    assert (stable.growth_rate == 0).all()
+    fig = variable_figure(stable, "growth_rate")
+    assert len(fig.axes) == 1 and "max" not in fig.axes[0].get_title()
+    assert "100.0 % of 32 grid points stable (growth rate 0)" in fig.axes[0].get_title().replace("\u00a0", " ").replace("\n", " ")
+    plot_atlas(stable, tmp_path / "line.png", var="growth_rate", sel={"c_1": 0.1})  # a log axis over nothing is not drawn
+    empty = stable.copy(deep=True)
+    empty["growth_rate"][:] = np.nan
+    title = variable_figure(empty, "growth_rate").axes[0].get_title().replace("\u00a0", " ").replace("\n", " ")
+    assert "no finite growth rate" in title and "no grid point drawn stable" in title and "32 without a value (NaN)" in title

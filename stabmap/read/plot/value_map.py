@@ -257,14 +257,17 @@ def draw_line(ax, ds: xr.Dataset, plan: FigurePlan, blocks: ValueBlocks, xe: np.
 
 
 def values_axis(ax, blocks: ValueBlocks, scale: str) -> None:
-    """The y axis of a line plot: log for a log scale, from the least to the largest value drawn (bounds included)."""
-    ax.set_yscale(scale)  # also drops the ticks a strip of classes has none of
+    """The y axis of a line plot: log for a log scale, from the least to the largest value drawn (bounds included);
+    without a value drawn (every point stable, say), an empty axis."""
     drawn = [blocks.top[scale][0]] + [b[0] for b in (blocks.lower, blocks.upper) if b is not None]
     values = np.concatenate(drawn)
     values = values[np.isfinite(values) & ((values > 0) if scale == "log" else True)]
-    if not values.size:
+    if not values.size:  # a log axis over nothing cannot be drawn
+        ax.set_yscale("linear")
+        ax.set_ylim(0, 1)
         ax.set_yticks([])
         return
+    ax.set_yscale(scale)  # also drops the ticks a strip of classes has none of
     lo, hi = float(values.min()), float(values.max())
     if scale == "log":
         ax.set_ylim(lo / 1.6, hi * 1.6)
@@ -279,17 +282,18 @@ def value_title(ds: xr.Dataset, plan: FigurePlan, da: xr.DataArray, system, bloc
     at which value; the points without one), the fixed axes, the notes and the rule that reduced a large grid."""
     s = blocks.stats
     units = units_text(str(da.attrs.get("units", "")))
-    if s.argmax is not None:
+    parts = []
+    if s.argmax is not None and (scale == "linear" or s.finite_max > 0):  # a largest value the scale shows
         row, col = s.argmax
         where = [value_text(ds, plan.x, float(ds[plan.x][col]))] + ([value_text(ds, plan.y, float(ds[plan.y][row]))] if plan.y else [])
-        parts = [f"max {short_name(da)} {number(s.finite_max)}" + (f" {units}" if units else "") + f" at {', '.join(where)}"]
-    else:
-        parts = [f"no finite {short_name(da)}"]
+        parts.append(f"max {short_name(da)} {number(s.finite_max)}" + (f" {units}" if units else "") + f" at {', '.join(where)}")
+    elif s.argmax is None:
+        parts.append(f"no finite {short_name(da)}")
     grid = f"the {s.points:,} grid points shown" if plan.fixed else f"{s.points:,} grid points"
     if system.stable_label is not None:
         n = s.off[scale]
-        said = f" ({values_text(da, *s.off_range[scale])})" if n else ""
-        parts.append(f"{100 * n / s.points:.1f} % of {grid} {system.stable_word}{said}")
+        parts.append(f"{100 * n / s.points:.1f} % of {grid} {system.stable_word} ({values_text(da, *s.off_range[scale])})" if n
+                     else f"no grid point drawn {system.stable_word}")  # the labels may say stable where no value is
     if s.nan:
         parts.append(f"{s.nan:,} without a value (NaN)")
     headline = ";\n".join(fill_mathtext(part, chars) for part in parts)  # mathtext counted as it shows
