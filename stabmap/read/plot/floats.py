@@ -69,7 +69,7 @@ def turned_off(ds: xr.Dataset, system, var: str) -> str:
             continue
         try:
             other = dataclasses.replace(scene, **{f.name: not value})
-        except StabmapError:
+        except (StabmapError, TypeError, ValueError):  # a flag the scene cannot take the other way (or not as an argument)
             continue
         if any(v.name == var for v in system.outputs(other)):
             fix = "rerun without it" if f.default is (not value) else f"rerun with {f.name} = {str(not value).lower()}"
