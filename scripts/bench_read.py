@@ -8,7 +8,7 @@ Big atlases are not computed (256 M points would take hours): :func:`make_atlas`
 variables, attributes, coordinates and scene of a real atlas (``paper-n2-fixed`` resampled to the size asked),
 and synthetic labels with the features a reader must keep (a curved stability boundary, bands of 1 and 2
 complex pairs, an unstable line one grid value thin inside the stable region, a degenerate patch and an inferred
-patch), chunked as ``stabmap atlas`` writes them (``MAX_CHUNK_POINTS`` points a chunk).
+patch) and growth rates to match (0 where stable, NaN where degenerate or inferred), chunked as ``stabmap atlas`` writes them (``MAX_CHUNK_POINTS`` points a chunk).
 
 Each command runs in a fresh process: it first runs the same command on a 1 M-point atlas of the same kind
 (imports, matplotlib and dask loaded, and a figure of the same size drawn), then on the big one. ``start-up MiB``
@@ -73,9 +73,19 @@ def _block(shape, variable, block_info=None):
         return stability_from_pairs(nc)
     u, v = i / (shape[0] - 1), k / (shape[1] - 1)
     patch = (u > 0.5) & (u < 0.7) & (v > 0.6) & (v < 0.8)
+    if variable in ("growth_rate", "growth_rate_lower", "growth_rate_upper", "efolding_time"):
+        # as a real atlas stores them: 0 where stable, a rate that falls towards the stable region where not, NaN where
+        # degenerate or inferred (not computed)
+        rate = np.where(nc > 0, 0.1 + nc * (1.0 - u), 0.0)
+        rate = np.where((nc < 0) | patch, np.nan, rate).astype(np.float32)
+        if variable == "efolding_time":
+            with np.errstate(divide="ignore"):
+                return (np.float32(1) / rate).astype(np.float32)
+        step = {"growth_rate_lower": -np.inf, "growth_rate_upper": np.inf}.get(variable)
+        return rate if step is None else np.where(rate > 0, np.nextafter(rate, np.float32(step)), rate).astype(np.float32)
     if variable == "cell":  # the inferred patch not proved, every other cell node_only
         return np.where(patch, 3, 0).astype(np.int8)
-    return np.where(patch, 3, 0).astype(np.int8)  # decided_by: an inferred patch
+    return np.where(patch, 3, 0).astype(np.int8)  # decided_by, growth_rate_method: an inferred patch
 
 
 def make_atlas(path: str | Path, shape: tuple[int, int], chunk_points: int | None = None) -> Path:

@@ -47,6 +47,7 @@ _API: dict[str, str | tuple[str, str]] = {
     "smallest_stable": "stabmap.read.query",
     "stable_fraction": "stabmap.read.query",
     "summary": "stabmap.read.summary",
+    "variable_figure": "stabmap.read.plot",
     "write_atlas": "stabmap.read.subset",
 }
 _MODULES = {"cavity": "stabmap.systems.gyroscopes.cavity", "closed": "stabmap.closed", "reactions": "stabmap.reactions"}

@@ -163,17 +163,19 @@ def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, roo
 @click.option("--max-panels", type=int, metavar="N", help="at most N panels, evenly spaced values (default 12)")
 @click.option("--max-mb", type=float, metavar="MB",
               help="an .html page's size bound: slider values beyond it are left out, evenly spaced ones kept (default 20)")
+@click.option("--var", metavar="NAME", help="draw this float variable instead of the classes, e.g. growth_rate: a map with a colour "
+              "bar, or a line along one axis (docs/plots.md)")
 @click.option("--campbell", is_flag=True,
               help="the Campbell diagram: every mode's frequency against the spin rate, critical speeds, growth rate "
                    "(an atlas computed with frequencies = true; docs/rates.md)")
 @_overwrite
-def plot(atlas, items, output, x, y, sel, facet, max_panels, max_mb, overwrite, campbell):
+def plot(atlas, items, output, x, y, sel, facet, max_panels, max_mb, var, overwrite, campbell):
     """Draw an atlas: a map of its classes, small multiples for 3 or 4 axes (docs/plots.md); or write an interactive
     page (.html, no server needed: docs/explore.md). --campbell: its Campbell diagram (docs/rates.md)."""
     from . import jobs
 
     _report(jobs.plot(atlas, output, x=x, y=y, sel=[*sel, *items], facet=facet, max_panels=max_panels, max_mb=max_mb,
-                      overwrite=overwrite, campbell=campbell))
+                      overwrite=overwrite, var=var, campbell=campbell))
 
 
 @cli.command(short_help="Stable intervals of one parameter (the critical spin rates, say), ends to 1e-10.")

@@ -325,17 +325,22 @@ def plot(
     max_panels: int | None = None,
     max_mb: float | None = None,
     overwrite: bool = False,
+    var: str | None = None,
     campbell: bool = False,
 ) -> Done:
     """``stabmap plot``: draw an atlas (or critical values) to a PNG or PDF file, or write its interactive page (.html);
-    an existing output only if ``overwrite``.  ``campbell``: the Campbell diagram of an atlas with frequencies."""
+    an existing output only if ``overwrite``. ``var``: draw that float variable of the atlas instead of its classes;
+    ``campbell``: the Campbell diagram of an atlas with frequencies."""
     from .read import plot as figures
     from .store.dataset import is_critical
     from .store.files import check_new_output, open_atlas
 
     if campbell:
-        return _campbell(path, output, x=x, y=y, sel=sel, facet=facet, max_panels=max_panels, max_mb=max_mb, overwrite=overwrite)
+        return _campbell(path, output, x=x, y=y, sel=sel, facet=facet, max_panels=max_panels, max_mb=max_mb, var=var, overwrite=overwrite)
     page = Path(output).suffix.lower() in (".html", ".htm")
+    if var is not None and page:
+        raise StabmapError(f"{param('var')} draws PNG and PDF figures; an .html page shows the classes (use a .png or .pdf name)")
+    figures.check_value_options(var, facet, max_panels is not None)
     if page:
         from .read import explore
 
@@ -370,24 +375,25 @@ def plot(
             line.close()
         return Done([f"note: {note}" for note in made.notes] + [f"wrote {output} ({Path(output).stat().st_size / 1e6:.1f} MB)"])
     if is_critical(ds):
-        extra = [name for name, v in (("x", x), ("y", y), ("facet", facet), ("max_panels", max_panels)) if v is not None]
+        extra = [name for name, v in (("var", var), ("x", x), ("y", y), ("facet", facet), ("max_panels", max_panels)) if v is not None]
         if extra:
             raise StabmapError(f"{param(extra[0])} applies to atlases; {path} holds critical values (fix other axes with {param('sel')})")
         figures.plot_critical(ds, output, sel=chosen)
         return Done([f"wrote {output}"])
     panels = figures.MAX_PANELS if max_panels is None else max_panels
-    figures.plot_atlas(ds, output, x=x, y=y, sel=chosen, facet=facet, max_panels=panels)
+    figures.plot_atlas(ds, output, x=x, y=y, sel=chosen, facet=facet, max_panels=panels, var=var)
     plan = figures.plan_figure(ds, x=x, y=y, sel=chosen, facet=facet, max_panels=panels)
     return Done([f"note: {note}" for note in plan.notes] + [f"wrote {output}"])
 
 
-def _campbell(path, output, *, x, y, sel, facet, max_panels, max_mb, overwrite) -> Done:
+def _campbell(path, output, *, x, y, sel, facet, max_panels, max_mb, var, overwrite) -> Done:
     """``stabmap plot --campbell``: the checks, then the figure or page (``plot``)."""
     from .read import plot as figures
     from .store.dataset import is_critical
     from .store.files import check_new_output, open_atlas
 
-    extra = [name for name, v in (("y", y), ("facet", facet), ("max_panels", max_panels), ("max_mb", max_mb)) if v is not None]
+    extra = [name for name, v in (("y", y), ("facet", facet), ("max_panels", max_panels), ("max_mb", max_mb), ("var", var))
+             if v is not None]
     if extra:
         raise StabmapError(f"{param(extra[0])} does not apply to {param('campbell')}: a Campbell diagram draws frequencies "
                            f"against one spin axis ({param('x')}), other axes fixed with {param('sel')}")

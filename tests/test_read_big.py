@@ -247,6 +247,7 @@ def atlases(tmp_path_factory):
         ["query", "--boundaries", "K_1", "--limit", "2"],
         ["query", "--smallest-stable", "omega", "--over", "K_1", "--limit", "2"],
         ["plot", "-o", "{png}"],
+        ["plot", "-o", "{png}", "--var", "growth_rate"],
     ],
 )
 def test_memory_does_not_grow_with_the_atlas(atlases, command, monkeypatch, tmp_path, capsys):

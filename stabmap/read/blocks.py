@@ -164,31 +164,43 @@ def reduce_blocks(values, flags, stable: int | None, factors: tuple[int, int]) -
     by one task, so every chunk is read once and dropped at once: one pass, a few chunks in memory. With
     factors (1, 1) the blocks are the points.
     """
+    dtype = as_dask(values).dtype
+    done = block_tasks([values, flags], factors, _reduce_block, stable=stable)
+    low, high, mixed_stable, flagged = (np.block([[p[0][k] for p in row] for row in done]) for k in range(4))
+    return Blocks((int(factors[0]), int(factors[1])), low.astype(dtype), high.astype(dtype), mixed_stable.astype(bool),
+                  None if flags is None else flagged, _merge(counted for row in done for _, counted in row))
+
+
+def block_tasks(arrays: list, factors: tuple[int, int], reduce, **options) -> list[list]:
+    """``reduce(*chunks, valid, start, factors=..., **options)`` of every chunk of the 2-D ``arrays`` (one shape; an
+    entry None is passed as None), as a grid of results (rows of chunks), one task a chunk.
+
+    The arrays are padded at their far ends by repeating their last row and column (``valid``: the chunk's size
+    without the padding; ``start``: its first point's index in the map) and cut into chunks holding whole blocks
+    of ``factors``, the same for every array, so that each chunk is read once and dropped at once.
+    """
     factors = (int(factors[0]), int(factors[1]))
-    v = as_dask(values)
-    f = None if flags is None else as_dask(flags)
-    shape = v.shape
+    given = [None if a is None else as_dask(a) for a in arrays]
+    first = next(a for a in given if a is not None)
+    shape = first.shape
     pad = [(0, -n % k) for n, k in zip(shape, factors, strict=True)]
     if any(p for _, p in pad):
-        v = da.pad(v, pad, mode="edge")
-        f = None if f is None else da.pad(f, pad, mode="edge")
-    chunks = tuple(_multiple(c, k, n) for c, k, n in zip(v.chunksize, factors, v.shape, strict=True))
-    v = v.rechunk(chunks)
-    f = None if f is None else f.rechunk(chunks)
-    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in v.chunks]
-    grid = v.numblocks
-    vs, fs = v.to_delayed(), None if f is None else f.to_delayed()
+        given = [None if a is None else da.pad(a, pad, mode="edge") for a in given]
+        first = next(a for a in given if a is not None)
+    chunks = tuple(_multiple(c, k, n) for c, k, n in zip(first.chunksize, factors, first.shape, strict=True))
+    given = [None if a is None else a.rechunk(chunks) for a in given]
+    first = next(a for a in given if a is not None)
+    starts = [np.concatenate([[0], np.cumsum(c)[:-1]]) for c in first.chunks]
+    delayed = [None if a is None else a.to_delayed() for a in given]
     tasks = []
-    for block in np.ndindex(*grid):
-        valid = tuple(int(min(c[b], n - s[b])) for c, s, b, n in zip(v.chunks, starts, block, shape, strict=True))
-        tasks.append(dask.delayed(_reduce_block)(vs[block], None if fs is None else fs[block], valid, stable=stable, factors=factors))
+    for block in np.ndindex(*first.numblocks):
+        valid = tuple(int(min(c[b], n - s[b])) for c, s, b, n in zip(first.chunks, starts, block, shape, strict=True))
+        start = tuple(int(s[b]) for s, b in zip(starts, block, strict=True))
+        parts = [None if d is None else d[block] for d in delayed]
+        tasks.append(dask.delayed(reduce)(*parts, valid, start, factors=factors, **options))
     done = compute(*tasks)
-    parts = np.empty(grid, dtype=object)
-    for block, (reduced, _) in zip(np.ndindex(*grid), done, strict=True):
-        parts[block] = reduced
-    low, high, mixed_stable, flagged = (np.block([[p[k] for p in row] for row in parts]) for k in range(4))
-    return Blocks(factors, low.astype(v.dtype), high.astype(v.dtype), mixed_stable.astype(bool), None if flags is None else flagged,
-                  _merge(counted for _, counted in done))
+    ncols = first.numblocks[1]
+    return [list(done[r * ncols : (r + 1) * ncols]) for r in range(first.numblocks[0])]
 
 
 def _multiple(chunk: int, k: int, n: int) -> int:
@@ -196,7 +208,8 @@ def _multiple(chunk: int, k: int, n: int) -> int:
     return min(n, max(k, round(chunk / k) * k))
 
 
-def _reduce_block(v: np.ndarray, f: np.ndarray | None, valid: tuple[int, int], *, stable, factors) -> tuple[np.ndarray, tuple]:
+def _reduce_block(v: np.ndarray, f: np.ndarray | None, valid: tuple[int, int], start: tuple[int, int], *, stable,
+                  factors) -> tuple[np.ndarray, tuple]:
     """One chunk's blocks (low, high, mixed stability, any flag), and the counts of its labels but for padding."""
     fy, fx = factors
     ny, nx = v.shape[0] // fy, v.shape[1] // fx
@@ -231,3 +244,135 @@ def _merge(parts) -> dict[int, int]:
         for u, c in zip(labels, n, strict=True):
             out[int(u)] = out.get(int(u), 0) + int(c)
     return dict(sorted(out.items()))
+
+
+# ---------------------------------------------------------------------------------------------- float variables
+SCALES = ("linear", "log")  # what a colour scale of a float variable shows: finite values, or finite values > 0
+
+
+@dataclass(frozen=True)
+class ValueStats:
+    """A float map's numbers at full resolution (:func:`reduce_values`).
+
+    ``points`` and ``nan`` (points without a value); per scale of :data:`SCALES`, ``off[scale]``: the points of the
+    stable label whose value that scale cannot show (not NaN: an exact rate 0 on a log scale, an infinite e-folding
+    time), and ``off_range[scale]`` the least and largest of those values; ``unstable_min``: the least finite value
+    at a point of any other label (+inf: none); ``positive_min``: the least finite value > 0 (+inf: none);
+    ``finite_min``, ``finite_max`` (±inf: none) and ``argmax``, the (row, column) of the largest finite value
+    (None: no finite value).
+    """
+
+    points: int
+    nan: int
+    off: dict[str, int]
+    off_range: dict[str, tuple[float, float]]
+    unstable_min: float
+    positive_min: float
+    finite_min: float
+    finite_max: float
+    argmax: tuple[int, int] | None
+
+
+@dataclass(frozen=True)
+class ValueBlocks:
+    """A float map reduced to blocks of ``factors`` = (rows, columns) points, beside its label (:func:`reduce_values`).
+
+    Per scale of :data:`SCALES`, ``top[scale]``: the largest value of each block that the scale shows (NaN: none);
+    ``off[scale]``: the block holds a point of the stable label whose value the scale cannot show. ``state``: 1
+    where every point of the block has the stable label, 2 where some do and some do not, 0 where none does (the
+    states :func:`stabmap.read.plot.geometry.block_classes` gives the class map's blocks). ``lower``, ``upper``:
+    the least lower bound and the largest upper bound in each block (NaN: none; None: no bounds were given).
+    """
+
+    factors: tuple[int, int]
+    top: dict[str, np.ndarray]
+    off: dict[str, np.ndarray]
+    state: np.ndarray
+    lower: np.ndarray | None
+    upper: np.ndarray | None
+    stats: ValueStats
+
+    @property
+    def reduced(self) -> bool:
+        return self.factors != (1, 1)
+
+
+def reduce_values(values, labels, stable: int | None, factors: tuple[int, int], lower=None, upper=None) -> ValueBlocks:
+    """Reduce a 2-D map of a float variable ``values`` (its label map ``labels`` beside it, and optionally bounds
+    ``lower`` and ``upper`` of the values) to blocks of ``factors`` points, in one pass, chunk by chunk.
+
+    A block keeps the largest value of its points (a map of growth rates shows the fastest growth in each block)
+    and whether it holds a point of the stable label that a colour scale cannot show; the numbers of
+    :class:`ValueStats` are counted over every point.
+    """
+    done = block_tasks([values, labels, lower, upper], factors, _reduce_values, stable=stable)
+
+    def joined(pick) -> np.ndarray:
+        return np.block([[pick(blocks) for blocks, _ in row] for row in done])
+
+    top = {s: joined(lambda b, s=s: b["top"][s]) for s in SCALES}
+    off = {s: joined(lambda b, s=s: b["off"][s]) for s in SCALES}
+    low, high = (None if given is None else joined(lambda b, k=k: b[k]) for k, given in (("lower", lower), ("upper", upper)))
+    parts = [stats for row in done for _, stats in row]
+    best = max((p for p in parts if p["argmax"] is not None), key=lambda p: p["finite_max"], default=None)
+    stats = ValueStats(
+        points=sum(p["points"] for p in parts), nan=sum(p["nan"] for p in parts),
+        off={s: sum(p["off"][s] for p in parts) for s in SCALES},
+        off_range={s: (min(p["off_range"][s][0] for p in parts), max(p["off_range"][s][1] for p in parts)) for s in SCALES},
+        unstable_min=min(p["unstable_min"] for p in parts), positive_min=min(p["positive_min"] for p in parts),
+        finite_min=min(p["finite_min"] for p in parts), finite_max=-np.inf if best is None else best["finite_max"],
+        argmax=None if best is None else best["argmax"],
+    )
+    return ValueBlocks((int(factors[0]), int(factors[1])), top, off, joined(lambda b: b["state"]), low, high, stats)
+
+
+def _reduce_values(v, label, lower, upper, valid: tuple[int, int], start: tuple[int, int], *, stable, factors) -> tuple[dict, dict]:
+    """One chunk's blocks (see :class:`ValueBlocks`) and its numbers (see :class:`ValueStats`) but for padding."""
+    fy, fx = factors
+    ny, nx = v.shape[0] // fy, v.shape[1] // fx
+    v = np.asarray(v, dtype=np.float64)
+    is_stable = np.zeros(v.shape, dtype=bool) if stable is None else np.asarray(label) == stable
+    finite = np.isfinite(v)
+    shown = {"linear": finite, "log": finite & (v > 0)}
+    off = {s: is_stable & ~np.isnan(v) & ~shown[s] for s in SCALES}
+
+    def per_block(a: np.ndarray, how) -> np.ndarray:
+        return how(a.reshape(ny, fy, nx, fx), axis=(1, 3))
+
+    def extreme(a: np.ndarray, keep: np.ndarray, how, empty: float) -> np.ndarray:
+        """``how`` (np.max, np.min) of ``a`` where ``keep`` over each block; NaN where it keeps nothing."""
+        out = per_block(np.where(keep, a, empty), how)
+        return np.where(out == empty, np.nan, out)
+
+    any_stable, all_stable = per_block(is_stable, np.any), per_block(is_stable, np.all)
+    blocks = {
+        "top": {s: extreme(v, shown[s], np.max, -np.inf) for s in SCALES},
+        "off": {s: per_block(off[s], np.any) for s in SCALES},
+        "state": np.where(any_stable & ~all_stable, 2, all_stable).astype(np.int8),
+    }
+    for key, bound, how, empty in (("lower", lower, np.min, np.inf), ("upper", upper, np.max, -np.inf)):
+        if bound is not None:
+            b = np.asarray(bound, dtype=np.float64)
+            blocks[key] = extreme(b, ~np.isnan(b), how, empty)
+
+    inside = (slice(0, valid[0]), slice(0, valid[1]))
+    v, is_stable, finite = v[inside], is_stable[inside], finite[inside]
+    f = np.where(finite, v, np.nan)
+
+    def least(mask: np.ndarray) -> float:
+        return float(v[mask].min()) if mask.any() else np.inf
+
+    def largest(mask: np.ndarray) -> float:
+        return float(v[mask].max()) if mask.any() else -np.inf
+
+    stats = {
+        "points": int(v.size), "nan": int(np.isnan(v).sum()),
+        "off": {s: int(off[s][inside].sum()) for s in SCALES},
+        "off_range": {s: (least(off[s][inside]), largest(off[s][inside])) for s in SCALES},
+        "unstable_min": least(finite & ~is_stable), "positive_min": least(finite & (v > 0)), "finite_min": least(finite),
+        "finite_max": -np.inf, "argmax": None,
+    }
+    if finite.any():
+        row, col = np.unravel_index(int(np.nanargmax(f)), f.shape)
+        stats["finite_max"], stats["argmax"] = float(f[row, col]), (int(row) + start[0], int(col) + start[1])
+    return blocks, stats

@@ -1,5 +1,6 @@
 """Pictures of an atlas: maps of its label (the system's classes: for gyroscopes the number of complex root pairs),
-with the boundaries between classes, and the figure of a critical-values file.
+with the boundaries between classes; maps of its float variables (``variable_figure``: growth rates, e-folding
+times) with the same axes and stability boundary; and the figure of a critical-values file.
 
 ``atlas_figure`` draws an atlas Dataset into a new matplotlib Figure and computes nothing: it reads the system's
 label, its provenance flags and ``cell``, and their coordinates, chunk by chunk when the atlas is lazy
@@ -40,7 +41,10 @@ One module an idea:
 - :mod:`.atlas`: the atlas figure (plan -> reduce -> draw -> legend and title);
 - :mod:`.critical`: the figure of critical values;
 - :mod:`.campbell`, :mod:`.campbell_page`: the Campbell diagram of an atlas with frequencies (a figure, an .html page);
-- :mod:`.saving`: figure files (:func:`check_figure_path`, :func:`save_figure`, :func:`plot_atlas`, :func:`plot_critical`).
+- :mod:`.floats`: which float variables a figure of values can draw, why another cannot, its colour scale;
+- :mod:`.value_map`: the figure of a float variable (:func:`variable_figure`): a map with a colour bar, or a line;
+- :mod:`.saving`: figure files (:func:`check_figure_path`, :func:`save_figure`, :func:`plot_atlas`, :func:`plot_critical`,
+  :func:`plot_campbell`); ``plot_atlas(..., var=NAME)`` saves :func:`variable_figure`.
 """
 
 from __future__ import annotations
@@ -64,11 +68,12 @@ from .palette import (
 )
 from .reduce import reduce_panels
 from .saving import check_figure_path, plot_atlas, plot_campbell, plot_critical, save_figure
+from .value_map import check_value_options, variable_figure
 
 __all__ = [
     "ABSENT_COLOUR", "DEGENERATE_COLOUR", "MAX_PANELS", "STABLE_COLOUR", "UNDECIDED_COLOUR", "UNSTABLE_COLOUR",
     "FigurePlan", "atlas_figure", "axis_label", "block_classes", "boundary_widths", "captioned_figure",
-    "cell_edge_boundaries", "check_figure_path", "class_label", "class_patch", "colour", "critical_figure",
+    "cell_edge_boundaries", "check_figure_path", "check_value_options", "class_label", "class_patch", "colour", "critical_figure",
     "display_ticks", "fixed_caption", "log_ticks", "panel_pixels", "panel_points", "plan_figure", "plot_atlas",
-    "plot_critical", "reduce_panels", "save_figure", "campbell_figure", "plot_campbell",
+    "plot_critical", "reduce_panels", "save_figure", "variable_figure", "campbell_figure", "plot_campbell",
 ]

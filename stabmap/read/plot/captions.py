@@ -17,12 +17,13 @@ from .layout import FigurePlan
 
 def atlas_title(
     ds: xr.Dataset, plan: FigurePlan, headline: str, chars: int, factors: tuple[int, int] = (1, 1), shape: tuple[int, int] = (1, 1),
+    *, filled: bool = False,
 ) -> str:
-    """The atlas title, its ``headline`` (:mod:`stabmap.read.headline`: the grid points and cells drawn), the fixed
-    axes, the panels, the notes and the rule that reduced a large grid."""
+    """The atlas title, its ``headline`` (:mod:`stabmap.read.headline`: the grid points and cells drawn; ``filled``:
+    already in lines), the fixed axes, the panels, the notes and the rule that reduced a large grid."""
     title = [fill_title(ds.attrs.get("title", "") or "stabmap atlas", chars)]
     # narrower: clear of the legend beside it; the cells' part on a line of its own, after the grid points'
-    title.append(";\n".join(textwrap.fill(part, min(chars, 72 if plan.facet else 60)) for part in headline.split("; ")))
+    title.append(headline if filled else ";\n".join(textwrap.fill(part, min(chars, 72 if plan.facet else 60)) for part in headline.split("; ")))
     if plan.fixed:
         fixed = []
         for k, (i, asked) in plan.fixed.items():

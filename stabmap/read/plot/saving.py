@@ -13,6 +13,7 @@ from .atlas import atlas_figure
 from .campbell import campbell_figure
 from .critical import critical_figure
 from .layout import DPI, MAX_PANELS
+from .value_map import check_value_options, variable_figure
 
 
 def check_figure_path(path: str | Path) -> Path:
@@ -47,12 +48,17 @@ def plot_atlas(
     sel: dict[str, float] | None = None,
     facet: str | None = None,
     max_panels: int = MAX_PANELS,
+    var: str | None = None,
 ) -> Path:
-    """Draw ``ds`` with :func:`atlas_figure` and write it to ``path`` (.png or .pdf) atomically; returns the path.
+    """Draw ``ds`` with :func:`atlas_figure`, or its float variable ``var`` (e.g. ``"growth_rate"``) with
+    :func:`variable_figure`, and write it to ``path`` (.png or .pdf) atomically; returns the path.
 
     Every check runs before anything is written, so bad options leave no file.
     """
     path = check_figure_path(path)
+    if var is not None:
+        check_value_options(var, facet, max_panels != MAX_PANELS)
+        return save_figure(variable_figure(ds, var, x=x, y=y, sel=sel), path)
     return save_figure(atlas_figure(ds, x=x, y=y, sel=sel, facet=facet, max_panels=max_panels), path)
 
 
