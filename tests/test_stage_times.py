@@ -189,3 +189,11 @@ def test_a_checkpoint_without_seconds_resumes_and_says_what_was_timed(tmp_path, 
     assert open_atlas(out).attrs["stabmap_run_timed"] == costs.RESUMED_ONLY
     assert main(["info", str(out)]) == 0
     assert "timed: only the resumed part" in capsys.readouterr().out
+
+
+def test_a_stage_its_system_does_not_declare_is_an_error():
+    class Run:
+        seconds = {"labels": 1.0, "mystery": 2.0}
+
+    with pytest.raises(ValueError, match="'mystery', which its system does not declare"):
+        costs.Costs(Run(), ("labels", "cells", "write", "wall")).take()  # type: ignore[arg-type]
