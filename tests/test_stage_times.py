@@ -122,6 +122,16 @@ def test_a_run_whose_rates_cost_more_than_its_labels_says_so_last(tmp_path, caps
     assert open_atlas(out).attrs["stabmap_seconds_rates"] >= 100
 
 
+def test_a_refined_run_keeps_its_work_and_says_so_too(tmp_path, capsys, monkeypatch):
+    _rates_cost(monkeypatch, "rates")
+    out = tmp_path / "r.nc"
+    assert main(["atlas", str(_scene(tmp_path)), "-o", str(out), "--refine", "--coarse-stride", "2", "-q"]) == 0
+    assert capsys.readouterr().err.strip().splitlines()[-1].startswith("note: growth rates took")
+    a = open_atlas(out).attrs
+    assert a["stabmap_seconds_rates"] >= 100 and a["stabmap_seconds_wall"] > 0
+    assert "stabmap_seconds_write" not in a  # written after the run, by the command: not timed
+
+
 @pytest.mark.parametrize("head,stage", [("growth_rate = false\n", "rates"), ("", "labels")])
 def test_no_note_without_rates_or_when_the_labels_cost_more(tmp_path, capsys, monkeypatch, head, stage):
     _rates_cost(monkeypatch, stage)
