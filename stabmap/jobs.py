@@ -78,6 +78,7 @@ def atlas(
     from . import systems
     from .read.plot import check_figure_path, plot_atlas
     from .read.summary import summary
+    from .run import costs
     from .run import refine as refining
     from .run.atlas import compute_to_file
     from .run.chunks import check_chunk_points
@@ -107,18 +108,20 @@ def atlas(
             ds = refining.compute_refined(scene, coarse_stride=stride, margin=cells, **where)
         write_atlas(ds, output)
         stats = summary_line(system, summary(ds), ds.attrs.get("n_evaluated_points"))
+        note = costs.note(system, scene, costs.from_attrs(ds.attrs))
     else:
-        report = compute_to_file(scene, output, resume=resume, prove_cells=prove_cells, **where)
+        report = compute_to_file(scene, output, resume=resume, prove_cells=prove_cells, note=False, **where)
         with open_atlas(output, lazy=True) as ds:
             stats = summary_line(system, summary(ds))
         if report.reused:
             stats += f"; resumed: {report.reused} of {report.chunks} chunks were already done, {report.computed} computed now"
+        note = report.note
     lines = [f"wrote {output} in {time.perf_counter() - t0:.1f} s: {stats}"]
     if png is not None:
         with open_atlas(output, lazy=True) as ds:
             plot_atlas(ds, png)
         lines.append(f"wrote {png}")
-    return Done(lines)
+    return Done(lines + ([note] if note else []))  # last: what the user may change before the next run
 
 
 @contextlib.contextmanager

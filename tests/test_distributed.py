@@ -77,11 +77,12 @@ SLOW_CHUNK = 1024  # 40 chunks: one tile of 32 x 32 cells each (stabmap.run.cell
 
 
 def _same_atlas(a: xr.Dataset, b: xr.Dataset) -> None:
-    """Cell for cell, coordinate for coordinate, attribute for attribute (but the time in 'history')."""
+    """Cell for cell, coordinate for coordinate, attribute for attribute (but the time in 'history' and the run's
+    seconds, threads and what they cover: stabmap.run.costs)."""
     xr.testing.assert_identical(a.drop_attrs(), b.drop_attrs())
     for name in set(a.variables) | set(b.variables):
         assert a[name].dtype == b[name].dtype, name
-    keys = (set(a.attrs) | set(b.attrs)) - {"history"}
+    keys = {k for k in set(a.attrs) | set(b.attrs) if not k.startswith(("stabmap_seconds_", "stabmap_run_"))} - {"history"}
     assert {k: str(a.attrs.get(k)) for k in keys} == {k: str(b.attrs.get(k)) for k in keys}
 
 
@@ -258,6 +259,9 @@ def test_probe_times_neighbouring_points_spread_over_the_grid(slow_scene_file):
 def test_cluster_equals_in_process(loopback, slow_scene_file, slow_local):
     ds = compute(stabmap.load_scene(slow_scene_file), client=loopback.address, progress=False, chunk_points=4096)
     _same_atlas(ds, slow_local)
+    # the seconds by stage came back from the workers' processes with their results
+    assert ds.attrs["stabmap_seconds_labels"] > 0 and ds.attrs["stabmap_seconds_rates"] > 0
+    assert ds.attrs["stabmap_run_threads"] == 2
 
 
 @pytest.mark.slow

@@ -9,9 +9,11 @@ import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError, given
+from ..run import costs
 from ..scene import units
 from ..scene.units import unit_suffix
 from ..store.dataset import is_critical
+from ..systems.stages import CELLS, LABELS
 from .summary import summary
 
 WIDTH = 100  # characters a line of ``stabmap info`` may take
@@ -138,8 +140,36 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
     if "cell" in s:  # their shares of the region are in the headline
         counts = [f"{m.replace('_', ' ')} {n}" for m, n in s["cell"].items() if n]
         lines += wrapped("cells: ", counts[:-1] + [counts[-1] + " (docs/cells.md)"])
+    lines += times(a)
     lines += provenance(a)
     return "\n".join(lines)
+
+
+def times(attrs: dict) -> list[str]:
+    """The seconds the run that made the atlas spent, by stage (``stabmap.run.costs``); nothing for an atlas
+    written before they were kept."""
+    seconds = costs.from_attrs(attrs)
+    if not seconds:
+        return []
+    threads = int(attrs.get(costs.THREADS, 1))
+    stages = [k for k in seconds if k not in (costs.WRITE, costs.WALL)]
+    stages.sort(key=lambda k: (k != LABELS, k != CELLS, k))
+    shown = [f"{'cells (box proofs)' if k == CELLS else k} {_seconds(seconds[k])}" for k in stages if k == LABELS or seconds[k] > 0]
+    on = f" (CPU-seconds on {plural(threads, 'thread')})" if threads > 1 else ""
+    text = f"work {_seconds(costs.work(seconds))} summed over tasks{on}: {', '.join(shown)}"
+    if costs.WRITE in seconds:
+        text += f"; writing {_seconds(seconds[costs.WRITE])}"
+    if costs.WALL in seconds:
+        text += f"; wall {_seconds(seconds[costs.WALL])}"
+    lines = wrapped("time: ", [text])
+    timed = attrs.get(costs.TIMED)
+    if timed and timed != costs.WHOLE:
+        lines += wrapped("", [f"timed: {timed}"], indent="    ")
+    return lines
+
+
+def _seconds(x: float) -> str:
+    return f"{x:.2g} s" if x < 0.1 else f"{x:.2f} s" if x < 1 else f"{x:.1f} s" if x < 1000 else f"{x:,.0f} s"
 
 
 def provenance(attrs: dict) -> list[str]:

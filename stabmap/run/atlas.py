@@ -3,15 +3,18 @@
 ``compute`` returns the atlas in memory.  ``compute_to_file`` writes finished
 chunks into a checkpoint (``stabmap.store.checkpoint``) and then into the
 netCDF or Zarr file, so the writing process never holds the whole atlas, and an
-interrupted run resumes where it stopped.
+interrupted run resumes where it stopped.  Both keep the seconds the run spent,
+by stage, in the atlas's attributes (``stabmap.run.costs``).
 """
 
 from __future__ import annotations
 
 import math
+import sys
+import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +25,7 @@ from ..store.checkpoint import Checkpoint, partial_dir
 from ..store.dataset import empty_arrays, finished_atlas
 from ..store.files import check_writable, write_streamed
 from ..systems.base import SceneBase
-from . import cells, runner
+from . import cells, costs, runner
 from .chunks import (
     BLOCK_SECONDS,
     CELL_BLOCK_SECONDS,
@@ -70,11 +73,29 @@ def compute(
         Decide the grid cell by cell (default): boxes proved first, nodes computed only where no box proves, and
         the ``cell`` variable saying what is proved about each cell (``stabmap.run.cells``).  False: every node
         computed on its own, every cell ``node_only``.
+
+    The atlas's attributes ``stabmap_seconds_*`` keep the seconds of the run by stage (``stabmap.run.costs``);
+    with the progress line, a run whose optional stage (growth rates) cost more than its labels ends with a note
+    that says so, and how the scene skips it.
     """
+    t0 = time.perf_counter()
     chunk_points = check_chunk_points(chunk_points)
+    system = systems.of(scene)
     with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run:
+        spent = costs.Costs(run, costs.columns(system), t0)
         arrays = decide_grid(run, scene, progress=progress, chunk_points=chunk_points, prove_cells=prove_cells)
-    return finished_atlas(systems.of(scene), scene, arrays)
+    seconds = spent.take()
+    del seconds[costs.WRITE]  # nothing written: a file written from the Dataset says nothing of its writing
+    ds = finished_atlas(system, scene, arrays)
+    ds.attrs.update(costs.attrs(seconds, run.most_threads))
+    tell(costs.note(system, scene, seconds), progress)
+    return ds
+
+
+def tell(note: str | None, progress: bool | None) -> None:
+    """``note`` on stderr, after the progress line, where the run shows one."""
+    if note is not None and wanted(progress):
+        print(note, file=sys.stderr)
 
 
 def decide_grid(run: runner.Runner, scene: SceneBase, *, progress: bool | None = None, chunk_points: int | None = None,
@@ -193,12 +214,16 @@ class _Once:
 
 @dataclass
 class FileReport:
-    """What ``compute_to_file`` did: chunks computed now and reused from an interrupted run."""
+    """What ``compute_to_file`` did: chunks computed now and reused from an interrupted run, the seconds by stage
+    that the file keeps (``stabmap.run.costs``), and ``note``: the line that says an optional stage cost more than
+    the labels, and how to skip it (None otherwise)."""
 
     path: Path
     chunks: int
     computed: int
     reused: int
+    seconds: dict[str, float] = field(default_factory=dict)
+    note: str | None = None
 
 
 def compute_to_file(
@@ -212,6 +237,7 @@ def compute_to_file(
     chunk_points: int | None = None,
     resume: bool = False,
     prove_cells: bool = True,
+    note: bool | None = None,
 ) -> FileReport:
     """Compute the atlas of ``scene`` straight into ``path`` (``.nc``: netCDF4; ``.zarr``: Zarr).
 
@@ -228,7 +254,14 @@ def compute_to_file(
         ``PATH.partial/`` is an error, so that no finished work is thrown away unasked.
     prove_cells : bool
         As for ``compute``; a resumed run keeps the interrupted run's choice.
+    note : bool, optional
+        Print ``FileReport.note`` on stderr at the end (default: where the progress line is shown); a caller that
+        prints more after the run (the CLI) prints it last itself.
+
+    The file's attributes ``stabmap_seconds_*`` keep the seconds of the run by stage; a resumed run adds those
+    that the interrupted run's saved chunks kept (``stabmap.run.costs``).
     """
+    t0 = time.perf_counter()
     path = check_writable(path)
     where = partial_dir(path)
     system = systems.of(scene)
@@ -251,12 +284,20 @@ def compute_to_file(
         with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run, _Layout(
             run, scene, progress, chunk_points, checkpoint, prove_cells
         ) as layout:
+            spent = costs.Costs(run, costs.columns(system), t0)
+            resumed = checkpoint is not None
             if checkpoint is None:
-                checkpoint = Checkpoint.create(where, system, scene, layout.chunks, prove_cells)
+                checkpoint = Checkpoint.create(where, system, scene, layout.chunks, prove_cells, costs.columns(system))
             done = checkpoint.done()
             todo = [i for i in range(len(layout.locations)) if i not in done]
+
+            def save(i, block):
+                row = spent.take()  # the seconds since the last save, kept with this chunk for a resumed run
+                with spent.writing():
+                    checkpoint.save(i, layout.locations[i], block, row)
+
             try:
-                layout.run(todo, lambda i, block: checkpoint.save(i, layout.locations[i], block))
+                layout.run(todo, save)
             except (StabmapError, KeyboardInterrupt):
                 raise
             except Exception as exc:
@@ -271,11 +312,22 @@ def compute_to_file(
             f"{exc}; {len(checkpoint.done()):,} of {len(chunk_locations(checkpoint.shape, checkpoint.chunks)):,} chunks are saved "
             f"in {str(where)!r}: start a scheduler and workers and run the same command with --resume (and the new --scheduler ADDRESS)"
         ) from None
+    before = checkpoint.seconds(done)  # what the interrupted run's saved chunks kept (None: untimed)
+    timed = costs.RESUMED_ONLY if resumed and before is None else costs.RESUMED if resumed else costs.WHOLE
+    seconds: dict[str, float] = {}
+
+    def late_attrs() -> dict:  # once the data are written: the writing's seconds are known
+        spent.take()
+        seconds.update(costs.added(before or {}, spent.spent))
+        return costs.attrs(seconds, run.most_threads, timed)
+
     arrays, store = checkpoint.arrays()
-    with store:
-        write_streamed(finished_atlas(system, scene, arrays), path)
+    with store, spent.writing():
+        write_streamed(finished_atlas(system, scene, arrays), path, late_attrs)
     checkpoint.remove()
-    return FileReport(path, len(layout.locations), len(todo), len(done))
+    report = FileReport(path, len(layout.locations), len(todo), len(done), seconds, costs.note(system, scene, seconds))
+    tell(report.note, progress if note is None else note)
+    return report
 
 
 def _tiles(shape: tuple[int, ...], tile: tuple[int, ...]) -> int:

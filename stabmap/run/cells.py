@@ -41,6 +41,7 @@ from .. import systems
 from ..store.dataset import bounds
 from ..store.variables import CELL
 from ..systems.base import SceneBase
+from ..systems.stages import CELLS, stage
 
 SUB_ROUNDS = 2  # rounds of halving inside one cell before it is left node_only
 # Box proofs stop where they fail broadly (clustered roots, say): a round of at least PAYS_MIN boxes of at most
@@ -97,19 +98,20 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
     failed_cell = np.zeros(shape, dtype=bool)  # single cells whose own box was tried and failed
 
     lo, hi = chunk.tiles()
-    while lo.shape[0] and chunk.provable:
-        tile = chunk.tile_of(lo)
-        got, proved, tried, along = chunk.prove(lo, hi, tile)
-        chunk.credit += np.bincount(tile[proved], weights=np.prod(hi - lo, axis=1)[proved], minlength=chunk.credit.size)
-        for b in np.flatnonzero(proved):
-            where = tuple(slice(a, z) for a, z in zip(lo[b], hi[b], strict=True))
-            label[where], cell[where], known[where] = got[b], WHOLE_CELL, True
-        one = np.all(hi - lo == 1, axis=1)
-        failed_cell[tuple(lo[one & tried & ~proved].T)] = True
-        small = np.prod(hi - lo, axis=1) <= PAYS_CELLS
-        chunk.stop(tile, tried, proved, small)
-        go = ~proved & ~one & ~chunk.stopped[tile]
-        lo, hi = _halves(lo[go], hi[go], along[go])
+    with stage(CELLS):
+        while lo.shape[0] and chunk.provable:
+            tile = chunk.tile_of(lo)
+            got, proved, tried, along = chunk.prove(lo, hi, tile)
+            chunk.credit += np.bincount(tile[proved], weights=np.prod(hi - lo, axis=1)[proved], minlength=chunk.credit.size)
+            for b in np.flatnonzero(proved):
+                where = tuple(slice(a, z) for a, z in zip(lo[b], hi[b], strict=True))
+                label[where], cell[where], known[where] = got[b], WHOLE_CELL, True
+            one = np.all(hi - lo == 1, axis=1)
+            failed_cell[tuple(lo[one & tried & ~proved].T)] = True
+            small = np.prod(hi - lo, axis=1) <= PAYS_CELLS
+            chunk.stop(tile, tried, proved, small)
+            go = ~proved & ~one & ~chunk.stopped[tile]
+            lo, hi = _halves(lo[go], hi[go], along[go])
 
     if known.any():
         for k, v in system.proved_box(label[known]).items():
@@ -129,7 +131,8 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
             out[k][where] = v
         label[where] = computed[system.label]
         sub_boxes = failed_cell[where] & ~chunk.stopped[chunk.tile_of(nodes)]
-        cell[where] = chunk.classify(nodes, label, sub_boxes)
+        with stage(CELLS):
+            cell[where] = chunk.classify(nodes, label, sub_boxes)
     out[CELL.name] = cell
     return out
 

@@ -36,7 +36,7 @@ from ..errors import StabmapError, given
 from ..store.dataset import empty_arrays, finished_atlas
 from ..store.variables import CELL
 from ..systems.base import SceneBase
-from . import runner
+from . import costs, runner
 from .atlas import decide_points
 from .chunks import check_chunk_points
 from .progress import ProgressLine, wanted
@@ -361,6 +361,7 @@ def compute_refined(
     bar = _Progress(wanted(progress), total)
     try:
         with runner.start(client, workers=workers, threads=threads, announce=bar.enabled) as run:
+            spent = costs.Costs(run, costs.columns(system), t0)
             ev = _Evaluator(scene, run, chunk_points, bar)
             if shape:
                 _run_levels(ev, strides, margin)
@@ -368,7 +369,10 @@ def compute_refined(
                 ev.evaluate_point()
     finally:
         bar.close()
+    seconds = spent.take()
+    del seconds[costs.WRITE]  # written later, by the caller
     ds = finished_atlas(system, scene, ev.finish())
+    ds.attrs.update(costs.attrs(seconds, run.most_threads))
     ds.attrs["history"] += (
         f"; adaptive refinement (coarse stride {list(strides)}, margin {margin}): "
         f"{ev.evaluated} of {total} points evaluated in {time.perf_counter() - t0:.1f} s"

@@ -123,6 +123,10 @@ class Runner:
     def __init__(self, client, threads: int):
         self.client, self.threads = client, threads
         self.pace = Pace()
+        # the seconds of every task handed over, by stage (stabmap.systems.stages), and the most threads seen:
+        # what the run's work cost (stabmap.run.costs)
+        self.seconds: dict[str, float] = {}
+        self.most_threads = threads
         self.workers = 0 if client is not None else 1
         self._looked = -float("inf")
         self._counter = itertools.count()
@@ -149,6 +153,7 @@ class Runner:
                 nthreads = None
             if nthreads is not None:
                 self.workers, self.threads = len(nthreads), sum(nthreads.values())
+                self.most_threads = max(self.most_threads, self.threads)
         return max(1, self.threads)
 
     def run(self, task: Callable, scene, work: Work, on_result: Callable[[object, object], None],
@@ -177,8 +182,10 @@ class Runner:
         def hand_over(futures) -> None:
             for f in futures:
                 handle, points = pending.pop(f)
-                result, seconds = self._result(f)
+                result, seconds, by_stage = self._result(f)
                 self.pace.record(points, seconds)
+                for k, v in by_stage.items():
+                    self.seconds[k] = self.seconds.get(k, 0.0) + v
                 on_result(handle, result)
 
         try:

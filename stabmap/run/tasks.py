@@ -7,7 +7,9 @@ and dense atlases, adaptive refinement and critical values all submit it.
 Every task goes through ``run_task``, which checks the worker's stabmap version,
 loads the system's kernels once per process (untimed: compiling or loading them
 is not the cost of the points), and returns the task's result with its measured
-run time, from which the runner sizes the next tasks (``stabmap.run.runner``).
+run time, from which the runner sizes the next tasks (``stabmap.run.runner``),
+and that time split by stage (``stabmap.systems.stages``): the seconds travel
+with the result, so a worker in another process reports them alike.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import numpy as np
 from .. import systems
 from ..errors import StabmapError
 from ..store.variables import CELL
+from ..systems import stages
 from ..systems.base import SceneBase
 from ..version import __version__
 from . import cells
@@ -32,16 +35,18 @@ _warm: set[str] = set()  # the systems whose kernels this process has loaded
 _warm_lock = threading.Lock()
 
 
-def run_task(version: str, function, scene: SceneBase, *args) -> tuple[object, float]:
-    """``function(scene, *args)`` and its run time [s], on a worker of stabmap ``version`` with warm kernels."""
+def run_task(version: str, function, scene: SceneBase, *args) -> tuple[object, float, dict[str, float]]:
+    """``function(scene, *args)``, its run time [s] and that time by stage, on a worker of stabmap ``version`` with
+    warm kernels."""
     if version != __version__:
         raise StabmapError(
             f"a worker runs stabmap {__version__}, the calling process {version}; install the same stabmap on every worker"
         )
     warm_up(scene)
     t0 = time.perf_counter()
-    result = function(scene, *args)
-    return result, time.perf_counter() - t0
+    with stages.timed() as by_stage:
+        result = function(scene, *args)
+    return result, time.perf_counter() - t0, by_stage
 
 
 def warm_up(scene: SceneBase) -> None:

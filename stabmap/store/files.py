@@ -7,6 +7,7 @@ import math
 import os
 import shutil
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 import dask
@@ -81,13 +82,14 @@ def _is_zarr_store(path: Path) -> bool:
     return any((path / name).exists() for name in ("zarr.json", ".zgroup", ".zattrs"))
 
 
-def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
+def write_atlas(ds: xr.Dataset, path: str | Path, late_attrs: Callable[[], dict] | None = None) -> Path:
     """Write ``ds`` to ``path`` (netCDF4 with zlib level 4, or Zarr for ``.zarr``) atomically.
 
     The data go to a temporary file in the same directory, renamed over
     ``path`` only when complete, so a failure or Ctrl-C never leaves a partial file.  ``ds`` is written as it is:
     ``stabmap.write_atlas`` (``stabmap.read.subset.write_atlas``) also rewrites the stored scene of a part of
-    an atlas (``ds.sel(...)``) to the part's grid.
+    an atlas (``ds.sel(...)``) to the part's grid.  ``late_attrs()``, called once the data are written, gives global
+    attributes known only then (the seconds the writing took), added before the file takes its name.
     """
     path = check_writable(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
@@ -97,9 +99,17 @@ def write_atlas(ds: xr.Dataset, path: str | Path) -> Path:
                 # zarr-python says that Zarr format 3 has no consolidated metadata in its spec yet: known, and harmless
                 warnings.filterwarnings("ignore", message="Consolidated metadata is currently not part")
                 ds.to_zarr(tmp, mode="w", consolidated=True)
+                if late_attrs is not None:
+                    import zarr
+
+                    zarr.open_group(str(tmp), mode="r+").attrs.update(late_attrs())
+                    zarr.consolidate_metadata(str(tmp))
         else:
             encoding = {name: {"zlib": True, "complevel": 4, **_chunksizes(ds[name])} for name in ds.data_vars}
             ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=encoding)
+            if late_attrs is not None:
+                with netCDF4.Dataset(tmp, "a") as nc:
+                    nc.setncatts(late_attrs())
         _replace(tmp, path)
     except BaseException:
         _remove(tmp)
@@ -145,13 +155,14 @@ def _remove(path: Path) -> None:
         path.unlink(missing_ok=True)
 
 
-def write_streamed(ds: xr.Dataset, path: Path) -> Path:
-    """Write ``ds``, whose variables are dask arrays read chunk by chunk, holding one chunk at a time."""
+def write_streamed(ds: xr.Dataset, path: Path, late_attrs: Callable[[], dict] | None = None) -> Path:
+    """Write ``ds``, whose variables are dask arrays read chunk by chunk, holding one chunk at a time (``late_attrs``:
+    as for ``write_atlas``)."""
     # Synchronous: the chunks are on this machine, and one chunk at a time bounds the memory. Each netCDF
     # chunk is written once, whole, so netCDF's chunk cache (64 MiB a variable by default, the largest use of
     # memory here) only needs to hold one.
     with _small_chunk_cache(), dask.config.set(scheduler="synchronous"):
-        return write_atlas(ds, path)
+        return write_atlas(ds, path, late_attrs)
 
 
 READ_CHUNK_POINTS = 1 << 20  # grid points per dask chunk of a lazily opened atlas (a few MiB per variable)

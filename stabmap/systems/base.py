@@ -146,6 +146,10 @@ class System(ABC, Generic[SceneT]):
     paper : str or None
         The module (``stabmap.paper.<name>``) whose ``run(out=..., quick=..., **options)`` is this system's
         ``stabmap paper`` check; None: the system has none.
+    stages : tuple of str
+        Optional parts of its work that the system times itself, each wrapped in
+        ``stabmap.systems.stages.stage(name)`` (e.g. ``("rates",)``); an atlas stores their seconds beside the
+        labels' (``stabmap info``), and ``skip_stage`` says how a scene turns each off.
     """
 
     @property
@@ -192,6 +196,7 @@ class System(ABC, Generic[SceneT]):
     stable_word: str = "stable"  # what ``stable_label`` is called in titles and summaries
     provenance: str | None = None
     symbols: dict[str, str] = {}
+    stages: tuple[str, ...] = ()
 
     def __init__(self) -> None:
         # What abstract members cannot say: the label is one of the variables, an integer with a fill value (it pads
@@ -244,6 +249,12 @@ class System(ABC, Generic[SceneT]):
         return [("", list(names))] if names else []
 
     # ------------------------------------------------------------------ points
+    def skip_stage(self, scene: SceneT, stage: str) -> tuple[str, str] | None:
+        """What the stage ``stage`` (one of ``stages``) computes for ``scene`` and how the scene skips it, e.g.
+        ``("growth rates", "set growth_rate = false in the scene to skip them")``: a run whose stage cost more
+        than its labels ends with that advice.  None (the default): nothing to skip."""
+        return None
+
     def labels_only(self, scene: SceneT) -> SceneT:
         """``scene`` with every optional output off: what a computation that needs the label alone (critical
         values) evaluates.  Default: the scene itself."""

@@ -18,6 +18,7 @@ import numpy as np
 
 from ...store.variables import Variable
 from ..base import System
+from ..stages import stage
 from .outputs import ALL_VARIABLES, BY_BOX, BY_INFERRED, FREQUENCY_VARIABLES, GROWTH_VARIABLES, N_COMPLEX_PAIRS, VARIABLES, stability_from_pairs
 from .scene import Body, Scene
 
@@ -42,6 +43,7 @@ class Gyroscopes(System[Scene]):
     scene_type = Scene
     default_axis = "omega"  # "how fast must it spin?"
     paper = "stabmap.paper.gyroscopes"
+    stages = ("rates",)  # the growth rates and frequencies: optional, and at times the dearer part (docs/rates.md)
 
     def derived_coords(self, scene: Scene) -> dict[str, tuple]:
         from .ratios import coordinates
@@ -135,7 +137,8 @@ class Gyroscopes(System[Scene]):
         if scene.growth_rate or scene.frequencies:
             from .rates import rates
 
-            out.update(rates(points, nc, scene.growth_rate, scene.frequencies))
+            with stage("rates"):
+                out.update(rates(points, nc, scene.growth_rate, scene.frequencies))
         return {k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}
 
     def box_axes(self, scene: Scene) -> set[str]:
@@ -181,7 +184,15 @@ class Gyroscopes(System[Scene]):
         from .points import point_arrays
         from .rates import rates
 
-        return rates(point_arrays(scene, values), label, scene.growth_rate, scene.frequencies)
+        with stage("rates"):
+            return rates(point_arrays(scene, values), label, scene.growth_rate, scene.frequencies)
+
+    def skip_stage(self, scene: Scene, stage: str) -> tuple[str, str] | None:
+        keys = [k for k in ("growth_rate", "frequencies") if stage == "rates" and getattr(scene, k)]
+        if not keys:
+            return None
+        what = " and ".join({"growth_rate": "growth rates", "frequencies": "frequencies"}[k] for k in keys)
+        return what, f"set {' and '.join(f'{k} = false' for k in keys)} in the scene to skip them"
 
     def class_name(self, value: int) -> str:
         if value < 0:
