@@ -84,6 +84,10 @@ def test_tracking_is_the_same_whatever_the_chunks_and_in_a_file(tmp_path):
         for name in ("frequency", "frequency_radius", "root_kind", "mode_tracking"):
             np.testing.assert_array_equal(whole[name].values, other[name].values, err_msg=name)
     assert stored.frequency.dims == ("omega", "mode") and stored.mode.attrs["followed_along"] == "omega"
+    from stabmap.read.info import describe
+
+    followed = int((stored.mode_tracking == FOLLOWED).sum())
+    assert f"modes: 3, followed along omega; links followed {followed:,}" in describe(stored)
 
 
 def test_each_line_of_a_map_is_followed_on_its_own():

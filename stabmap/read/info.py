@@ -135,6 +135,7 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
         if not g["max"] > 0:
             top = "none grows" if g["max"] == 0 else f"every mode decays, the slowest at {g['max']:.6g} s-1 (proved <= {g['max_upper']:.6g})"
         lines += wrapped("growth rate: ", [top, *(f"{m.replace('_', ' ')} {n}" for m, n in g["method"].items() if n)])
+    lines += modes(ds)
     for line in system.caveats(ds):
         lines += textwrap.wrap(line, width=WIDTH, initial_indent="  ", subsequent_indent="    ")
     if "cell" in s:  # their shares of the region are in the headline
@@ -143,6 +144,22 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
     lines += times(a)
     lines += provenance(a)
     return "\n".join(lines)
+
+
+def modes(ds: xr.Dataset) -> list[str]:
+    """The modes of an atlas that stores every root on a ``mode`` dimension: how many, the axis they are followed
+    along, and how the links between neighbouring points went (``mode_tracking``, docs/rates.md)."""
+    if "mode_tracking" not in ds or "mode" not in ds.dims:
+        return []
+    from .summary import _counts
+
+    along = ds["mode"].attrs.get("followed_along")
+    head = f"modes: {ds.sizes['mode']}, " + (f"followed along {along}" if along else "by ascending real part (no spin axis)")
+    var = ds["mode_tracking"]
+    by = _counts(var.data)
+    names = dict(zip(var.attrs.get("flag_values", []), str(var.attrs.get("flag_meanings", "")).split(), strict=False))
+    links = [f"{names.get(k, k)} {n:,}" for k, n in sorted(by.items()) if names.get(k) in ("followed", "ambiguous") and n]
+    return wrapped(head + ("; links " if links else ""), links[:-1] + [links[-1] + " (mode_tracking)"] if links else [])
 
 
 def times(attrs: dict) -> list[str]:
