@@ -151,12 +151,12 @@ def modes(ds: xr.Dataset) -> list[str]:
     along, and how the links between neighbouring points went (``mode_tracking``, docs/rates.md)."""
     if "mode_tracking" not in ds or "mode" not in ds.dims:
         return []
-    from .summary import _counts
+    from .blocks import counts
 
     along = ds["mode"].attrs.get("followed_along")
     head = f"modes: {ds.sizes['mode']}, " + (f"followed along {along}" if along else "by ascending real part (no spin axis)")
     var = ds["mode_tracking"]
-    by = _counts(var.data)
+    by = counts(var.data)
     names = dict(zip(var.attrs.get("flag_values", []), str(var.attrs.get("flag_meanings", "")).split(), strict=False))
     links = [f"{names.get(k, k)} {n:,}" for k, n in sorted(by.items()) if names.get(k) in ("followed", "ambiguous") and n]
     return wrapped(head + ("; links " if links else ""), links[:-1] + [links[-1] + " (mode_tracking)"] if links else [])
