@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from ... import systems
 from ...errors import StabmapError, param
 from .captions import captioned_figure, fill_title
 from .labels import axis_label, display_ticks, log_ticks, symbol, value_text
@@ -44,7 +45,7 @@ def campbell_figure(ds: xr.Dataset, *, x: str | None = None, sel: dict[str, floa
         top, bottom = fig.subplots(), None
     drawn = draw_modes(top, line, along)
     spin_lines(top, line, along, crossings)
-    unstable = shade_unstable(top, line, along)
+    unstable = shade_unstable(top, line, along, systems.of_atlas(ds.attrs))
     if bottom is not None:
         draw_growth(bottom, line, along)
         bottom.set_xlabel(axis_label(ds, along, shown=display_ticks(ds, along, bottom.xaxis)))
@@ -77,7 +78,8 @@ def campbell_line(ds: xr.Dataset, *, x: str | None, sel: dict[str, float] | None
         fixed[d] = (0, float(ds[d][0]))
     if rest:
         notes.append(f"{', '.join(rest)} fixed at the first grid value (fix {'them' if len(rest) > 1 else 'it'} with {param('sel')})")
-    names = [v for v in ("frequency", "frequency_radius", "root_kind", "mode_tracking", "n_complex_pairs", "growth_rate",
+    label = systems.of_atlas(ds.attrs).label
+    names = [v for v in ("frequency", "frequency_radius", "root_kind", "mode_tracking", label, "growth_rate",
                          "growth_rate_lower", "growth_rate_upper") if v in ds]
     line = ds[names].isel({d: i for d, (i, _) in fixed.items()}).transpose(along, ...).load()
     return line, along, notes
@@ -168,12 +170,14 @@ def spin_lines(ax, line: xr.Dataset, along: str, crossings: list[tuple[int, floa
                 gid="critical-speeds")
 
 
-def shade_unstable(ax, line: xr.Dataset, along: str) -> bool:
-    """A light band over every stretch of grid points with a complex pair (N_c > 0); whether there is one."""
-    if "n_complex_pairs" not in line:
+def shade_unstable(ax, line: xr.Dataset, along: str, system) -> bool:
+    """A light band over every stretch of grid points whose label is an unstable class (N_c > 0); whether there is
+    one."""
+    if system.label not in line or system.stable_label is None:
         return False
     xs = np.asarray(line[along], dtype=float)
-    bad = np.asarray(line["n_complex_pairs"]) > 0
+    value = np.asarray(line[system.label])
+    bad = (value >= 0) & (value != system.stable_label)
     edges = np.concatenate([[xs[0]], (xs[:-1] + xs[1:]) / 2, [xs[-1]]])
     for a, b in _runs(bad):
         ax.axvspan(edges[a], edges[b], color=PAIR, alpha=0.1, lw=0, zorder=0)
