@@ -137,22 +137,6 @@ def decide_chunk(scene: SceneBase, location: tuple[tuple[int, int], ...], evalua
     return out
 
 
-def _tile_by_tile(prove, scene: SceneBase, rows: np.ndarray, tile: np.ndarray, lower: dict, upper: dict) -> list:
-    """(rows, prove(scene, lower, upper)) for the boxes ``rows`` of each tile in turn (tiles in order of first
-    appearance, boxes in their order): a system's proof of a block of boxes may steer each box by the one before it
-    (a neighbour's separators), so one call a tile makes what a tile proves independent of the chunk it lies in,
-    and an atlas the same cell for cell however it is cut into chunks or tasks."""
-    if rows.size == 0:
-        return []
-    owner = tile[rows]
-    _, first = np.unique(owner, return_index=True)
-    out = []
-    for t in owner[np.sort(first)]:
-        mine = rows[owner == t]
-        out.append((mine, prove(scene, {k: v[mine] for k, v in lower.items()}, {k: v[mine] for k, v in upper.items()})))
-    return out
-
-
 def _pairs_beside_change(label: np.ndarray, nodes: np.ndarray, tile: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The pairs of neighbouring nodes in one tile (``tile``: each index's tile along its axis) with other labels, one
     of them among ``nodes`` (rows of indices into ``label``), each pair once: (lower node, upper node, axis)."""
@@ -279,12 +263,20 @@ class _Chunk:
         if self.cheap > 0.0:
             # the cheap proof first, each box charged its price; those it leaves pay the full price on top
             tried = self.afford(tile, self.cheap, self.reserve)
-            for rows, (got, ok) in _tile_by_tile(self.system.prove_boxes_cheaply, self.scene, np.flatnonzero(tried), tile, lower, upper):
+            rows = np.flatnonzero(tried)
+            if rows.size:
+                # one batch a tile: a box steered by its neighbour's proof only within its tile, so that what a tile
+                # proves does not depend on the chunk it lies in (System.prove_boxes_cheaply)
+                got, ok = self.system.prove_boxes_cheaply(self.scene, {k: v[rows] for k, v in lower.items()},
+                                                          {k: v[rows] for k, v in upper.items()}, tile[rows])
                 label[rows], proved[rows] = got, ok
             left = tried & ~proved
         full = np.zeros(npts, dtype=bool)
         full[left] = self.afford(tile[left], self.cost, self.reserve)
-        for rows, (got, ok, cut) in _tile_by_tile(self.system.prove_and_cut_boxes, self.scene, np.flatnonzero(full), tile, lower, upper):
+        rows = np.flatnonzero(full)
+        if rows.size:
+            got, ok, cut = self.system.prove_and_cut_boxes(self.scene, {k: v[rows] for k, v in lower.items()},
+                                                           {k: v[rows] for k, v in upper.items()})
             label[rows], proved[rows] = got, ok
             for d, name in enumerate(self.names):
                 along[rows, d] = cut[name]

@@ -306,9 +306,14 @@ class System(ABC, Generic[SceneT]):
         the budget of box proofs in an atlas (``stabmap.run.cells``)."""
         return 1.0
 
-    def prove_boxes_cheaply(self, scene: SceneT, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+    def prove_boxes_cheaply(self, scene: SceneT, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray],
+                            batch: np.ndarray | None = None):
         """(label, proved) as ``prove_boxes``, by a proof that costs ``cheap_box_cost`` a box, which an atlas tries
-        first; the boxes it leaves go on to ``prove_and_cut_boxes``.  None (the default): no such proof."""
+        first; the boxes it leaves go on to ``prove_and_cut_boxes``.  None (the default): no such proof.
+
+        ``batch`` (one integer a box; None: one batch): a box's result may depend only on the boxes of its own
+        batch before it (a proof may steer a box by its neighbour's), so that the cells of an atlas, one batch a
+        tile, do not depend on which tiles share a chunk."""
         return None
 
     def cheap_box_cost(self, scene: SceneT) -> float:

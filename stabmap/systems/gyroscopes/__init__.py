@@ -151,10 +151,11 @@ class Gyroscopes(System[Scene]):
 
         return box_cost(scene)
 
-    def prove_boxes_cheaply(self, scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+    def prove_boxes_cheaply(self, scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray],
+                            batch: np.ndarray | None = None):
         from .kreinboxes import prove_boxes_cheaply
 
-        return prove_boxes_cheaply(scene, lower, upper)
+        return prove_boxes_cheaply(scene, lower, upper, batch)
 
     def cheap_box_cost(self, scene: Scene) -> float:
         from .kreinboxes import cheap_box_cost

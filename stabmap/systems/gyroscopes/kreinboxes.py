@@ -9,6 +9,7 @@ are affine in it.  The kernel gets the inputs at the axis's two ends with every 
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,6 +41,11 @@ class KreinBoxes:
     parent: np.ndarray
     u_lo: np.ndarray
     u_hi: np.ndarray
+
+    def take(self, rows: np.ndarray) -> KreinBoxes:
+        """The boxes ``rows`` (the per-box fields; the chain's structure is shared)."""
+        per_box = ("body", "joint", "g", "at", "E", "kappa", "u_lo", "u_hi")
+        return dataclasses.replace(self, **{f: getattr(self, f)[rows] for f in per_box})
 
     def kernel_args(self):
         args = (self.body, self.joint, self.g, self.at, self.E, self.kappa, self.nmodes, self.free, self.parent, self.u_lo, self.u_hi)
@@ -96,9 +102,12 @@ def krein_arrays(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np
     return rows, KreinBoxes(b, joint[rows], g[rows], at[rows], lo.E[rows], lo.kappa[rows], lo.nmodes, lo.free, lo.parent, u_lo, u_hi)
 
 
-def prove_krein_boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray], warm: bool = True):
+def prove_krein_boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray], warm: bool = True,
+                      batch: np.ndarray | None = None):
     """(N_c int16 with -1 where not proved, proved bool, info (npts, NINFO) int64) of each box.  ``warm``: each box
-    first tries what proved the one before it (``kernels.kreinbox.krein_box_block``)."""
+    first tries what proved the one before it (``kernels.kreinbox.krein_box_block``).  ``batch`` (an integer a box):
+    one kernel call per batch, its boxes in their order, so that no box is steered by another batch's (the kernel's
+    scratch, warm start included, carries from box to box within a call)."""
     npts = int(np.prod(np.broadcast_shapes(*(np.shape(v) for v in (*lower.values(), *upper.values())))))
     nc = np.full(npts, -1, dtype=np.int16)
     info = np.full((npts, NINFO), -1, dtype=np.int64)
@@ -107,14 +116,23 @@ def prove_krein_boxes(scene: Scene, lower: dict[str, np.ndarray], upper: dict[st
         count = np.empty(rows.size, dtype=np.int16)
         status = np.empty(rows.size, dtype=np.int8)
         out_info: np.ndarray = np.zeros((rows.size, NINFO), dtype=np.int64)
-        krein_box_block(*part.kernel_args(), warm, count, status, out_info)
+        if batch is None:
+            krein_box_block(*part.kernel_args(), warm, count, status, out_info)
+        else:
+            owner = np.asarray(batch)[rows]
+            order = np.argsort(owner, kind="stable")  # each batch's boxes together, in their order
+            cuts = np.flatnonzero(np.diff(owner[order])) + 1
+            for run in np.split(order, cuts):
+                c, st, inf = count[run], status[run], out_info[run]
+                krein_box_block(*part.take(run).kernel_args(), warm, c, st, inf)
+                count[run], status[run], out_info[run] = c, st, inf
         good = status != UNDECIDED
         nc[rows[good]] = count[good]
         info[rows] = out_info
     return nc, nc >= 0, info
 
 
-def prove_boxes_cheaply(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray]):
+def prove_boxes_cheaply(scene: Scene, lower: dict[str, np.ndarray], upper: dict[str, np.ndarray], batch: np.ndarray | None = None):
     """(N_c, proved) of each box by the Krein test alone (``System.prove_boxes_cheaply``): boxes that span an axis
     outside ``box_axes``, or that do not qualify (module docstring), are left unproved."""
     npts = int(np.prod(np.broadcast_shapes(*(np.shape(v) for v in (*lower.values(), *upper.values())))))
@@ -126,7 +144,7 @@ def prove_boxes_cheaply(scene: Scene, lower: dict[str, np.ndarray], upper: dict[
     if todo.size:
         sub = {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,))[todo] for k, v in lower.items()}
         got = prove_krein_boxes(scene, sub, {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (npts,))[todo]
-                                             for k, v in upper.items()})[0]
+                                             for k, v in upper.items()}, batch=None if batch is None else np.asarray(batch)[todo])[0]
         nc[todo] = got
     return nc, nc >= 0
 
