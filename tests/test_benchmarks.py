@@ -238,3 +238,10 @@ def test_bench_campbell_quick(capsys):
     assert out["num"] == 200 and out["plot_png_s"] > 0 and out["png_kB"] > 0
     assert out["followed"] + out["ambiguous"] > 0
     assert "stabmap plot --campbell" in capsys.readouterr().out
+
+
+def test_bench_readme_ways_quick(capsys):
+    rows = runpy.run_path(str(SCRIPTS / "bench_readme_ways.py"))["main"](["--quick"])
+    assert [r["grid"] for r in rows] == ["24 x 12 x 3"]
+    assert all(r[k] > 0 for r in rows for k in ("default", "node-by-node", "plain"))
+    assert "`--node-by-node` s" in capsys.readouterr().out
