@@ -36,7 +36,11 @@ def campbell_figure(ds: xr.Dataset, *, x: str | None = None, sel: dict[str, floa
     spin axis the modes were followed along), other axes fixed by ``sel`` (nearest grid value) or at their first
     value, which the title says.  Raises StabmapError for an atlas without frequencies, naming the scene key."""
     line, along, notes = campbell_line(ds, x=x, sel=sel)
-    crossings = critical_speeds(line, along)
+    return draw_campbell(ds, line, along, notes, critical_speeds(line, along))
+
+
+def draw_campbell(ds: xr.Dataset, line: xr.Dataset, along: str, notes: list[str], crossings: list[tuple[int, float, float]]):
+    """The figure of ``campbell_figure`` from the line it read (``campbell_line``) and its ``critical_speeds``."""
     rates = "growth_rate" in line
     fig = captioned_figure(ds, (8.4, 6.4 if rates else 4.6))
     if rates:
@@ -261,4 +265,4 @@ def campbell_title(ds: xr.Dataset, line: xr.Dataset, along: str, crossings: list
     return text + "".join(f"\n{n}" for n in notes)
 
 
-__all__ = ["campbell_figure", "campbell_line", "critical_speeds"]
+__all__ = ["campbell_figure", "campbell_line", "critical_speeds", "draw_campbell"]

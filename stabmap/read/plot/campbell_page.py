@@ -11,15 +11,16 @@ import re
 import numpy as np
 import xarray as xr
 
-from .campbell import COMPLEX, campbell_figure, campbell_line, critical_speeds
+from .campbell import COMPLEX, campbell_line, critical_speeds, draw_campbell
 
 
 def campbell_page(ds: xr.Dataset, *, x: str | None = None, sel: dict[str, float] | None = None) -> str:
     """The page's text (HTML) for the Campbell diagram of ``ds`` (:func:`stabmap.read.plot.campbell.campbell_figure`)."""
     import matplotlib.pyplot as plt
 
-    line, along, _ = campbell_line(ds, x=x, sel=sel)
-    fig = campbell_figure(ds, x=x, sel=sel)
+    line, along, notes = campbell_line(ds, x=x, sel=sel)  # read once: the figure and the table share it
+    crossings = critical_speeds(line, along)
+    fig = draw_campbell(ds, line, along, notes, crossings)
     buf = io.StringIO()
     try:
         fig.savefig(buf, format="svg")
@@ -29,7 +30,6 @@ def campbell_page(ds: xr.Dataset, *, x: str | None = None, sel: dict[str, float]
     svg = svg[svg.index("<svg"):]  # the XML prologue does not belong inside HTML
     unit, k = _unit(ds, along)
     tips = _mode_tips(line, unit, k)
-    crossings = critical_speeds(line, along)
     tips["critical-speeds"] = "critical speeds: " + "; ".join(
         f"{along} = {w / k:.5g} {unit} ({abs(o)}\u00d7 spin{', backward' if o > 0 else ''})" for o, w, _ in crossings)
 
