@@ -207,10 +207,26 @@ def test_every_skip_says_why_and_the_readme_keeps_its_first_two_commands():
                 assert len(b.mark) > len("skip: ") + 10, f"{b.where()}: a skip must give its reason"
     first = blocks(ROOT / "README.md")[0]
     assert first.body == (
-        "pip install . && stabmap atlas --example paper-n3-fixed -o atlas.nc --png atlas.png\n"
+        "pip install . && stabmap atlas --example paper-n3-fixed -o atlas.nc --png atlas.png --overwrite\n"
         "pip install '.[test]' && python -m pytest -q\n"
     )
     assert first.mark == "no-install"
+
+
+def test_the_readme_is_a_users_page_and_the_index_maps_every_doc():
+    """The README stays short (its two commands, how to read the first picture, the words, the next commands) and
+    docs/index.md links every page of docs/, so that a page added later cannot go unlisted."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert len(readme.splitlines()) <= 150
+    for word in ("N_c", "necessary sense", "Proved", "Cell", "Undecided", "ds.stabmap", "docs/index.md", "CONTRIBUTING.md"):
+        assert word in readme, word
+    for developer_only in (".ci/run", "ruff", "mypy", "seed 003", "kernels/"):
+        assert developer_only not in readme, developer_only
+    index = (ROOT / "docs" / "index.md").read_text(encoding="utf-8")
+    linked = set(re.findall(r"\]\(([^)#]+)\)", index))
+    pages = {p.name for p in (ROOT / "docs").iterdir() if p.suffix in (".md", ".ipynb") and p.name != "index.md"}
+    assert pages <= linked, sorted(pages - linked)
+    assert all((ROOT / "docs" / target).exists() for target in linked), sorted(t for t in linked if not (ROOT / "docs" / t).exists())
 
 
 CLUSTER_BASH = """<!-- doc-test: cluster -->

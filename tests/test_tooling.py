@@ -136,10 +136,10 @@ def test_a_source_copy_without_git_or_build_gets_the_fallback(tmp_path):
     assert Path(where).parent == copy and version == fallback
 
 
-def test_the_readme_installs_the_lint_tools_ci_pins():
-    """The README's Development section installs the very lint group .ci/run reads from pyproject.toml."""
+def test_contributing_installs_the_lint_tools_ci_pins():
+    """CONTRIBUTING.md's lint section installs the very lint group .ci/run reads from pyproject.toml."""
     pinned = tomllib.loads((ROOT / "pyproject.toml").read_text())["dependency-groups"]["lint"]
-    line = next(x for x in (ROOT / "README.md").read_text().splitlines() if x.startswith("pip install 'ruff"))
+    line = next(x for x in (ROOT / "CONTRIBUTING.md").read_text().splitlines() if x.startswith("pip install 'ruff"))
     assert re.findall(r"'([^']+)'", line.split("#")[0]) == pinned
     assert "dependency-groups" in (ROOT / ".ci" / "run").read_text()
 
