@@ -55,8 +55,10 @@ def coordinates(system, scene, skip: tuple[str, ...] = ()) -> dict:
             attrs["display_units"] = axis.display_units
         coords[axis.name] = (axis.name, axis.array, attrs)
         what = "the value itself (a discrete axis: separate cases)" if axis.discrete else "midpoints between grid values"
-        coords[name] = ((axis.name, BOUNDS_DIM), bounds(axis.array, bool(axis.discrete)), {"units": info.units,
-                        "long_name": f"edges of the grid cells along {axis.name} ({what})"})
+        # CF 7.1: a bounds variable is part of its coordinate's metadata; it takes the coordinate's units and names,
+        # and any long_name or units of its own must equal the coordinate's, so it carries only a comment.
+        coords[name] = ((axis.name, BOUNDS_DIM), bounds(axis.array, bool(axis.discrete)),
+                        {"comment": f"edges of the grid cells along {axis.name} ({what}), in the units of {axis.name}"})
     for key, value in system.fixed_values(scene).items():
         info = system.parameter(scene, key)
         coords[key] = ((), np.float64(value), {"units": info.units, "long_name": info.long_name})

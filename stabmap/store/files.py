@@ -105,7 +105,12 @@ def write_atlas(ds: xr.Dataset, path: str | Path, late_attrs: Callable[[], dict]
                     zarr.open_group(str(tmp), mode="r+").attrs.update(late_attrs())
                     zarr.consolidate_metadata(str(tmp))
         else:
+            ds = _string_axes_as_labels(_cf_bounds(ds))
             encoding = {name: {"zlib": True, "complevel": 4, **_chunksizes(ds[name])} for name in ds.data_vars}
+            # No _FillValue on coordinates or bounds: CF 2.5.1 forbids missing values in coordinate variables and
+            # CF 7.1 recommends none on bounds; xarray would otherwise give every float variable a NaN _FillValue.
+            for name in [*ds.coords, *_bounds_names(ds)]:
+                encoding[name] = {**encoding.get(name, {}), "_FillValue": None}
             ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=encoding)
             if late_attrs is not None:
                 with netCDF4.Dataset(tmp, "a") as nc:
@@ -115,6 +120,66 @@ def write_atlas(ds: xr.Dataset, path: str | Path, late_attrs: Callable[[], dict]
         _remove(tmp)
         raise
     return path
+
+
+LABEL_SUFFIX = "_label"  # the string-valued auxiliary coordinate that holds a string axis's values in a netCDF file
+
+
+def _string_axes_as_labels(ds: xr.Dataset) -> xr.Dataset:
+    """``ds`` with each dimension whose coordinate holds strings (a reactions atlas's ``component``: x, y, z) left
+    without a coordinate variable, its strings in the auxiliary coordinate ``NAME_label`` instead.
+
+    A CF coordinate variable is numeric and monotonic (CF 1.10 section 1.3); strings along a dimension are labels,
+    a string-valued auxiliary coordinate (section 6.1).  ``open_atlas`` turns them back into the dimension's
+    coordinate, so ``ds.R.sel(component="z")`` reads a file as it read the Dataset that was written.
+    """
+    strings = [d for d in ds.dims if d in ds.coords and ds[d].dtype.kind in "OUS"]
+    if not strings:
+        return ds
+    ds = ds.drop_indexes(strings).rename_vars({d: f"{d}{LABEL_SUFFIX}" for d in strings}).copy(deep=False)
+    for var in ds.variables.values():  # a file's 'coordinates' read back would name the old coordinate, not the label
+        var.encoding.pop("coordinates", None)
+    return ds
+
+
+def _labels_as_string_axes(ds: xr.Dataset) -> xr.Dataset:
+    """The inverse of ``_string_axes_as_labels`` on a file read: each ``NAME_label`` of a dimension NAME that has no
+    coordinate becomes NAME's coordinate again (files written before have the string coordinate itself)."""
+    for d in list(ds.dims):
+        label = f"{d}{LABEL_SUFFIX}"
+        if d not in ds.variables and label in ds.coords and ds[label].dims == (d,) and ds[label].dtype.kind in "OUS":
+            ds = ds.assign_coords({d: (d, ds[label].values, ds[label].attrs)}).drop_vars(label)
+    return ds
+
+
+def _bounds_names(ds: xr.Dataset) -> list[str]:
+    """The bounds variables of ``ds``: those a variable names in its ``bounds`` attribute (CF 7.1)."""
+    names = (ds[name].attrs.get("bounds") for name in ds.variables)
+    return [b for b in names if isinstance(b, str) and b in ds.variables]
+
+
+def _cf_bounds(ds: xr.Dataset) -> xr.Dataset:
+    """``ds`` with its bounds variables as CF 7.1 recommends: no ``units`` or ``long_name`` of their own.
+
+    A bounds variable shares its coordinate's units and names, and any of those attributes it carries must equal
+    the coordinate's.  Older atlases gave each bounds variable a ``long_name`` of its own describing the edges; one
+    of them rewritten (``stabmap.write_atlas`` of a part) keeps that text as a ``comment`` instead.
+    """
+    out = ds
+    for name in ds.variables:
+        b = ds[name].attrs.get("bounds")
+        if not (isinstance(b, str) and b in ds.variables):
+            continue
+        attrs = dict(ds[b].attrs)
+        if "long_name" in attrs and attrs["long_name"] != ds[name].attrs.get("long_name"):
+            attrs.setdefault("comment", attrs["long_name"])
+        for key in ("long_name", "units"):
+            attrs.pop(key, None)
+        if attrs != ds[b].attrs:
+            var = ds[b].variable.copy(deep=False)
+            var.attrs = attrs
+            out = out.assign_coords({b: var}) if b in ds.coords else out.assign({b: var})
+    return out
 
 
 def write_text(text: str, path: str | Path) -> Path:
@@ -211,7 +276,7 @@ def open_atlas(path: str | Path, *, lazy: bool = False) -> xr.Dataset:
     if "stabmap_format_version" not in ds.attrs:
         ds.close()
         raise StabmapError(f"{str(path)!r} is a netCDF file but not a stabmap atlas (no stabmap_format_version)")
-    return ds
+    return _labels_as_string_axes(ds)
 
 
 @contextlib.contextmanager
