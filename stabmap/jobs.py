@@ -81,6 +81,7 @@ def atlas(
     from .run import costs
     from .run import refine as refining
     from .run.atlas import compute_to_file
+    from .run import sizes
     from .run.chunks import check_chunk_points
     from .store.files import check_atlas_output, check_new_output, open_atlas, write_atlas
 
@@ -90,6 +91,10 @@ def atlas(
         check_new_output(png, overwrite, param("png"))
     check_grid(scene)
     check_chunk_points(chunk_points)
+    size = sizes.of(scene)  # a grid that cannot fit is refused before any work
+    sizes.check_disk(size, output)
+    if refine:
+        sizes.check_memory(size, f"an adaptive atlas ({param('refine')}), held in memory,")
     if not refine:
         extra = [name for name, v in (("coarse_stride", coarse_stride), ("margin", margin)) if v is not None]
         if extra:

@@ -24,6 +24,10 @@ from . import units
 from .values import Parameter, check_value, no_unknown
 
 SCALES = ("linear", "log", "values")
+# An axis's values are held in memory as Python floats (the scene) and as the atlas's coordinate and its bounds, about
+# 60 bytes a value, and each is checked: a million take 60 MB and a second or two, and a finer single axis is a job for
+# ``stabmap critical`` (docs/critical.md), which locates its boundaries to 1e-10.
+MAX_AXIS_VALUES = 1_000_000
 _AXIS_KEYS = {"start", "stop", "num", "scale", "values", "display_units", "discrete"}
 _NUMBER = Parameter("", "", "")  # any finite number: the limits are the system's (check_axes)
 
@@ -121,6 +125,9 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
         num = spec["num"]
         if isinstance(num, bool) or not isinstance(num, int) or num < 1:
             raise StabmapError(f"{where}.num must be a whole number >= 1, got {num!r}")
+        if num > MAX_AXIS_VALUES:
+            raise StabmapError(f"{where}.num = {num:,}: an axis holds at most {MAX_AXIS_VALUES:,} values; give a smaller num "
+                               "(to locate a boundary finely along one axis, use 'stabmap critical', docs/critical.md)")
         start = check_value(f"{where}.start", spec["start"], info)
         stop = check_value(f"{where}.stop", spec["stop"], info)
         unit = units.common_unit(where, [spec["start"], spec["stop"]])
