@@ -126,7 +126,8 @@ def atlas(
         with open_atlas(output, lazy=True) as ds:
             plot_atlas(ds, png)
         lines.append(f"wrote {png}")
-    return Done(lines + ([note] if note else []))  # last: what the user may change before the next run
+    unused = scene.unused() if hasattr(scene, "unused") else []  # values given that the model does not use
+    return Done(lines + unused + ([note] if note else []))  # last: what the user may change before the next run
 
 
 @contextlib.contextmanager

@@ -131,6 +131,17 @@ class Scene(SceneBase):
                 out.append((f"body {k}", liquid.describe(b.cavity)))
         return out
 
+    def unused(self) -> list[str]:
+        """Notes on values the scene gives that the model does not use: ``s`` on the top body of a chain (it has no
+        joint above it; docs/model.md).  Not refused: a chain of identical bodies is naturally written with s on each."""
+        top = self.bodies[-1]
+        if self.topology is not None or top.s == 0.0 or "s" in {a.name for a in self.grid}:
+            return []
+        n = self.n
+        what = "a single body has" if n == 1 else f"body {n} is the top of the chain and has"
+        return [f"note: bodies[{n}].s = {top.s:g} is not used: {what} no joint above it (s is the distance from a body's "
+                "lower joint to the joint of the body above it)"]
+
     def with_grid(self, grid: tuple[Axis, ...]) -> Scene:
         # modes = "auto" chose its count from this grid's extremes; a subset keeps that count, and so its labels.
         bodies = tuple(b if b.cavity is None or b.cavity.modes != liquid.AUTO
@@ -332,6 +343,11 @@ def _axis_name(name: str, n: int, support: str, tree: bool):
         raise StabmapError(
             f"grid axis {name!r} has no effect in a scene with [topology]: joints sit at topology.at; "
             "scan at_k, the position of body k's joint on its parent's axis"
+        )
+    if not tree and parsed.symbol == "s" and parsed.kind == "body" and parsed.index == n:
+        raise StabmapError(
+            f"grid axis {name!r} has no effect: s_k is the distance to the joint of the body above body k, and body {n} "
+            "is the top of the chain; scan s_k of a lower body"
         )
     if not tree and parsed.kind == "position":
         raise StabmapError(
