@@ -78,10 +78,9 @@ def atlas(
     from . import systems
     from .read.plot import check_figure_path, plot_atlas
     from .read.summary import summary
-    from .run import costs
+    from .run import costs, sizes
     from .run import refine as refining
     from .run.atlas import compute_to_file
-    from .run import sizes
     from .run.chunks import check_chunk_points
     from .store.files import check_atlas_output, check_new_output, open_atlas, write_atlas
 

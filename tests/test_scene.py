@@ -80,7 +80,7 @@ BAD = [
     (_replace("title =", "title = = "), "TOML syntax error"),
     (_replace("m_2 = {", "m_9 = {"), "'m_9': bodies are numbered 1..2"),
     (_replace("m_2 = {", "mass_2 = {"), "unknown parameter name 'mass_2'"),
-    (_replace("K_1 = {", "K_2 = {"), "'K_2': a chain of 2 bodies has joints K_1..K_1 between its bodies"),
+    (_replace("K_1 = {", "K_2 = {"), "'K_2': a chain of 2 bodies has one joint, K_1, between its bodies"),
     (_replace("num = 5", "num = 0"), "grid.omega.num must be a whole number >= 1"),
     (_replace("K_1 = { values = [0.0, 10.0, 100.0] }", "K_1 = { values = [] }"), "grid.K_1.values must be a non-empty list"),
     (_replace("K_1 = { values = [0.0, 10.0, 100.0] }", "K_1 = { values = [0.0, 10.0, 5.0] }"), "grid.K_1: values must be distinct and sorted"),

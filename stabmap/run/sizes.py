@@ -79,7 +79,7 @@ def check_memory(size: Size, what: str = "an atlas in memory") -> None:
 def available_memory() -> int | None:
     """Bytes of memory available to a new allocation (psutil, which dask.distributed installs), or None if unknown."""
     try:
-        import psutil
+        import psutil  # type: ignore[import-untyped]
     except ImportError:
         return None
     return int(psutil.virtual_memory().available)
