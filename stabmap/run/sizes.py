@@ -2,7 +2,7 @@
 
 A grid's size is the product of its axes, so a few keys of a scene can ask for more than a disk or a machine holds
 (a 40 000 x 40 000 scan is 1.6e9 points).  A run that cannot fit is refused here, before any work, in one line;
-a large one says what it will cost before it starts (docs/own-scene.md, "How big a grid").
+a large one says what it will cost before it starts (docs/own-scene.md, "What a scene refuses, and how big a grid may be").
 
 The sizes are exact before compression: the bytes of every variable the system stores at a grid point (its dtypes,
 ``stabmap.store.dataset.empty_arrays``) times the points.  The file and the run's checkpoint are compressed (zlib,
