@@ -78,7 +78,7 @@ def atlas(
     from . import systems
     from .read.plot import check_figure_path, plot_atlas
     from .read.summary import summary
-    from .run import costs
+    from .run import costs, sizes
     from .run import refine as refining
     from .run.atlas import compute_to_file
     from .run.chunks import check_chunk_points
@@ -90,6 +90,10 @@ def atlas(
         check_new_output(png, overwrite, param("png"))
     check_grid(scene)
     check_chunk_points(chunk_points)
+    size = sizes.of(scene)  # a grid that cannot fit is refused before any work
+    sizes.check_disk(size, output)
+    if refine:
+        sizes.check_memory(size, f"an adaptive atlas ({param('refine')}), held in memory,")
     if not refine:
         extra = [name for name, v in (("coarse_stride", coarse_stride), ("margin", margin)) if v is not None]
         if extra:
@@ -121,7 +125,8 @@ def atlas(
         with open_atlas(output, lazy=True) as ds:
             plot_atlas(ds, png)
         lines.append(f"wrote {png}")
-    return Done(lines + ([note] if note else []))  # last: what the user may change before the next run
+    unused = scene.unused() if hasattr(scene, "unused") else []  # values given that the model does not use
+    return Done(lines + unused + ([note] if note else []))  # last: what the user may change before the next run
 
 
 @contextlib.contextmanager

@@ -99,7 +99,7 @@ def test_reactions_angular_velocity_in_rpm():
 
 
 @pytest.mark.parametrize("change, message", [
-    (("c = 0.1\n", 'c = "0.1 rpm"\n'), "bodies[1].c = '0.1 rpm': a unit is accepted for spin rates only (rad/s, rpm or Hz); give bodies[1].c as a plain number [m]"),
+    (("c = 0.1\n", 'c = "0.1 rpm"\n'), "bodies[1].c = '0.1 rpm': a unit is accepted for spin rates only (rad/s, rpm or Hz); give bodies[1].c as a plain number in m"),
     (("0.05, 0.1", '"0.05 rpm", "0.1 rpm"'), "a unit is accepted for spin rates only"),
     (('"50 rpm"', '"50 rps"'), "grid.omega.start = '50 rps': unknown unit 'rps'; a spin rate may be given in rad/s, rpm or Hz"),
     (('"50 rpm"', '"1 Hz"'), "grid.omega: mixed units (Hz, rpm); give every value of one axis in the same unit (rad/s, rpm or Hz)"),
@@ -180,7 +180,7 @@ def test_cli_queries_in_rpm(rpm_file, in_rpm, capsys):
 def test_cli_unit_errors(rpm_file, capsys):
     for items, message in (
         (["omega=110 rps", "c_1=0.1"], "omega = '110 rps': unknown unit 'rps'; a spin rate may be given in rad/s, rpm or Hz"),
-        (["omega=110", "c_1=0.1 rpm"], "c_1 = '0.1 rpm': a unit is accepted for spin rates only (rad/s, rpm or Hz); give c_1 as a plain number [m]"),
+        (["omega=110", "c_1=0.1 rpm"], "c_1 = '0.1 rpm': a unit is accepted for spin rates only (rad/s, rpm or Hz); give c_1 as a plain number in m"),
     ):
         assert main(["query", str(rpm_file), *items]) == 2
         assert message in capsys.readouterr().err

@@ -25,7 +25,7 @@ from ..store.checkpoint import Checkpoint, partial_dir
 from ..store.dataset import empty_arrays, finished_atlas
 from ..store.files import check_writable, write_streamed
 from ..systems.base import SceneBase
-from . import cells, costs, runner
+from . import cells, costs, runner, sizes
 from .chunks import (
     BLOCK_SECONDS,
     CELL_BLOCK_SECONDS,
@@ -81,6 +81,7 @@ def compute(
     t0 = time.perf_counter()
     chunk_points = check_chunk_points(chunk_points)
     system = systems.of(scene)
+    sizes.check_memory(sizes.of(scene))
     with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run:
         spent = costs.Costs(run, costs.columns(system), t0)
         arrays = decide_grid(run, scene, progress=progress, chunk_points=chunk_points, prove_cells=prove_cells)
@@ -265,6 +266,8 @@ def compute_to_file(
     path = check_writable(path)
     where = partial_dir(path)
     system = systems.of(scene)
+    size = sizes.of(scene)
+    sizes.check_disk(size, path)
     checkpoint = None
     if where.exists():
         if not resume:
@@ -280,9 +283,12 @@ def compute_to_file(
             )
         prove_cells = checkpoint.prove_cells
     chunk_points = check_chunk_points(chunk_points)
+    said = wanted(progress) and sizes.worth_saying(size)
+    if said:  # at once: a large grid's checkpoint alone takes a while to create
+        print(f"[atlas] {size.text()}; timing a probe", file=sys.stderr)
     try:
         with runner.start(client, workers=workers, threads=threads, announce=wanted(progress)) as run, _Layout(
-            run, scene, progress, chunk_points, checkpoint, prove_cells
+            run, scene, progress, chunk_points, checkpoint, prove_cells, said=said
         ) as layout:
             spent = costs.Costs(run, costs.columns(system), t0)
             resumed = checkpoint is not None
@@ -341,16 +347,20 @@ class _Layout:
 
     Without a checkpoint or ``chunk_points``, a probe task first times a few hundred points spread over the grid
     (``stabmap.run.tasks.probe``): the chunks hold about BLOCK_SECONDS of work at that pace, and tasks of several
-    chunks about TASK_SECONDS, resized as tasks finish.
+    chunks about TASK_SECONDS, resized as tasks finish.  A large run (``stabmap.run.sizes.worth_saying``) says the time
+    the probe predicts before it starts (and its size, unless ``said`` already); one whose chunks need no probe is
+    probed for that alone.
     """
 
     def __init__(self, run: runner.Runner, scene, progress, chunk_points: int | None, checkpoint: Checkpoint | None = None,
-                 prove_cells: bool = True):
+                 prove_cells: bool = True, said: bool = False):
         self.scene, self.runner, self.prove_cells = scene, run, prove_cells
         self.progress = ProgressLine(wanted(progress))
         self.progress.redraw = lambda: self._show(self._rate)
         self._rate: Rate | None = None
         self.total = math.prod(scene.shape)
+        self.cost: float | None = None  # seconds a point on one thread, once a probe has timed some
+        self.timed = 0  # the points (or tiles' points) the probe timed
         self.done_before = 0  # points finished by an earlier, interrupted run
         self.batch = chunk_points is None
         order = point_order(scene)
@@ -376,6 +386,25 @@ class _Layout:
                 raise
         self.chunks = chunks
         self.locations = chunk_locations(scene.shape, chunks)
+        try:
+            self._say_size(tile, said)
+        except BaseException:
+            self.progress.close()
+            raise
+
+    def _say_size(self, tile: tuple[int, ...] | None, said: bool) -> None:
+        """The size and the predicted time of a large run, on stderr where the progress line is shown."""
+        if not self.progress.enabled:
+            return
+        size = sizes.of(self.scene)
+        if said and self.cost is None:
+            self._probe(tile)  # for the estimate alone: the chunks were chosen without it
+        if self.cost is None:
+            return
+        threads = self.runner.slots()
+        if said or sizes.worth_saying(size, self.total * self.cost / threads):
+            estimate = sizes.estimate(size, self.cost, threads, self.timed)
+            self.progress.say(f"[atlas] {estimate}" if said else f"[atlas] {size.text()}; {estimate}")
 
     def __enter__(self) -> _Layout:
         return self
@@ -406,6 +435,7 @@ class _Layout:
         points, seconds = measured[0]
         cost = seconds / max(1, points)
         self.runner.pace = runner.Pace(cost)
+        self.cost, self.timed = cost, points
         return cost
 
     def run(self, todo: list[int], on_result) -> None:

@@ -56,6 +56,14 @@ class ProgressLine:
         sys.stderr.write(f"\r{text}   ")
         sys.stderr.flush()
 
+    def say(self, text: str) -> None:
+        """``text`` on a line of its own (below the progress line, if one is drawn), shown whatever the time."""
+        if not self.enabled:
+            return
+        sys.stderr.write(("\n" if self.shown else "") + text + "\n")
+        sys.stderr.flush()
+        self.shown = False
+
     def close(self) -> None:
         if self._notice is not None:  # the notice goes back to whoever had it before this line
             from ..kernels import options

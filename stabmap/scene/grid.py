@@ -1,7 +1,8 @@
 """The grid of a scan: one axis per scanned parameter, read from a scene's ``[grid]`` table.
 
 An axis is named exactly like the parameter it scans (the name becomes the
-Dataset dimension) and holds its values, sorted and distinct.  In TOML it is
+Dataset dimension) and holds its values, distinct and increasing (given
+decreasing, ``start = 40, stop = 1``, they are the same axis, stored increasing).  In TOML it is
 ``name = { start = .., stop = .., num = .., scale = "linear" | "log" }`` or
 ``name = { values = [...] }``.  An axis given as a list of values is **discrete**: a set of separate cases, so a
 grid cell does not span it (its CF bounds are the value itself) and cells are proved in the other axes only;
@@ -24,13 +25,17 @@ from . import units
 from .values import Parameter, check_value, no_unknown
 
 SCALES = ("linear", "log", "values")
+# An axis's values are held in memory as Python floats (the scene) and as the atlas's coordinate and its bounds, about
+# 60 bytes a value, and each is checked: a million take 60 MB and a second or two, and a finer single axis is a job for
+# ``stabmap critical`` (docs/critical.md), which locates its boundaries to 1e-10.
+MAX_AXIS_VALUES = 1_000_000
 _AXIS_KEYS = {"start", "stop", "num", "scale", "values", "display_units", "discrete"}
 _NUMBER = Parameter("", "", "")  # any finite number: the limits are the system's (check_axes)
 
 
 @dataclass(frozen=True)
 class Axis:
-    """One scanned parameter: its name (the Dataset dimension) and its values, sorted and distinct."""
+    """One scanned parameter: its name (the Dataset dimension) and its values, distinct and increasing."""
 
     name: str
     values: tuple[float, ...]
@@ -49,6 +54,10 @@ class Axis:
         diffs = np.diff(self.values)
         if len(self.values) > 1 and not (np.all(diffs > 0) or np.all(diffs < 0)):
             raise StabmapError(f"{where}: values must be distinct and sorted (increasing or decreasing)")
+        if len(self.values) > 1 and diffs[0] < 0:
+            # start > stop (or a decreasing list) is the same axis: stored increasing, as every reader of an atlas
+            # takes it (a cell spans a node and the next one up; plots and searches go upward)
+            object.__setattr__(self, "values", self.values[::-1])
         if self.scale == "log" and min(self.values) <= 0:
             raise StabmapError(f'{where}: scale = "log" needs values > 0, got {min(self.values)}')
         object.__setattr__(self, "display_units", units.check_display(f"{where}.display_units", self.display_units))
@@ -121,6 +130,9 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
         num = spec["num"]
         if isinstance(num, bool) or not isinstance(num, int) or num < 1:
             raise StabmapError(f"{where}.num must be a whole number >= 1, got {num!r}")
+        if num > MAX_AXIS_VALUES:
+            raise StabmapError(f"{where}.num = {num:,}: an axis holds at most {MAX_AXIS_VALUES:,} values; give a smaller num "
+                               "(to locate a boundary finely along one axis, use 'stabmap critical', docs/critical.md)")
         start = check_value(f"{where}.start", spec["start"], info)
         stop = check_value(f"{where}.stop", spec["stop"], info)
         unit = units.common_unit(where, [spec["start"], spec["stop"]])
@@ -128,6 +140,7 @@ def parse_axes(raw, parameter: Callable[[str], Parameter]) -> tuple[Axis, ...]:
             raise StabmapError(f"{where}: num = 1 gives the one value start = {start:g} and would ignore stop = {stop:g}; "
                                f"give num >= 2, or values = [{start:g}]")
         scale = spec.get("scale", "linear")
+        start, stop = min(start, stop), max(start, stop)  # descending: the same axis (Axis), and the very same values
         if scale == "linear":
             values = np.linspace(start, stop, num)
         elif scale == "log":

@@ -59,13 +59,18 @@ def in_si(where: str, value, units: str):
     """
     if not isinstance(value, str):
         return value
+    if units != SPIN:
+        # Any unit on another quantity ("1.2 kg", "9.81 m/s2") is refused for what it is, a unit where none is read,
+        # before the unit is looked up: "unknown unit 'kg'" would send the user to the spin units instead.
+        match = _TEXT.match(value)
+        if match and match["unit"]:
+            shown = " (dimensionless)" if units == "1" else f" in {units}" if units else ""
+            raise StabmapError(f"{where} = {value!r}: a unit is accepted for spin rates only ({ACCEPTED}); "
+                               f"give {where} as a plain number{shown}")
+        return value  # not a number with a unit: the caller's check says what it should be
     number, unit = split(where, value)
     if unit is None:  # a number written as a string is not a number: the caller's check says so
         return value
-    if units != SPIN:
-        shown = f" [{units}]" if units and units != "1" else ""
-        raise StabmapError(f"{where} = {value!r}: a unit is accepted for spin rates only ({ACCEPTED}); "
-                           f"give {where} as a plain number{shown}")
     return number * factor(unit)
 
 

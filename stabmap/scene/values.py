@@ -25,7 +25,8 @@ def check_value(where: str, value, info: Parameter) -> float:
     """Return ``value`` as a float or raise a StabmapError naming ``where``; a spin rate may carry a unit ("14000 rpm")."""
     value = in_si(where, value, info.units)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise StabmapError(f"{where} must be a number, got {value!r}")
+        quoted = " (remove the quotes: TOML reads a quoted number as text)" if isinstance(value, str) and _is_number(value) else ""
+        raise StabmapError(f"{where} must be a number, got {value!r}{quoted}")
     value = float(value)
     if not math.isfinite(value):
         raise StabmapError(f"{where} must be finite, got {value}")
@@ -35,6 +36,14 @@ def check_value(where: str, value, info: Parameter) -> float:
         if not info.strict and value < info.minimum:
             raise StabmapError(f"{where} must be >= {info.minimum:g}, got {value}")
     return value
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def did_you_mean(name: str, known) -> str:

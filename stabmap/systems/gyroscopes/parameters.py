@@ -138,7 +138,8 @@ def parse_name(name: str, n_bodies: int, support: str) -> Name:
         if index == 0 and support == "free":
             raise StabmapError(f"{name!r}: a free system has no base joint; K_0 is for support = \"fixed\"")
         if index > n_bodies - 1:
-            joints = "no joint between bodies" if n_bodies == 1 else f"joints K_1..K_{n_bodies - 1} between its bodies"
+            joints = ("no joint between bodies" if n_bodies == 1 else "one joint, K_1, between its bodies" if n_bodies == 2
+                      else f"joints K_1..K_{n_bodies - 1} between its bodies")
             raise StabmapError(
                 f"{name!r}: a chain of {n_bodies} bod{'y' if n_bodies == 1 else 'ies'} has {joints} (and K_0 at a fixed base); "
                 "in a tree, K_k is the joint of body k+1 with its parent"

@@ -131,6 +131,17 @@ class Scene(SceneBase):
                 out.append((f"body {k}", liquid.describe(b.cavity)))
         return out
 
+    def unused(self) -> list[str]:
+        """Notes on values the scene gives that the model does not use: ``s`` on the top body of a chain (it has no
+        joint above it; docs/model.md).  Not refused: a chain of identical bodies is naturally written with s on each."""
+        top = self.bodies[-1]
+        if self.topology is not None or top.s == 0.0 or "s" in {a.name for a in self.grid}:
+            return []
+        n = self.n
+        what = "a single body has" if n == 1 else f"body {n} is the top of the chain and has"
+        return [f"note: bodies[{n}].s = {top.s:g} is not used: {what} no joint above it (s is the distance from a body's "
+                "lower joint to the joint of the body above it)"]
+
     def with_grid(self, grid: tuple[Axis, ...]) -> Scene:
         # modes = "auto" chose its count from this grid's extremes; a subset keeps that count, and so its labels.
         bodies = tuple(b if b.cavity is None or b.cavity.modes != liquid.AUTO
@@ -265,12 +276,7 @@ def _validate(scene: Scene) -> None:
         raise StabmapError(_G_FREE)
     joints = tuple(scene.joints)
     if joints and len(joints) != n - 1:
-        if tree is not None:
-            raise StabmapError(
-                f"joints has {len(joints)} values; a tree of {n} bodies has {n - 1} joints between bodies "
-                f"(K_1..K_{n - 1}, K_k the joint of body k+1 with its parent)"
-            )
-        raise StabmapError(f"joints has {len(joints)} values; a chain of {n} bodies has {n - 1} joints (K_1..K_{n - 1})")
+        raise StabmapError(_joints_count(len(joints), n, tree is not None))
     put("joints", tuple(check_value(f"joints[{i + 1}] (K_{i + 1})", v, JOINT) for i, v in enumerate(joints)))
     K_0 = check_value("K_0", scene.K_0, BASE)
     if K_0 and scene.free:
@@ -286,6 +292,18 @@ def _validate(scene: Scene) -> None:
     _check_omega(scene)
     _check_one_liquid_model(scene)
     put("bodies", _check_cavities(scene))
+
+
+def _joints_count(given: int, n: int, tree: bool) -> str:
+    """What is wrong with ``given`` joint stiffnesses for ``n`` bodies, in words that count right."""
+    values = f"joints has {given} value{'s' if given != 1 else ''}"
+    if n == 1:
+        return f"{values}, but one body has no joint between bodies (its base joint is K_0); remove joints"
+    names = "K_1" if n == 2 else f"K_1..K_{n - 1}"
+    what = "tree" if tree else "chain"
+    whose = ", K_k the joint of body k+1 with its parent" if tree else ""
+    return (f"{values}; a {what} of {n} bodies has {n - 1} joint{'s' if n > 2 else ''} between bodies ({names}{whose}); "
+            "give one stiffness per joint")
 
 
 def _checked_body(b: Body, k: int, tree: bool) -> Body:
@@ -309,8 +327,11 @@ def _checked_body(b: Body, k: int, tree: bool) -> Body:
     E = tuple(check_value(f"{where}.fluid.E[{i + 1}]", v, _E) for i, v in enumerate(b.E))
     kappa = tuple(check_value(f"{where}.fluid.kappa[{i + 1}]", v, _KAPPA) for i, v in enumerate(b.kappa))
     for i, v in enumerate(kappa):
-        if v == 0.0:
-            raise StabmapError(f"{where}.fluid.kappa[{i + 1}] must be nonzero (lambda = 2 omega / kappa)")
+        # An inertial wave of a liquid spinning at omega has a frequency below 2 omega in the rotating frame
+        # (Greenspan 1968, 2.7), and lambda = 2 omega / kappa is that frequency: so |kappa| > 1, as a cavity's table.
+        if abs(v) <= 1.0:
+            raise StabmapError(f"{where}.fluid.kappa[{i + 1}] = {v:g}: a liquid mode has |kappa| > 1 (its frequency in the body, "
+                               "2 omega / kappa, is below 2 omega; docs/cavities.md)")
     cavity = None if b.cavity is None else liquid.check(b.cavity, f"{where}.cavity")
     return Body(omega=omega, E=E, kappa=kappa, cavity=cavity, **values)
 
@@ -322,6 +343,11 @@ def _axis_name(name: str, n: int, support: str, tree: bool):
         raise StabmapError(
             f"grid axis {name!r} has no effect in a scene with [topology]: joints sit at topology.at; "
             "scan at_k, the position of body k's joint on its parent's axis"
+        )
+    if not tree and parsed.symbol == "s" and parsed.kind == "body" and parsed.index == n:
+        raise StabmapError(
+            f"grid axis {name!r} has no effect: s_k is the distance to the joint of the body above body k, and body {n} "
+            "is the top of the chain; scan s_k of a lower body"
         )
     if not tree and parsed.kind == "position":
         raise StabmapError(
