@@ -11,6 +11,7 @@ bounded whatever the size of the atlas.  A file is written to a temporary name a
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from pathlib import Path
 from typing import TextIO
 
@@ -53,9 +54,8 @@ def write_csv(ds: xr.Dataset, out: TextIO, *, points: int = READ_CHUNK_POINTS) -
             header.append(f"{d} [{shown.display_unit(ds, d)}]")
     header += [_header(ds, k) for k in extra] + [_header(ds, k) for k in names]
     out.write(",".join(header) + "\n")
-    if not axes:
-        slabs = [ds]
-    else:
+    slabs: Iterable[xr.Dataset] = [ds]
+    if axes:
         rest = int(np.prod([ds.sizes[d] for d in axes[1:]], dtype=np.int64)) if len(axes) > 1 else 1
         step = max(1, points // max(rest, 1))
         slabs = (ds.isel({axes[0]: slice(i, i + step)}) for i in range(0, ds.sizes[axes[0]], step))

@@ -48,7 +48,8 @@ def _attrs(ds, crit, along: str, axes, kind: str, label, system) -> dict:
     gaps = int(np.sum(crit["n_undecided"].values))
     return {
         "title": ds.attrs.get("title", ""), "stabmap_query": kind, "label": label.name, "label_symbol": system.label_symbol,
-        "label_fill": label.fill, "along": along, "along_units": units, "along_display_units": shown.display_unit(ds, along), "along_range": [float(x.min()), float(x.max())],
+        "label_fill": label.fill, "along": along, "along_units": units, "along_display_units": shown.display_unit(ds, along),
+        "along_range": [float(x.min()), float(x.max())],
         "along_grid_values": int(x.size), "selection": selection_text(axes),
         "fixed_axes": fixed_names(axes), "located": 1, "n_undecided": gaps,
         "located_by": f"located to {RTOL:g} relative by critical values of the atlas's scene (docs/critical.md)",

@@ -9,6 +9,8 @@ display unit named beside), as the variables are.
 
 from __future__ import annotations
 
+import functools
+
 import xarray as xr
 
 from ..scene import units as spin_units
@@ -16,10 +18,31 @@ from ..scene.units import unit_suffix
 
 
 def display_unit(ds: xr.Dataset | None, name: str) -> str:
-    """The unit ``name`` is shown in, "rpm" or "Hz", or "" (its stored units)."""
-    if ds is None or name not in ds.variables:
+    """The unit ``name`` is shown in, "rpm" or "Hz", or "" (its stored units): the ``display_units`` of its
+    coordinate, else (critical values keep no coordinate of the scanned axis) that of the stored scene's axis."""
+    if ds is None:
         return ""
-    return str(ds[name].attrs.get("display_units", "") or "")
+    if name in ds.variables and ds[name].attrs.get("display_units"):
+        return str(ds[name].attrs["display_units"])
+    return _scene_units(ds).get(name, "")
+
+
+def _scene_units(ds: xr.Dataset) -> dict[str, str]:
+    """``{axis: display unit}`` of the scene stored in ``ds`` (none if there is none, or it does not read)."""
+    text = ds.attrs.get("scene")
+    return dict(_units_of_scene(str(text))) if text else {}
+
+
+@functools.lru_cache(maxsize=8)
+def _units_of_scene(text: str) -> tuple[tuple[str, str], ...]:
+    from .. import systems
+    from ..errors import StabmapError
+
+    try:
+        scene = systems.loads_scene(text, "the stored scene")
+    except (StabmapError, OSError, ValueError):
+        return ()
+    return tuple((a.name, a.display_units) for a in getattr(scene, "grid", ()) if getattr(a, "display_units", ""))
 
 
 def stored_units(ds: xr.Dataset | None, name: str) -> str:
