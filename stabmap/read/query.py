@@ -261,7 +261,7 @@ def select(ds: xr.Dataset, sel: dict, *, along: str | None = None, nearest_edge:
             if not keep.any():
                 raise StabmapError(
                     f"{name} in [{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}] holds no grid "
-                    f"value; the {grid.size} grid values of {name} run from {shown.span_text(grid.min(), grid.max(), units, disp)}"
+                    f"value; the {grid.size} grid values of {name} run from {shown.span_text(grid.min(), grid.max(), units, disp, sep=' to ')}"
                 )
             index[name] = _contiguous(np.flatnonzero(keep))
             axes[name] = AxisSelection(name, units, requested, tuple(float(v) for v in grid[keep]), display_units=disp, via=via)

@@ -74,12 +74,12 @@ def axis_value(ds: xr.Dataset | None, name: str, value: float, digits: int = 8) 
     return value_text(value, stored_units(ds, name), display_unit(ds, name), digits)
 
 
-def span_text(lo: float, hi: float, units: str, display: str = "", digits: int = 8) -> str:
-    """``8000 .. 20000 rpm (837.75804 .. 2094.3951 rad s-1)``, or ``1 .. 150 rad s-1``."""
-    si = f"{number(lo, digits)} .. {number(hi, digits)}{unit_suffix(units)}"
+def span_text(lo: float, hi: float, units: str, display: str = "", digits: int = 8, sep: str = " .. ") -> str:
+    """``8000 .. 20000 rpm (837.75804 .. 2094.3951 rad s-1)``, or ``1 .. 150 rad s-1`` (``sep`` between the ends)."""
+    si = f"{number(lo, digits)}{sep}{number(hi, digits)}{unit_suffix(units)}"
     if not display:
         return si
-    return f"{number(in_display(lo, display), digits)} .. {number(in_display(hi, display), digits)} {display} ({si})"
+    return f"{number(in_display(lo, display), digits)}{sep}{number(in_display(hi, display), digits)} {display} ({si})"
 
 
 def header_units(units: str, display: str = "") -> str:
