@@ -83,7 +83,7 @@ def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
     lines = []
     for k, v in label.requested.items():
         note = " (outside the scan: nearest edge, as asked)" if k in label.outside else ""
-        asked = (f"{label.via[k]}; {k}" if k in label.via
+        asked = (f"{label.via[k]}\n{k}" if k in label.via
                  else f"{k} = {shown.value_text(v, shown.stored_units(atlas, k), shown.display_unit(atlas, k), 6)}")
         lines.append(f"{asked} -> nearest grid point {shown.axis_value(atlas, k, label.grid_point[k])}" + note)
     for k, v in label.derived.items():  # functions of the grid axes (S_g, a moved half height): at the grid point used
