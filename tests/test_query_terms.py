@@ -255,3 +255,14 @@ def test_the_whole_atlas_as_csv_one_row_per_grid_point(shell_file, shell, tmp_pa
 def test_the_answers_render_the_same_from_python(shell):
     text = render(stabmap.label_at(shell, omega="100 rpm", m_1=1), atlas=shell)
     assert text.splitlines()[0] == f"omega = 100 rpm ({100 * RPM:.6g} rad s-1) -> nearest grid point 100 rpm ({100 * RPM:.8g} rad s-1)"
+
+
+def test_a_monotone_derived_quantity_becomes_an_axis_for_plots(shell):
+    from stabmap.read.derived import as_axis
+
+    swapped = as_axis(shell, "S_g")
+    assert swapped["n_complex_pairs"].dims == ("S_g", "m_1")
+    np.testing.assert_array_equal(swapped["omega"].values, shell["omega"].values)
+    assert ((swapped["n_complex_pairs"].sel(m_1=1.0).values == 0) == (swapped["S_g"].values >= 1)).all()
+    with pytest.raises(stabmap.StabmapError, match="no derived quantity"):
+        as_axis(shell, "m_1")

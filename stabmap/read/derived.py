@@ -92,3 +92,14 @@ def within(value: float, lo: float, hi: float) -> bool:
     """``lo <= value <= hi``, up to the 8 significant digits the text prints (a value copied from it is inside)."""
     slack = 1e-7 * max(abs(lo), abs(hi))
     return lo - slack <= value <= hi + slack
+
+
+def as_axis(ds: xr.Dataset, name: str) -> xr.Dataset:
+    """``ds`` with the derived quantity ``name`` as the index of the grid axis it is monotone along (for a plot
+    against S_g, say: ``as_axis(ds, "S_g")`` then has the dimension S_g where it had omega); the axis's values stay
+    a coordinate. A StabmapError, as :func:`along`, where ``name`` is not monotone along one axis."""
+    known = names(ds, [str(d) for d in ds.dims])
+    if name not in known:
+        raise StabmapError(f"{name!r} is no derived quantity of this atlas; those it has: {', '.join(known) or '(none)'}")
+    axis, _, _ = along(ds, name)
+    return ds.swap_dims({axis: name})
