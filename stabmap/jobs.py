@@ -290,7 +290,7 @@ def query(
             question = asked[0] if asked else "--locate" if locate else "--over"
             raise StabmapError(f"{path} holds critical values, not an atlas, and {question} asks an atlas; 'stabmap query {path}' "
                                "(--csv or --json; NAME=VALUE picks lines) lists its stable intervals and boundaries")
-        return _answer(render_table(select_lines(ds, sel), fmt, limit=limit), output)
+        return _answer(render_table(select_lines(ds, sel, nearest_edge=nearest_edge), fmt, limit=limit), output)
     if roots:
         from .read.roots import roots as roots_at
 

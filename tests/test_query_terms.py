@@ -116,6 +116,9 @@ def test_critical_values_are_printed_in_rpm(capsys, tmp_path):
     stabmap.write_atlas(crit, path)
     code, out, _ = run(capsys, "query", path)
     assert code == 0 and "omega lower [rpm (rad s-1)]" in out.splitlines()[1]
+    code, _, err = run(capsys, "query", path, "m_1=3")  # outside the scan of the other axis: refused, as for an atlas
+    assert code == 2 and "m_1 = 3 kg lies outside the scan of m_1" in err
+    assert run(capsys, "query", path, "m_1=3", "--nearest-edge")[0] == 0
 
 
 # --- 2. every printed value carries its unit -------------------------------------------------------------------

@@ -233,10 +233,12 @@ def critical_summary(ds: xr.Dataset) -> dict:
     return out
 
 
-def select_lines(ds: xr.Dataset, sel: dict) -> xr.Dataset:
+def select_lines(ds: xr.Dataset, sel: dict, *, nearest_edge: bool = False) -> xr.Dataset:
     """The lines of a critical-values Dataset that ``sel`` selects: ``{axis: number}`` keeps the grid value nearest
-    to it, ``{axis: (lo, hi)}`` (None: open) the grid values in [lo, hi]; every axis stays a dimension."""
-    from .query import requested_value
+    to it (outside the scan an error, unless ``nearest_edge``), ``{axis: (lo, hi)}`` (None: open) the grid values in
+    [lo, hi]; every axis stays a dimension."""
+    from .derived import within
+    from .query import outside_error, requested_value
 
     along = check_critical(ds, "a selection of critical values")
     dims = list(ds["n_stable_intervals"].dims)
@@ -255,6 +257,8 @@ def select_lines(ds: xr.Dataset, sel: dict) -> xr.Dataset:
                                    f"{grid.min():.8g} to {grid.max():.8g} {_units(ds, name)}".rstrip())
             index[name] = keep
         else:
+            if not nearest_edge and not within(requested, float(grid.min()), float(grid.max())):
+                raise outside_error(ds, name, requested, grid)
             index[name] = [int(np.argmin(np.abs(grid - requested)))]
     return ds.isel(index) if index else ds
 
