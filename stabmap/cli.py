@@ -117,6 +117,7 @@ examples:
   stabmap query a.nc --smallest-stable omega=0: --csv      ... of positive spin rates only, as CSV
   stabmap query a.nc --boundaries omega K_1=3 --locate     every change, however narrow, located to 1e-10
   stabmap query crit.nc --csv -o crit.csv                  critical values: every stable interval and boundary
+  stabmap query a.nc --csv -o a.csv                        the whole atlas: one row per grid point
   stabmap query a.nc omega=42.5 K_1=3 --roots              every root there, enclosed, with kind and origin
 \b
 Without --locate, boundaries are known to grid resolution only; --locate computes critical values of the
@@ -136,9 +137,11 @@ atlas's scene along the selected lines: complete, and located to 1e-10 (docs/cri
 @click.option("--csv", "fmt", flag_value="csv", help="print CSV (every row)")
 @click.option("--json", "fmt", flag_value="json", help="print JSON (every row)")
 @click.option("--limit", type=int, default=40, metavar="N", help="rows of a text table (default 40; 0: all)")
-@click.option("-o", "--output", metavar="FILE", help="write the answer to FILE (atomically) instead of printing it")
+@click.option("-o", "--output", metavar="FILE", help="write the answer to FILE (atomically) instead of printing it; "
+              "its suffix picks the format (.txt, .csv, .json)")
+@click.option("--nearest-edge", is_flag=True, help="a value outside the scan takes its nearest end (otherwise an error)")
 @_overwrite
-def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, roots, fmt, limit, output, overwrite):
+def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, roots, fmt, limit, output, nearest_edge, overwrite):
     """Ask a saved atlas: the label at a point, the stable fraction, boundaries, the smallest stable value.
 
     NAME=VALUE selects the grid value of NAME nearest to VALUE (the value used is printed); NAME=LO:HI keeps the
@@ -148,8 +151,10 @@ def query(atlas, items, fraction, boundaries, smallest_stable, over, locate, roo
 
     # a question's axis is the library's along: name the flag that gave it
     with cli_spelling({**FLAGS, "along": "--boundaries" if boundaries is not None else "--smallest-stable"}):
-        click.echo(jobs.query(atlas, items, fraction=fraction, boundaries=boundaries, smallest_stable=smallest_stable,
-                              over=over, locate=locate, roots=roots, fmt=fmt or "text", limit=limit, output=output, overwrite=overwrite))
+        text = jobs.query(atlas, items, fraction=fraction, boundaries=boundaries, smallest_stable=smallest_stable, over=over,
+                          locate=locate, roots=roots, fmt=fmt, limit=limit, output=output, overwrite=overwrite, nearest_edge=nearest_edge)
+    if text is not None:  # None: every grid point was streamed to standard output
+        click.echo(text)
 
 
 @cli.command(short_help="Draw an atlas (or critical values) to a PNG or PDF file, or an interactive HTML page.")

@@ -232,12 +232,13 @@ def query(
     over: str | None = None,
     locate: bool = False,
     roots: bool = False,
-    fmt: str = "text",
+    fmt: str | None = None,
     limit: int = 40,
     progress: bool | None = None,
     output: str | Path | None = None,
     overwrite: bool = False,
-) -> str:
+    nearest_edge: bool = False,
+) -> str | None:
     """``stabmap query``: the label at a point, or the answer to one question about a slice (docs/query.md).
 
     ``items`` are ``NAME=VALUE`` or ``NAME=LO:HI``; a question's axis may also come first among them.
@@ -245,10 +246,13 @@ def query(
     ``locate``: answer --boundaries and --smallest-stable with critical values of the atlas's scene (complete,
     located to 1e-10: ``stabmap.read.located``) instead of the grid.
     A critical-values file answers with its table (``stabmap.read.table``): every stable interval, boundary and gap.
-    ``output``: write the answer to this file (atomically; an existing one only if ``overwrite``) instead of returning it.
+    ``output``: write the answer to this file (atomically; an existing one only if ``overwrite``) instead of returning it;
+    without ``fmt``, its suffix chooses the format (``.csv``: CSV). ``nearest_edge``: a value outside the scan takes its
+    nearest end (otherwise an error). ``fmt="csv"`` with no point and no question: every grid point, one row each
+    (``stabmap.read.export``), streamed to ``output`` or to standard output (then None is returned).
     """
     from .read import query as q
-    from .read.report import render
+    from .read.report import output_format, render
     from .store.dataset import is_critical
     from .store.files import check_new_output, open_atlas
 
@@ -271,8 +275,19 @@ def query(
             smallest_stable = ""  # the system's default axis
     if output is not None:
         check_new_output(output, overwrite)
+    fmt = output_format(fmt, output)
     ds = open_atlas(path, lazy=True)  # read chunk by chunk: bounded memory at any size
     sel = q.parse_selection(items)
+    if fmt == "csv" and not items and not asked and not is_critical(ds):  # the whole atlas, one row per grid point
+        from .read import export
+
+        if output is None:
+            import sys
+
+            export.write_csv(ds, sys.stdout)
+            return None
+        _, rows = export.save_csv(ds, output)
+        return f"wrote {output}: {rows} rows, one per grid point"
     if is_critical(ds):
         from .read.table import render_table, select_lines
 
@@ -280,7 +295,7 @@ def query(
             question = asked[0] if asked else "--locate" if locate else "--over"
             raise StabmapError(f"{path} holds critical values, not an atlas, and {question} asks an atlas; 'stabmap query {path}' "
                                "(--csv or --json; NAME=VALUE picks lines) lists its stable intervals and boundaries")
-        return _answer(render_table(select_lines(ds, sel), fmt, limit=limit), output)
+        return _answer(render_table(select_lines(ds, sel, nearest_edge=nearest_edge), fmt, limit=limit), output)
     if roots:
         from .read.roots import roots as roots_at
 
@@ -292,23 +307,23 @@ def query(
         from .read import located
 
         if boundaries is not None:
-            result = located.located_boundaries(ds, boundaries, progress=progress, **sel)
+            result = located.located_boundaries(ds, boundaries, progress=progress, nearest_edge=nearest_edge, **sel)
         else:
-            result = located.located_smallest_stable(ds, smallest_stable or None, over, progress=progress, **sel)
+            result = located.located_smallest_stable(ds, smallest_stable or None, over, progress=progress, nearest_edge=nearest_edge, **sel)
     elif boundaries is not None:
-        result = q.boundaries(ds, boundaries, **sel)
+        result = q.boundaries(ds, boundaries, nearest_edge=nearest_edge, **sel)
     elif smallest_stable is not None:
-        result = q.smallest_stable(ds, smallest_stable or None, over, **sel)
+        result = q.smallest_stable(ds, smallest_stable or None, over, nearest_edge=nearest_edge, **sel)
     elif fraction:
-        result = q.stable_fraction(ds, **sel)
+        result = q.stable_fraction(ds, nearest_edge=nearest_edge, **sel)
     else:
         if not items:
             axes = " ".join(f"{d}=VALUE" for d in q.grid_axes(ds))
             raise StabmapError(
                 f"give the point: {axes} (nearest grid point), or ask --fraction, --boundaries AXIS or "
-                "--smallest-stable [AXIS]; see 'stabmap query --help'"
+                "--smallest-stable [AXIS], or --csv for every grid point; see 'stabmap query --help'"
             )
-        result = q.label_at(ds, **sel)
+        result = q.label_at(ds, nearest_edge=nearest_edge, **sel)
     return _answer(render(result, fmt, limit=limit, atlas=ds), output)
 
 

@@ -196,7 +196,7 @@ def test_info_all_and_limit(crit_file, crit, capsys):
         assert code == 0 and len(shown) == 6 and "more points" not in out
         for line in shown:  # "c_1 = 0.1, m_1 = 0.5: stable omega [rad s-1] -60 (scan start) to -7.38... (boundary); ..."
             where, _, text = line.partition(": stable omega [rad s-1] ")
-            c, m = (float(part.split(" = ")[1]) for part in where.split(", "))
+            c, m = (float(part.split(" = ")[1].split()[0]) for part in where.split(", "))
             n = _expected_intervals(c, m)
             assert (text == "nowhere in the scan") == (n == 0)
             if n:

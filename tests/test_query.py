@@ -70,7 +70,7 @@ def test_stable_fraction_counts_the_closed_form(top, expected):
     assert whole.unstable == expected.size - expected.sum() and whole.degenerate == 0 and whole.inferred == 0
     assert whole.selected == {"omega": (-60.0, 60.0), "c_1": (-0.1, 1.0)}
     for j, c in enumerate(C1):
-        f = stabmap.stable_fraction(top, c_1=c + 0.01)  # nearest grid value
+        f = stabmap.stable_fraction(top, c_1=c + 0.01 if c < 1 else c - 0.01)  # nearest grid value, inside the scan
         assert f.axes["c_1"].fixed and f.selected["c_1"] == c
         assert (f.stable, f.points) == (int(expected[:, j].sum()), OMEGA.size)
     assert stabmap.stable_fraction(top, c_1=-0.1).fraction == 1.0
@@ -90,10 +90,12 @@ def test_stable_fraction_of_ranges(top, expected):
     assert positive.stable == int(expected[OMEGA >= 0].sum())
 
 
-def test_nearest_outside_the_grid_is_said(top):
-    f = stabmap.stable_fraction(top, c_1=5.0)
+def test_outside_the_scan_is_an_error_unless_the_nearest_edge_is_asked(top):
+    with pytest.raises(stabmap.StabmapError, match=r"c_1 = 5 m lies outside the scan of c_1, -0.1 \.\. 1 m; .* --nearest-edge"):
+        stabmap.stable_fraction(top, c_1=5.0)
+    f = stabmap.stable_fraction(top, c_1=5.0, nearest_edge=True)
     assert f.axes["c_1"].outside and f.selected["c_1"] == 1.0
-    assert "outside the grid" in f.axes["c_1"].describe()
+    assert "outside the scan: nearest edge, as asked" in f.axes["c_1"].describe()
 
 
 # --- boundaries -----------------------------------------------------------------------------------------------
@@ -178,8 +180,8 @@ def test_three_axes_over_one_needs_the_others_fixed():
     )
     with pytest.raises(stabmap.StabmapError, match=r"over='c_1': fix the other axes as well \(m_1=1"):
         stabmap.smallest_stable(ds, "omega", over="c_1")
-    s = stabmap.smallest_stable(ds, "omega", over="c_1", m_1=2.2)
-    assert float(s["m_1"]) == 2.0 and "m_1 = 2.2 -> nearest grid value 2 kg" in s.attrs["selection"]
+    s = stabmap.smallest_stable(ds, "omega", over="c_1", m_1=1.9)
+    assert float(s["m_1"]) == 2.0 and "m_1 = 1.9 kg -> nearest grid value 2 kg" in s.attrs["selection"]
     every = stabmap.smallest_stable(ds, "omega")
     assert every["smallest_stable"].dims == ("c_1", "m_1")
     for c in (0.1, 0.2):
@@ -305,12 +307,12 @@ def test_cli_label_keeps_its_form(atlas_file, capsys):
     code, out, _ = run(capsys, atlas_file, "omega=42.4", "c_1=0.1")
     assert code == 0
     assert out.splitlines() == [
-        "omega = 42.4 -> nearest grid point 42.5 rad s-1",
-        "c_1 = 0.1 -> nearest grid point 0.1 m",
+        "omega = 42.4 rad s-1 -> nearest grid point 42.5 rad s-1",
+        "c_1 = 0.1 m -> nearest grid point 0.1 m",
         "n_complex_pairs = 0",
         "stability = stable (decided by interval sturm sequence)",
-        "growth_rate = 0 (proved in [0, 0])",
-        "efolding_time = inf",
+        "growth_rate = 0 s-1 (proved in [0, 0] s-1)",
+        "efolding_time = inf s",
         "growth_rate_method = all_roots_real",
         "cell = node_only (the label is proved at the grid point only; at the requested point it is not decided)",
     ]
@@ -323,7 +325,7 @@ def test_cli_fraction(atlas_file, expected, capsys):
     code, out, _ = run(capsys, atlas_file, "--fraction", "c_1=0.21")
     n = int(expected[:, j].sum())
     assert code == 0
-    assert f"{n} of 97 grid points stable" in out and "c_1 = 0.21 -> nearest grid value 0.2 m" in out
+    assert f"{n} of 97 grid points stable" in out and "c_1 = 0.21 m -> nearest grid value 0.2 m" in out
     assert "omega: all 97 grid values, -60 .. 60 rad s-1" in out and "inferred: 0" in out
     code, out, _ = run(capsys, atlas_file, "--fraction", "omega=0:", "--json")
     data = json.loads(out)
@@ -356,7 +358,7 @@ def test_cli_smallest_stable(atlas_file, capsys):
     code, out, _ = run(capsys, atlas_file, "--smallest-stable", "omega", "omega=0:", "--over", "c_1")
     assert code == 0
     lines = out.splitlines()
-    assert lines[0] == "smallest stable omega [rad s-1], searched upward over 49 grid values 0 .. 60"
+    assert lines[0] == "smallest stable omega [rad s-1], searched upward over 49 grid values 0 .. 60 rad s-1"
     first = next(w for w in OMEGA if w >= 0 and maievskii_stable(w, 0.1))
     assert any(line.split()[:5] == ["0.1", f"{first:g}", f"{first - 1.25:g}", "1", "yes"] for line in lines)
     assert any(line.split()[:2] == ["1", "none"] for line in lines)

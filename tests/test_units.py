@@ -157,7 +157,7 @@ def test_cli_queries_in_rpm(rpm_file, in_rpm, capsys):
     assert main(["query", str(rpm_file), "omega=110 rpm", "c_1=0.1"]) == 0
     nearest = omega[np.argmin(np.abs(omega - exact_si("110", "rpm")))]
     out = capsys.readouterr().out
-    assert f"nearest grid point {nearest:.8g} rad s-1" in out
+    assert f"nearest grid point {nearest / exact_si('1', 'rpm'):.8g} rpm ({nearest:.8g} rad s-1)" in out
     assert ("n_complex_pairs = 0" in out) == maievskii_stable(nearest, 0.1)
     # a range with one unit for both ends, and the same range with a unit on each
     # (ends between grid values, 5 rpm apart: which side a grid value falls on does not hang on a rounding)

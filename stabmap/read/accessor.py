@@ -36,11 +36,11 @@ class StabmapAccessor:
     def __init__(self, ds: xr.Dataset) -> None:
         self._ds = ds
 
-    def label_at(self, **point: float):
+    def label_at(self, *, nearest_edge: bool = False, **point):
         """Every variable at the grid point nearest to ``point``: :func:`stabmap.label_at`."""
         from .query import label_at
 
-        return label_at(self._ds, **point)
+        return label_at(self._ds, nearest_edge=nearest_edge, **point)
 
     def stable_fraction(self, **sel):
         """The fraction of stable grid points in a slice: :func:`stabmap.stable_fraction`."""

@@ -14,6 +14,7 @@ from ..scene import units
 from ..scene.units import unit_suffix
 from ..store.dataset import is_critical
 from ..systems.stages import CELLS, LABELS
+from . import shown as in_units
 from .summary import summary
 
 WIDTH = 100  # characters a line of ``stabmap info`` may take
@@ -76,7 +77,8 @@ def describe(ds: xr.Dataset, name: str = "", limit: int = 8) -> str:
         from .table import counts_line, critical_summary
 
         dims = list(ds["n_stable_intervals"].dims)
-        counts = textwrap.wrap(counts_line(critical_summary(ds), dims), width=WIDTH, initial_indent="  ", subsequent_indent="    ")
+        line = counts_line(critical_summary(ds), dims, in_units.display_unit(ds, str(ds.attrs["critical_along"])))
+        counts = textwrap.wrap(line, width=WIDTH, initial_indent="  ", subsequent_indent="    ")
         return "\n".join([head, *comment, *counts, *intervals(ds, limit)])
     system = systems.of_atlas(ds.attrs)
     s = summary(ds)
@@ -236,20 +238,28 @@ def intervals(ds: xr.Dataset, limit: int = 8) -> list[str]:
         g = ds[["n_undecided", "undecided_lower", "undecided_upper"]]
         g = g.stack(point=dims) if dims else g.expand_dims(point=[0])
         gaps = g["n_undecided"].values, g["undecided_lower"].transpose("point", "gap").values, g["undecided_upper"].transpose("point", "gap").values
+    disp = in_units.display_unit(ds, along)
+
+    def end(value: float, what: str) -> str:  # a spin rate in its display unit first, the stored value beside
+        if not disp:
+            return f"{value:.10g} ({what})"
+        return f"{in_units.in_display(value, disp):.10g} {disp} ({value:.10g}{unit_suffix(units)}, {what})"
+
     lines = []
     for p, label in enumerate(table["point"].values[:limit or None]):
-        where = ", ".join(f"{d} = {v:g}" for d, v in zip(dims, label, strict=True)) if dims else "the scene"
+        where = ", ".join(f"{d} = {in_units.axis_value(ds, d, v)}" for d, v in zip(dims, label, strict=True)) if dims else "the scene"
         parts = [
-            f"{lo[p, k]:.10g} ({'scan start' if np.isnan(olo[p, k]) else 'boundary'}) to "
-            f"{hi[p, k]:.10g} ({'scan end' if np.isnan(ohi[p, k]) else 'boundary'})"
+            f"{end(lo[p, k], 'scan start' if np.isnan(olo[p, k]) else 'boundary')} to "
+            f"{end(hi[p, k], 'scan end' if np.isnan(ohi[p, k]) else 'boundary')}"
             for k in range(lo.shape[1])
             if np.isfinite(lo[p, k])
         ]
-        shown = f" [{unit_suffix(units).strip()}]" if unit_suffix(units) else ""
-        lines.append(f"{where}: stable {along}{shown} " + ("; ".join(parts) if parts else "nowhere in the scan"))
+        head = "" if disp else f" [{unit_suffix(units).strip()}]" if unit_suffix(units) else ""
+        lines.append(f"{where}: stable {along}{head} " + ("; ".join(parts) if parts else "nowhere in the scan"))
         if gaps is not None and gaps[0][p]:
             n = int(gaps[0][p])
-            pieces = [f"{a:.10g} to {b:.10g}" for a, b in zip(gaps[1][p, :n][:gaps_shown], gaps[2][p, :n][:gaps_shown], strict=True)]
+            ends = zip(gaps[1][p, :n][:gaps_shown], gaps[2][p, :n][:gaps_shown], strict=True)
+            pieces = [in_units.span_text(a, b, units, disp, 10) if disp else f"{a:.10g} to {b:.10g}" for a, b in ends]
             more = f" and {n - gaps_shown} more (--all lists every one)" if gaps_shown and n > gaps_shown else ""
             lines.append(f"  not proved inside {n} gap{'s' if n > 1 else ''}: " + "; ".join(pieces) + more)
     if limit and lo.shape[0] > limit:

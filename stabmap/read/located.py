@@ -17,18 +17,19 @@ import xarray as xr
 from .. import systems
 from ..errors import StabmapError, given
 from ..scene.grid import Axis
+from . import shown
 from .query import check_axis, fixed_coords, fixed_names, grid_axes, select, selection_text, stable_system
 
 RTOL = 1e-10
 
 
-def _critical(ds: xr.Dataset, along: str, sel: dict, progress: bool | None, threads: int | None):
+def _critical(ds: xr.Dataset, along: str, sel: dict, progress: bool | None, threads: int | None, nearest_edge: bool = False):
     """Critical values along ``along`` of the lines ``sel`` selects: (Dataset with the other axes' dims, axes)."""
     from ..run.critical import critical
 
     if "scene" not in ds.attrs:
         raise StabmapError("this atlas holds no scene (attribute 'scene'), so its boundaries cannot be located; use the grid answer")
-    sub, axes = select(ds, sel, along=along)
+    sub, axes = select(ds, sel, along=along, nearest_edge=nearest_edge)
     scene = systems.loads_scene(str(ds.attrs["scene"]), "the atlas's scene")
     grid = []
     for axis in scene.grid:
@@ -47,14 +48,16 @@ def _attrs(ds, crit, along: str, axes, kind: str, label, system) -> dict:
     gaps = int(np.sum(crit["n_undecided"].values))
     return {
         "title": ds.attrs.get("title", ""), "stabmap_query": kind, "label": label.name, "label_symbol": system.label_symbol,
-        "label_fill": label.fill, "along": along, "along_units": units, "along_range": [float(x.min()), float(x.max())],
+        "label_fill": label.fill, "along": along, "along_units": units, "along_display_units": shown.display_unit(ds, along),
+        "along_range": [float(x.min()), float(x.max())],
         "along_grid_values": int(x.size), "selection": selection_text(axes),
         "fixed_axes": fixed_names(axes), "located": 1, "n_undecided": gaps,
         "located_by": f"located to {RTOL:g} relative by critical values of the atlas's scene (docs/critical.md)",
     }
 
 
-def located_boundaries(ds: xr.Dataset, along: str | None = None, /, *, progress: bool | None = None, threads: int | None = None, **sel) -> xr.Dataset:
+def located_boundaries(ds: xr.Dataset, along: str | None = None, /, *, progress: bool | None = None, threads: int | None = None,
+                       nearest_edge: bool = False, **sel) -> xr.Dataset:
     """Every change of the label along ``along`` in the selected lines, located to 1e-10 and complete.
 
     As ``query.boundaries`` (same variables and coordinates, one row per boundary), but ``boundary_lower`` and
@@ -66,7 +69,7 @@ def located_boundaries(ds: xr.Dataset, along: str | None = None, /, *, progress:
     along = check_axis(ds, along, dims)  # None: the system's default_axis
     system = systems.of_atlas(ds.attrs)
     label = system.variable(system.label)
-    crit, sub, axes = _critical(ds, along, sel, progress, threads)
+    crit, sub, axes = _critical(ds, along, sel, progress, threads, nearest_edge)
     others = [d for d in crit["boundary_lower"].dims if d not in ("boundary",)]
     table = crit[["boundary_lower", "boundary_upper", f"{label.name}_below", f"{label.name}_above"]]
     table = table.stack(row=others + ["boundary"]) if others else table.rename({"boundary": "row"})
@@ -101,7 +104,7 @@ def located_boundaries(ds: xr.Dataset, along: str | None = None, /, *, progress:
 
 
 def located_smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | None = None, *, progress: bool | None = None,
-                            threads: int | None = None, **sel) -> xr.Dataset:
+                            threads: int | None = None, nearest_edge: bool = False, **sel) -> xr.Dataset:
     """The smallest stable value of ``along`` on each selected line, located to 1e-10 (``query.smallest_stable``'s
     layout): ``smallest_stable`` is the lower end of the first stable interval, ``unstable_below`` the value just
     below it, and ``undecided_below`` True where a stretch below it is not decided (a smaller stable value may
@@ -115,7 +118,7 @@ def located_smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: s
         extra = [d for d in dims if d not in (along, over) and d not in sel]
         if extra:
             raise StabmapError(f"{given('over', over)}: fix the other axes as well ({', '.join(f'{d}=...' for d in extra)})")
-    crit, sub, axes = _critical(ds, along, sel, progress, threads)
+    crit, sub, axes = _critical(ds, along, sel, progress, threads, nearest_edge)
     others = list(crit["n_stable_intervals"].dims)
     lower = crit[f"{along}_stable_lower"].isel(interval=0).values
     outer = crit[f"{along}_stable_lower_outer"].isel(interval=0).values

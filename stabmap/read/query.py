@@ -30,7 +30,7 @@ whatever the size of the atlas, and the answers are those of the atlas in memory
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -41,6 +41,7 @@ from ..errors import StabmapError, given, param
 from ..scene.units import common_unit, in_si, looks_like_rate, split
 from ..store.dataset import is_critical
 from ..store.variables import INFERRED
+from . import derived, shown
 from .blocks import changes, compute, first_true
 
 CRITICAL_HINT = "'stabmap critical SCENE --along {along}' locates the ends to 1e-10 (docs/critical.md)"
@@ -59,6 +60,8 @@ class Label:
     values: dict[str, object]
     outside: tuple[str, ...]  # axes on which the request lies outside the grid
     provenance: str | None = None  # the name of the variable that says how the point was decided
+    derived: dict[str, float] = field(default_factory=dict)  # derived quantities (S_g, ...) at the grid point
+    via: dict[str, str] = field(default_factory=dict)  # axes a derived quantity gave: how (stabmap.read.derived)
 
     def __getattr__(self, name: str):
         values = self.__dict__.get("values", {})
@@ -80,7 +83,9 @@ class AxisSelection:
     units: str
     requested: float | tuple[float | None, float | None] | None  # a number, a range (lo, hi), or None: whole axis
     values: tuple[float, ...]  # the grid values used, in grid order
-    outside: bool = False  # a number outside the grid's range: the nearest end was used
+    outside: bool = False  # a number outside the grid's range: the nearest end was used (only asked for: nearest_edge)
+    display_units: str = ""  # a spin-rate axis's display unit (rpm, Hz): the text shows it first, SI beside
+    via: str = ""  # the request came as a derived quantity (S_g = 2): how it became a value of this axis
 
     @property
     def fixed(self) -> bool:
@@ -93,19 +98,27 @@ class AxisSelection:
         return min(self.values), max(self.values)
 
     def describe(self) -> str:
-        """One line of text, e.g. ``K_1 = 3 -> nearest grid value 3.0150754 N m rad-1``."""
-        units = f" {self.units}" if self.units else ""
+        """One line of text, e.g. ``K_1 = 3 -> nearest grid value 3.0150754 N m rad-1``; a spin rate in its display
+        unit first (``omega = 12000 rpm (1256.6371 rad s-1) -> ...``)."""
+        units, disp = self.units, self.display_units
         req = self.requested
+        via = f"{self.via}; " if self.via else ""
         if req is not None and not isinstance(req, tuple):  # fixed (a local name, so the type checker narrows it)
-            note = " (outside the grid: nearest end)" if self.outside else ""
-            return f"{self.name} = {req:g} -> nearest grid value {self.values[0]:.8g}{units}{note}"
+            note = " (outside the scan: nearest edge, as asked)" if self.outside else ""
+            asked = f"{via}{self.name}" if self.via else f"{self.name} = {shown.value_text(req, units, disp, 6)}"
+            return f"{asked} -> nearest grid value {shown.value_text(self.values[0], units, disp)}{note}"
         lo, hi = self.bounds
         n = len(self.values)
-        span = f"{n} grid value{'s' if n != 1 else ''}, {lo:.8g} .. {hi:.8g}{units}"
+        span = f"{n} grid value{'s' if n != 1 else ''}, {shown.span_text(lo, hi, units, disp)}"
         if req is None:
             return f"{self.name}: all {span}"
         a, b = req
-        return f"{self.name} in [{'-inf' if a is None else f'{a:g}'}, {'inf' if b is None else f'{b:g}'}]: {span}"
+        ends = f"[{'-inf' if a is None else shown.number(_shown(a, disp), 6)}, {'inf' if b is None else shown.number(_shown(b, disp), 6)}]"
+        return f"{via}{self.name} in {ends}{' ' + disp if disp else ''}: {span}"
+
+
+def _shown(value: float, display: str) -> float:
+    return shown.in_display(value, display) if display else value
 
 
 @dataclass(frozen=True)
@@ -216,7 +229,7 @@ def requested_value(name: str, value, units: str = "") -> float | tuple[float | 
     return lo, hi
 
 
-def select(ds: xr.Dataset, sel: dict, *, along: str | None = None) -> tuple[xr.Dataset, dict[str, AxisSelection]]:
+def select(ds: xr.Dataset, sel: dict, *, along: str | None = None, nearest_edge: bool = False) -> tuple[xr.Dataset, dict[str, AxisSelection]]:
     """The slice of ``ds`` that ``sel`` asks for, and how every grid axis was selected.
 
     Parameters
@@ -225,17 +238,18 @@ def select(ds: xr.Dataset, sel: dict, *, along: str | None = None) -> tuple[xr.D
         An atlas.
     sel : dict
         ``{axis: number | (lo, hi) | slice(lo, hi)}`` (module docstring). A number removes the axis (it stays
-        as a scalar coordinate holding the grid value used); a range keeps the grid values inside it.
+        as a scalar coordinate holding the grid value used); a range keeps the grid values inside it. A derived
+        quantity (``S_g``) monotone along one grid axis stands for that axis (:mod:`stabmap.read.derived`).
     along : str, optional
         An axis that must stay an axis (boundaries, smallest_stable): a number for it is an error.
+    nearest_edge : bool
+        A number outside the scanned range takes the nearest end of the scan; without it, that is an error.
     """
     dims = grid_axes(ds)
     index, axes = {}, {}
-    for name, value in sel.items():
-        if name not in dims:
-            raise _not_an_axis(ds, name, dims)
+    for name, (requested, via) in _on_axes(ds, sel, dims, nearest_edge).items():
         units = str(ds[name].attrs.get("units", ""))
-        requested = requested_value(name, value, units)
+        disp = shown.display_unit(ds, name)
         grid = np.asarray(ds[name].values, dtype=np.float64)
         if isinstance(requested, tuple):
             lo, hi = requested
@@ -247,24 +261,75 @@ def select(ds: xr.Dataset, sel: dict, *, along: str | None = None) -> tuple[xr.D
             if not keep.any():
                 raise StabmapError(
                     f"{name} in [{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}] holds no grid "
-                    f"value; the {grid.size} grid values of {name} run from {grid.min():.8g} to {grid.max():.8g} {units}".rstrip()
+                    f"value; the {grid.size} grid values of {name} run from {shown.span_text(grid.min(), grid.max(), units, disp, sep=' to ')}"
                 )
             index[name] = _contiguous(np.flatnonzero(keep))
-            axes[name] = AxisSelection(name, units, requested, tuple(float(v) for v in grid[keep]))
+            axes[name] = AxisSelection(name, units, requested, tuple(float(v) for v in grid[keep]), display_units=disp, via=via)
         else:
             if name == along:
                 raise StabmapError(
                     f"{name}={requested:g} would fix {name}, the axis searched along; give a range instead, "
                     f"e.g. {name}=({grid.min():g}, {grid.max():g}), or leave {name} out"
                 )
+            outside = not via and not derived.within(requested, float(grid.min()), float(grid.max()))
+            if outside and not nearest_edge:
+                raise outside_error(ds, name, requested, grid)
             i = int(ds.indexes[name].get_indexer([requested], method="nearest")[0])
             index[name] = i
-            outside = not grid.min() <= requested <= grid.max()
-            axes[name] = AxisSelection(name, units, requested, (float(grid[i]),), outside)
+            axes[name] = AxisSelection(name, units, requested, (float(grid[i]),), outside or "nearest edge" in via,
+                                       display_units=disp, via=via)
     for d in dims:
         if d not in axes:
-            axes[d] = AxisSelection(d, str(ds[d].attrs.get("units", "")), None, tuple(float(v) for v in ds[d].values))
+            axes[d] = AxisSelection(d, str(ds[d].attrs.get("units", "")), None, tuple(float(v) for v in ds[d].values),
+                                    display_units=shown.display_unit(ds, d))
     return (ds.isel(index) if index else ds), {d: axes[d] for d in dims}
+
+
+def outside_error(ds: xr.Dataset, name: str, value: float, grid: np.ndarray) -> StabmapError:
+    """A number outside an axis's scan: one line with the value, the scan and the option that takes the nearest edge."""
+    units, disp = str(ds[name].attrs.get("units", "")), shown.display_unit(ds, name)
+    return StabmapError(
+        f"{name} = {shown.value_text(value, units, disp, 6)} lies outside the scan of {name}, "
+        f"{shown.span_text(float(grid.min()), float(grid.max()), units, disp)}; give a value inside it, or --nearest-edge "
+        "(Python: nearest_edge=True) to use the nearest end of the scan"
+    )
+
+
+def _on_axes(ds: xr.Dataset, sel: dict, dims: list[str], nearest_edge: bool) -> dict[str, tuple]:
+    """``sel`` with every entry on a grid axis: ``{axis: (number or (lo, hi), how a derived quantity gave it or "")}``."""
+    out: dict[str, tuple] = {}
+    made_by: dict[str, str] = {}
+    extra = derived.names(ds, dims)
+    for name, value in sel.items():
+        units = str(ds[name].attrs.get("units", "")) if name in ds.variables else ""
+        if name in dims:
+            axis, requested, via = name, requested_value(name, value, units), ""
+        elif name in extra:
+            requested = requested_value(name, value, units)
+            if isinstance(requested, tuple):  # a range of the quantity: the range of the axis between its ends
+                axis = derived.along(ds, name)[0]
+                ends = [None if e is None else derived.invert(ds, name, e, nearest_edge=True).value for e in requested]
+                if _falls(ds, name):  # a falling quantity: its low end is the axis's high end
+                    ends = ends[::-1]
+                shown_ends = ", ".join("-inf" if e is None and i == 0 else "inf" if e is None else f"{e:g}" for i, e in enumerate(requested))
+                via = f"{name} in [{shown_ends}] -> {axis} (linear between grid values)"
+                requested = (ends[0], ends[1])
+            else:
+                inv = derived.invert(ds, name, requested, nearest_edge=nearest_edge)
+                axis, requested, via = inv.axis, inv.value, inv.describe(ds)
+        else:
+            raise _not_an_axis(ds, name, dims)
+        if axis in out:
+            first = made_by.get(axis, axis)
+            raise StabmapError(f"{name} and {first} both set {axis}; give one of them")
+        out[axis] = (requested, via)
+        made_by[axis] = name
+    return out
+
+
+def _falls(ds: xr.Dataset, name: str) -> bool:
+    _, _, y = derived.along(ds, name)
+    return bool(y.size > 1 and y[-1] < y[0])
 
 
 def _contiguous(index: np.ndarray) -> np.ndarray | slice:
@@ -288,24 +353,32 @@ def selection_text(axes: dict[str, AxisSelection]) -> str:
 # the questions
 
 
-def label_at(ds: xr.Dataset, **point: float) -> Label:
-    """Label of the grid point nearest to ``point`` (one value per grid axis)."""
+def label_at(ds: xr.Dataset, /, *, nearest_edge: bool = False, **point: float) -> Label:
+    """Label of the grid point nearest to ``point`` (one value per grid axis).
+
+    A derived quantity monotone along one grid axis (a projectile's ``S_g``) may stand for that axis. A value
+    outside the scan is an error unless ``nearest_edge`` (then the nearest end of the scan is used, and said).
+    """
     dims = grid_axes(ds)
-    unknown = [k for k in point if k not in dims]
+    extra = derived.names(ds, dims)
+    unknown = [k for k in point if k not in dims and k not in extra]
     if unknown:
-        raise StabmapError(f"{unknown[0]!r} is not an axis of this atlas; its axes are: {', '.join(dims) or '(none)'}")
+        raise _not_an_axis(ds, unknown[0], dims)
     for k, v in point.items():
         if isinstance(v, (tuple, list, slice)):
             raise StabmapError(f"{k}={v!r}: the label is asked at one point; a range belongs to stable_fraction, boundaries or smallest_stable "
                 "(stabmap query --fraction, --boundaries AXIS, --smallest-stable)")
-    missing = [d for d in dims if d not in point]
+    asked = _on_axes(ds, point, dims, nearest_edge)
+    missing = [d for d in dims if d not in asked]
     if missing:
         raise StabmapError(f"give a value for every axis; missing: {', '.join(missing)} (e.g. {missing[0]}={float(ds[missing[0]][0]):g})")
-    point = {k: _number(k, v, str(ds[k].attrs.get("units", ""))) for k, v in point.items()}
-    sel = ds.sel(point, method="nearest") if dims else ds
-    outside = tuple(
-        d for d in dims if not float(ds[d].min()) <= float(point[d]) <= float(ds[d].max())
-    )
+    at = {k: float(v) for k, (v, _) in asked.items()}
+    outside = tuple(d for d in dims if not derived.within(at[d], float(ds[d].min()), float(ds[d].max())))
+    if outside and not nearest_edge:
+        raise outside_error(ds, outside[0], at[outside[0]], np.asarray(ds[outside[0]].values, dtype=np.float64))
+    outside += tuple(d for d, (_, via) in asked.items() if "nearest edge" in via and d not in outside)
+    index = {d: int(ds.indexes[d].get_indexer([at[d]], method="nearest")[0]) for d in dims}
+    sel = ds.isel(index) if dims else ds
     system = systems.of_atlas(ds.attrs)
     sel, = compute(sel)  # one point of every variable: a lazy atlas reads one chunk of each
     values: dict[str, object] = {}
@@ -317,15 +390,17 @@ def label_at(ds: xr.Dataset, **point: float) -> Label:
             else:
                 values[var.name] = x.item() if x.ndim == 0 else x
     return Label(
-        requested={k: float(v) for k, v in point.items()},
+        requested=at,
         grid_point={d: float(sel[d]) for d in dims},
         values=values,
         outside=outside,
         provenance=system.provenance if system.provenance in values else None,
+        derived={k: float(sel[k]) for k in extra},
+        via={k: via for k, (_, via) in asked.items() if via},
     )
 
 
-def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
+def stable_fraction(ds: xr.Dataset, /, *, nearest_edge: bool = False, **sel) -> StableFraction:
     """The fraction of stable grid points (the label equal to the system's ``stable_label``) in a slice of an atlas.
 
     Parameters
@@ -347,7 +422,7 @@ def stable_fraction(ds: xr.Dataset, /, **sel) -> StableFraction:
     >>> stable_fraction(ds, K_1=3)                  # a gyroscopes' atlas: every omega, K_1 nearest to 3
     >>> stable_fraction(ds, omega=(20, 60))         # 20 <= omega <= 60, every K_1
     """
-    sub, axes = select(ds, sel)
+    sub, axes = select(ds, sel, nearest_edge=nearest_edge)
     system = stable_system(ds, "the stable fraction")
     labels = sub[system.label].data
     inferred = _inferred(sub, system).data
@@ -421,7 +496,7 @@ def fixed_coords(sub: xr.Dataset, axes: dict[str, AxisSelection]) -> dict:
     return {k: sub[k].variable for k, a in axes.items() if a.fixed}
 
 
-def boundaries(ds: xr.Dataset, along: str | None = None, /, **sel) -> xr.Dataset:
+def boundaries(ds: xr.Dataset, along: str | None = None, /, *, nearest_edge: bool = False, **sel) -> xr.Dataset:
     """Every change of the label along one axis, bracketed by the two neighbouring grid values.
 
     For every line along ``along`` (one per grid point of the other axes, or of the slice ``sel`` selects), each
@@ -458,7 +533,7 @@ def boundaries(ds: xr.Dataset, along: str | None = None, /, **sel) -> xr.Dataset
     """
     dims = grid_axes(ds)
     along = check_axis(ds, along, dims)
-    sub, axes = select(ds, sel, along=along)
+    sub, axes = select(ds, sel, along=along, nearest_edge=nearest_edge)
     others, x, labels, inferred = _lines(sub, along)
     lab = systems.of_atlas(ds.attrs).label
     shape = labels.shape[:-1]
@@ -493,6 +568,7 @@ def boundaries(ds: xr.Dataset, along: str | None = None, /, **sel) -> xr.Dataset
         "label_symbol": systems.of_atlas(ds.attrs).label_symbol,
         "along": along,
         "along_units": units,
+        "along_display_units": shown.display_unit(ds, along),
         "n_lines": n_lines,
         "n_lines_with_boundary": int(np.unique(line).size),
         "along_grid_values": int(x.size),
@@ -508,7 +584,8 @@ def boundaries(ds: xr.Dataset, along: str | None = None, /, **sel) -> xr.Dataset
     return out
 
 
-def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | None = None, **sel) -> xr.Dataset:
+def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | None = None, *, nearest_edge: bool = False,
+                    **sel) -> xr.Dataset:
     """The smallest grid value of ``along`` at which the system is stable, for each value of ``over``.
 
     Parameters
@@ -547,7 +624,7 @@ def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | Non
     """
     dims = grid_axes(ds)
     along = check_axis(ds, along, dims)
-    sub, axes = select(ds, sel, along=along)
+    sub, axes = select(ds, sel, along=along, nearest_edge=nearest_edge)
     others, x, labels, inferred = _lines(sub, along)
     system = stable_system(ds, "smallest_stable")
     label = system.variable(system.label)
@@ -601,6 +678,7 @@ def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | Non
         "label_fill": label.fill,
         "along": along,
         "along_units": units,
+        "along_display_units": shown.display_unit(ds, along),
         "along_range": [float(x.min()), float(x.max())],
         "along_grid_values": int(x.size),
         "selection": selection_text(axes),

@@ -13,9 +13,30 @@ import xarray as xr
 from .. import systems
 from ..errors import StabmapError
 from ..scene.units import unit_suffix
+from . import shown
 from .query import CRITICAL_HINT, Label, StableFraction
 
 FORMATS = ("text", "csv", "json")
+SUFFIXES = {".csv": "csv", ".json": "json", ".txt": "text", ".text": "text", "": "text"}  # what -o FILE's suffix asks for
+
+
+def output_format(fmt: str | None, output) -> str:
+    """The format of an answer: ``fmt`` (--csv, --json) if given, else the one ``output``'s suffix names (``frac.csv``:
+    CSV), else text. A suffix that names no format, or another one than ``fmt``, is a StabmapError: a file named
+    .csv holds CSV."""
+    if output is None:
+        return fmt or "text"
+    from pathlib import Path
+
+    suffix = Path(output).suffix.lower()
+    named = SUFFIXES.get(suffix)
+    if named is None:
+        raise StabmapError(f"-o {output}: stabmap query writes text (.txt), CSV (.csv) or JSON (.json); name the file with one of "
+                           "these suffixes")
+    if fmt is not None and fmt != named and suffix:
+        raise StabmapError(f"-o {output}: the suffix {suffix} names {named} but --{fmt} was given; name the file "
+                           f"{Path(output).stem}.{fmt}, or leave out --{fmt}")
+    return fmt or named
 
 
 def render(result, fmt: str = "text", *, limit: int = 40, atlas: xr.Dataset | None = None) -> str:
@@ -40,6 +61,8 @@ def render(result, fmt: str = "text", *, limit: int = 40, atlas: xr.Dataset | No
         return buf.getvalue().rstrip("\n")
     if fmt == "json":
         head = {k: result.attrs[k] for k in ("stabmap_query", "along", "along_units", "selection", "comment")}
+        if result.attrs.get("along_display_units"):
+            head["along_display_units"] = result.attrs["along_display_units"]
         head["fixed"] = {k: float(result[k]) for k in _fixed_axes(result)}
         head["rows"] = frame.to_dict(orient="records")
         if "undecided_lower" in result:
@@ -50,27 +73,36 @@ def render(result, fmt: str = "text", *, limit: int = 40, atlas: xr.Dataset | No
 
 
 def _units(ds: xr.Dataset | None, name: str) -> str:
-    return unit_suffix(ds[name].attrs.get("units")) if ds is not None and name in ds.coords else ""
+    """`` s-1`` after a value of ``name`` (its ``units`` attribute), ``""`` for none, a flag or a count."""
+    if ds is None or name not in ds.variables or "flag_values" in ds[name].attrs:
+        return ""
+    return unit_suffix(ds[name].attrs.get("units"))
 
 
 def _label_text(label: Label, atlas: xr.Dataset | None) -> str:
     lines = []
     for k, v in label.requested.items():
-        note = " (outside the grid: nearest edge)" if k in label.outside else ""
-        lines.append(f"{k} = {v:g} -> nearest grid point {label.grid_point[k]:.8g}{_units(atlas, k)}" + note)
+        note = " (outside the scan: nearest edge, as asked)" if k in label.outside else ""
+        asked = (f"{label.via[k]}\n{k}" if k in label.via
+                 else f"{k} = {shown.value_text(v, shown.stored_units(atlas, k), shown.display_unit(atlas, k), 6)}")
+        lines.append(f"{asked} -> nearest grid point {shown.axis_value(atlas, k, label.grid_point[k])}" + note)
+    for k, v in label.derived.items():  # functions of the grid axes (S_g, a moved half height): at the grid point used
+        on = " and ".join(map(str, atlas[k].dims)) if atlas is not None and k in atlas.variables else "the grid"
+        lines.append(f"{k} = {shown.axis_value(atlas, k, v)} at that grid point (derived from {on})")
     # NAME_lower and NAME_upper, a proved enclosure of NAME, are shown on NAME's line
     bounds = {k for k in label.values for end in ("_lower", "_upper") if k.endswith(end) and k[: -len(end)] in label.values}
-    shown = [(k, v) for k, v in label.values.items() if k != label.provenance and k not in bounds]
-    lines += [f"{k} = {_value(v)}" + (f" ({CELL_TEXT[v]})" if k == "cell" and v in CELL_TEXT else "")
-              + (f" (proved in [{_value(label.values[k + '_lower'])}, {_value(label.values[k + '_upper'])}])" if k + "_lower" in bounds else "")
-              for k, v in shown]
+    shown_values = [(k, v) for k, v in label.values.items() if k != label.provenance and k not in bounds]
+    lines += [f"{k} = {_value(v)}{_units(atlas, k)}" + (f" ({CELL_TEXT[v]})" if k == "cell" and v in CELL_TEXT else "")
+              + (f" (proved in [{_value(label.values[k + '_lower'])}, {_value(label.values[k + '_upper'])}]{_units(atlas, k)})"
+                 if k + "_lower" in bounds else "")
+              for k, v in shown_values]
     if label.provenance is not None:
         how = str(label.values[label.provenance])  # a flag's meaning
         # How the point was decided qualifies its verdict (stability, else the label: the critical node), not
         # whichever variable happens to be last.
-        names = [k for k, _ in shown]
+        names = [k for k, _ in shown_values]
         main = "stability" if "stability" in names else systems.of_atlas(atlas.attrs).label if atlas is not None else None
-        at = len(lines) - len(shown) + names.index(main) if main in names else -1
+        at = len(lines) - len(shown_values) + names.index(main) if main in names else -1
         lines[at] += (
             " (not computed: inferred from the agreeing corners of its grid cell; docs/refine.md)"
             if label.inferred
@@ -96,7 +128,7 @@ def _value(v) -> str:
 
 
 def _label_record(label: Label) -> dict:
-    return {**label.grid_point, **{k: plain_value(v) for k, v in label.values.items()}}
+    return {**label.grid_point, **label.derived, **{k: plain_value(v) for k, v in label.values.items()}}
 
 
 def _label_csv(label: Label, atlas) -> str:
@@ -106,7 +138,8 @@ def _label_csv(label: Label, atlas) -> str:
 def _label_json(label: Label, atlas) -> str:
     return json_text({
         "stabmap_query": "label_at", "requested": label.requested, "grid_point": label.grid_point,
-        "outside": list(label.outside), **label.values, "inferred": label.inferred,
+        "outside": list(label.outside), **({"derived": label.derived} if label.derived else {}),
+        **({"via": label.via} if label.via else {}), **label.values, "inferred": label.inferred,
     })
 
 
@@ -189,6 +222,24 @@ def text_table(header: list[str], rows: list[list[str]]) -> list[str]:
     return ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in [header, *rows]]
 
 
+def _column(result: xr.Dataset, name: str) -> str:
+    """A table's header for an axis: its name and units, a spin rate's display unit first (``omega [rpm (rad s-1)]``)."""
+    return name + shown.header_units(str(result[name].attrs.get("units", "")), shown.display_unit(result, name))
+
+
+def _cell(result: xr.Dataset, name: str, value) -> str:
+    disp = shown.display_unit(result, name)
+    return shown.cell(float(value), disp) if disp and not _missing(value) else short_number(value)
+
+
+def _along_cell(value, disp: str) -> str:
+    return shown.cell(float(value), disp) if disp and not _missing(value) else short_number(value)
+
+
+def _missing(value) -> bool:
+    return isinstance(value, (float, np.floating)) and bool(np.isnan(value))
+
+
 def _head(result: xr.Dataset) -> list[str]:
     lines = [f"  {item}" for item in result.attrs["selection"].split("; ") if item]
     return lines
@@ -199,9 +250,9 @@ def more_rows_line(n: int, limit: int) -> list[str]:
 
 
 def _boundaries_text(b: xr.Dataset, frame, limit: int) -> str:
-    along, units = b.attrs["along"], b.attrs["along_units"]
+    along, units, disp = b.attrs["along"], b.attrs["along_units"], b.attrs.get("along_display_units", "")
     lab, sym = b.attrs["label"], b.attrs["label_symbol"]
-    u = f" [{units}]" if units else ""
+    u = shown.header_units(units, disp)
     n, lines_total = b.sizes["boundary"], b.attrs["n_lines"]
     lines = [
         f"boundaries along {along}{u}: {n} change{'s' if n != 1 else ''} of {sym} on {b.attrs['n_lines_with_boundary']} "
@@ -210,16 +261,16 @@ def _boundaries_text(b: xr.Dataset, frame, limit: int) -> str:
     ]
     lines += _head(b)
     others = [c for c in frame.columns if c in b.coords and b[c].ndim == 1]
-    header = [f"{d} [{b[d].attrs['units']}]" if b[d].attrs.get("units") else d for d in others]
+    header = [_column(b, d) for d in others]
     header += [f"{along} lower", f"{along} upper", f"{sym} below", f"{sym} above"]
     rows = []
-    shown = frame if not limit else frame.iloc[:limit]
+    visible = frame if not limit else frame.iloc[:limit]
     star = False
-    for r in shown.to_dict(orient="records"):
+    for r in visible.to_dict(orient="records"):
         nb = f"{r[lab + '_below']}" + ("*" if r["inferred_below"] else "")
         na = f"{r[lab + '_above']}" + ("*" if r["inferred_above"] else "")
         star |= bool(r["inferred_below"] or r["inferred_above"])
-        rows.append([short_number(r[d]) for d in others] + [short_number(r["boundary_lower"]), short_number(r["boundary_upper"]), nb, na])
+        rows.append([_cell(b, d, r[d]) for d in others] + [_along_cell(r["boundary_lower"], disp), _along_cell(r["boundary_upper"], disp), nb, na])
     if rows:
         lines += text_table(header, rows)
     else:
@@ -241,37 +292,40 @@ def _gaps_text(b: xr.Dataset, along: str) -> list[str]:
     head = f"{b.attrs['located_by']}; "
     if not n:
         return [head + f"the list is complete: every other stretch of {along} is proved to keep its label"]
-    shown: list[str] = []
+    stretches: list[str] = []
     if "undecided_lower" in b:
-        shown = [f"{a:.10g} .. {c:.10g}" for a, c in zip(b["undecided_lower"].values[:6], b["undecided_upper"].values[:6], strict=True)]
-    more = f" and {n - len(shown)} more" if n > len(shown) else ""
+        units, disp = b.attrs.get("along_units", ""), b.attrs.get("along_display_units", "")
+        stretches = [shown.span_text(a, c, units, disp, 10)
+                     for a, c in zip(b["undecided_lower"].values[:6], b["undecided_upper"].values[:6], strict=True)]
+    more = f" and {n - len(stretches)} more" if n > len(stretches) else ""
     return [head + f"complete but for {n} stretch{'es' if n != 1 else ''} not decided, where a change may hide: "
-            + "; ".join(shown) + more]
+            + "; ".join(stretches) + more]
 
 
 def _smallest_text(s: xr.Dataset, frame, limit: int) -> str:
-    along, units = s.attrs["along"], s.attrs["along_units"]
+    along, units, disp = s.attrs["along"], s.attrs["along_units"], s.attrs.get("along_display_units", "")
     lab, sym = s.attrs["label"], s.attrs["label_symbol"]
-    u = f" [{units}]" if units else ""
+    u = shown.header_units(units, disp)
     lo, hi = s.attrs["along_range"]
-    lines = [f"smallest stable {along}{u}, searched upward over {s.attrs['along_grid_values']} grid values {lo:.8g} .. {hi:.8g}"]
+    lines = [f"smallest stable {along}{u}, searched upward over {s.attrs['along_grid_values']} grid values "
+             f"{shown.span_text(lo, hi, units, disp)}"]
     lines += _head(s)
     others = list(s["smallest_stable"].dims)
-    header = [f"{d} [{s[d].attrs['units']}]" if s[d].attrs.get("units") else d for d in others]
+    header = [_column(s, d) for d in others]
     header += [f"smallest stable {along}", "unstable below", f"{sym} below", "stable to end"]
     rows = []
-    shown = frame if not limit else frame.iloc[:limit]
+    visible = frame if not limit else frame.iloc[:limit]
     star = False
-    for r in shown.to_dict(orient="records"):
+    for r in visible.to_dict(orient="records"):
         if np.isnan(r["smallest_stable"]):
             first, below, ncb = "none", "-", "-"
         else:
-            first = short_number(r["smallest_stable"]) + ("*" if r["inferred"] else "")
-            below = short_number(r["unstable_below"]) if not np.isnan(r["unstable_below"]) else "(scan start)"
+            first = _along_cell(r["smallest_stable"], disp) + ("*" if r["inferred"] else "")
+            below = _along_cell(r["unstable_below"], disp) if not np.isnan(r["unstable_below"]) else "(scan start)"
             below_label = r[lab + "_below"]
             ncb = f"{below_label}" + ("*" if r["inferred_below"] else "") if below_label != s.attrs["label_fill"] else "-"
         star |= bool(r["inferred"] or r["inferred_below"])
-        rows.append([short_number(r[d]) for d in others] + [first, below, ncb, short_number(r["stable_to_scan_end"]) if first != "none" else "-"])
+        rows.append([_cell(s, d, r[d]) for d in others] + [first, below, ncb, short_number(r["stable_to_scan_end"]) if first != "none" else "-"])
     lines += text_table(header, rows)
     lines += more_rows_line(len(frame), limit)
     if star:

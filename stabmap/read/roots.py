@@ -9,13 +9,14 @@ NAME=VALUE... --roots`` prints it.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError
-from ..scene.units import in_si, unit_suffix
+from ..scene.units import in_si
+from . import shown
 
 
 @dataclass(frozen=True)
@@ -28,6 +29,7 @@ class Roots:
     units: dict[str, str]
     roots: list
     rule: str
+    display: dict[str, str] = field(default_factory=dict)  # a spin-rate axis's display unit (rpm, Hz): shown first
 
     @property
     def n_complex_pairs(self) -> int:
@@ -39,7 +41,7 @@ class Roots:
         return max((r.growth_rate for r in self.roots), default=0.0)
 
     def text(self) -> str:
-        at = ", ".join(f"{k} = {v:g}{unit_suffix(self.units.get(k))}" for k, v in self.point.items())
+        at = ", ".join(f"{k} = {shown.value_text(v, self.units.get(k, ''), self.display.get(k, ''), 6)}" for k, v in self.point.items())
         lines = [f"{self.title}: roots of p(lambda) at {at} (computed at this point; solutions ~ exp(i lambda t))" if at else
                  f"{self.title}: roots of p(lambda) (solutions ~ exp(i lambda t))"]
         nc = self.n_complex_pairs
@@ -74,9 +76,10 @@ def roots(source, /, **point: float) -> Roots:
                                "pass the scene itself: stabmap.roots(scene, omega=...)")
         scene = systems.loads_scene(str(source.attrs["scene"]), "the atlas's scene")
         units = {d: str(source[d].attrs.get("units", "")) for d in source.dims if d in point}
+        display = {d: shown.display_unit(source, d) for d in units if shown.display_unit(source, d)}
     else:
         scene = source
-        units = {}
+        units, display = {}, {}
     system = systems.of(scene)
     axes = [a.name for a in scene.grid]
     unknown = [k for k in point if k not in axes]
@@ -95,4 +98,4 @@ def roots(source, /, **point: float) -> Roots:
     found = system.roots(scene, values)
     if found is None:
         raise StabmapError(f"the {system.name} system has no characteristic roots to list (--roots applies to gyroscopes)")
-    return Roots(scene.title or system.title, values, units, *found)
+    return Roots(scene.title or system.title, values, units, *found, display=display)

@@ -24,6 +24,7 @@ from .. import systems
 from ..errors import StabmapError
 from ..store.dataset import CRITICAL_KIND as KIND
 from ..store.dataset import is_critical
+from . import shown
 
 ROWS = ("boundary", "stable_interval", "undecided_gap", "no_stable_interval")  # the ``row`` kinds, in this order at equal lower ends
 
@@ -232,10 +233,12 @@ def critical_summary(ds: xr.Dataset) -> dict:
     return out
 
 
-def select_lines(ds: xr.Dataset, sel: dict) -> xr.Dataset:
+def select_lines(ds: xr.Dataset, sel: dict, *, nearest_edge: bool = False) -> xr.Dataset:
     """The lines of a critical-values Dataset that ``sel`` selects: ``{axis: number}`` keeps the grid value nearest
-    to it, ``{axis: (lo, hi)}`` (None: open) the grid values in [lo, hi]; every axis stays a dimension."""
-    from .query import requested_value
+    to it (outside the scan an error, unless ``nearest_edge``), ``{axis: (lo, hi)}`` (None: open) the grid values in
+    [lo, hi]; every axis stays a dimension."""
+    from .derived import within
+    from .query import outside_error, requested_value
 
     along = check_critical(ds, "a selection of critical values")
     dims = list(ds["n_stable_intervals"].dims)
@@ -254,6 +257,8 @@ def select_lines(ds: xr.Dataset, sel: dict) -> xr.Dataset:
                                    f"{grid.min():.8g} to {grid.max():.8g} {_units(ds, name)}".rstrip())
             index[name] = keep
         else:
+            if not nearest_edge and not within(requested, float(grid.min()), float(grid.max())):
+                raise outside_error(ds, name, requested, grid)
             index[name] = [int(np.argmin(np.abs(grid - requested)))]
     return ds.isel(index) if index else ds
 
@@ -264,7 +269,7 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
     CSV and JSON hold every row; their headers carry the units (``omega_lower [rad s-1]``), NaN and the fields that
     do not apply to a row are empty (JSON ``null``). ``limit`` caps the rows of the text (0: all).
     """
-    from .report import FORMATS, json_text, more_rows_line, plain_value, short_number, text_table
+    from .report import FORMATS, json_text, more_rows_line, plain_value, text_table
 
     if fmt not in FORMATS:
         raise StabmapError(f"format {fmt!r}: choose one of {', '.join(FORMATS)}")
@@ -285,9 +290,11 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
     system = systems.of_atlas(ds.attrs)
     sym = system.label_symbol
     dims = [c for c in table.columns if c in ds.dims and c in ds.coords]
-    u = f" [{s['units']}]" if s["units"] else ""
-    lines = [counts_line(s, dims)]
-    header = [f"{d} [{units[d]}]" if units.get(d) else d for d in dims] + ["row", f"{along} lower{u}", f"{along} upper{u}", "note"]
+    disp = shown.display_unit(ds, along)
+    u = shown.header_units(s["units"], disp)
+    lines = [counts_line(s, dims, disp)]
+    header = [d + shown.header_units(units.get(d, ""), shown.display_unit(ds, d)) for d in dims]
+    header += ["row", f"{along} lower{u}", f"{along} upper{u}", "note"]
     rows = []
     for r in (table if not limit else table.iloc[:limit]).to_dict(orient="records"):
         kind = r["row"]
@@ -301,7 +308,8 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
         else:
             note = f"nothing stable from {s['scan_range'][0]:.8g} to {s['scan_range'][1]:.8g}"
         ends = [r[f"{along}_lower"], r[f"{along}_upper"]]
-        rows.append([short_number(r[d]) for d in dims] + [kind.replace("_", " "), *(f"{v:.10g}" if v == v else "-" for v in ends), note])
+        rows.append([shown.cell(r[d], shown.display_unit(ds, d)) for d in dims]
+                    + [kind.replace("_", " "), *(shown.cell(v, disp, 10) if v == v else "-" for v in ends), note])
     lines += text_table(header, rows) if rows else ["(no rows)"]
     lines += more_rows_line(len(table), limit)
     lines.append("Stable ends are proved stable, and the boundary lies between each end and the proved-unstable value just "
@@ -309,9 +317,9 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
     return "\n".join(lines)
 
 
-def counts_line(s: dict, dims: list[str]) -> str:
-    """One line of counts: intervals, boundaries and gaps on how many lines."""
-    u = f" [{s['units']}]" if s["units"] else ""
+def counts_line(s: dict, dims: list[str], display: str = "") -> str:
+    """One line of counts: intervals, boundaries and gaps on how many lines (``display``: the scanned axis's display unit)."""
+    u = shown.header_units(s["units"], display)
     on = f"on {s['lines']} line{'s' if s['lines'] != 1 else ''} of {', '.join(dims)}" if dims else "on the one line of the scene"
     gaps = (f"{s['undecided_gaps']} undecided gap{'s' if s['undecided_gaps'] != 1 else ''} (on {s['lines_with_gaps']} "
             f"line{'s' if s['lines_with_gaps'] != 1 else ''})" if s["undecided_gaps"] else "no undecided gap")
