@@ -269,3 +269,14 @@ def test_a_monotone_derived_quantity_becomes_an_axis_for_plots(shell):
     assert ((swapped["n_complex_pairs"].sel(m_1=1.0).values == 0) == (swapped["S_g"].values >= 1)).all()
     with pytest.raises(stabmap.StabmapError, match="no derived quantity"):
         as_axis(shell, "m_1")
+
+
+def test_a_unit_on_an_axis_that_takes_none_is_refused_for_that(shell_file, capsys):
+    """m_1 is a mass: '1 kg' on it is refused as a unit where none is read, not as an unknown spin unit; a range's
+    unit goes the same way, and an unknown unit on the spin axis is still named as such."""
+    code, _, err = run(capsys, "query", shell_file, "omega=100 rpm", "m_1=1 kg")
+    assert code == 2 and "a unit is accepted for spin rates only" in err and "m_1 as a plain number in kg" in err
+    code, _, err = run(capsys, "query", shell_file, "--fraction", "m_1=1:2kg")
+    assert code == 2 and "a unit is accepted for spin rates only" in err
+    code, _, err = run(capsys, "query", shell_file, "omega=100 rpx", "m_1=1")
+    assert code == 2 and "unknown unit 'rpx'" in err

@@ -38,7 +38,7 @@ import xarray as xr
 
 from .. import systems
 from ..errors import StabmapError, given, param
-from ..scene.units import common_unit, in_si, looks_like_rate, split
+from ..scene.units import common_unit, in_si, looks_like_rate
 from ..store.dataset import is_critical
 from ..store.variables import INFERRED
 from . import derived, shown
@@ -694,15 +694,15 @@ def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | Non
 
 
 def _end(text: str, where: str) -> float | str | None:
-    """One end of a selection: None (open), a number, or a number with a unit, kept as text (``select`` converts it
-    by the axis's units); an unknown unit a StabmapError naming ``where``, anything else a ValueError."""
+    """One end of a selection: None (open), a number, or a number with a unit, kept as text: ``select`` converts it
+    by the axis's units, so that a unit on an axis that takes none is refused for that (``units.in_si``) rather than
+    as a spin unit it is not; anything else a ValueError."""
     if not text:
         return None
     if is_plain_number(text):
         return float(text)
     if not looks_like_rate(text):
         raise ValueError(text)
-    split(where, text)  # its unit is known, or a StabmapError naming it
     return text
 
 
@@ -726,8 +726,6 @@ def parse_selection(items: list[str], *, ranges: bool = True, option: str = "") 
             raise StabmapError(f"{prefix}{item!r}: {fix}")
         try:
             numbers = [_end(e.strip(), f"{prefix}{key}") for e in ends]
-        except StabmapError:  # an unknown unit, named
-            raise
         except ValueError:
             what = "a number or a range LO:HI" if ranges else "a number"
             raise StabmapError(f"{prefix}{item!r}: {value!r} is not {what}; write e.g. {key}=42.5" + (f" or {key}=0:10" if ranges else "")

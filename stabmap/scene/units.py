@@ -76,12 +76,22 @@ def in_si(where: str, value, units: str):
 
 def common_unit(where: str, values) -> str | None:
     """The one unit written in ``values`` (strings or numbers), None if none; mixed units (or a unit on some values and
-    not on others) are a StabmapError naming ``where``."""
-    units = {split(where, v)[1] if isinstance(v, str) else None for v in values}
+    not on others) are a StabmapError naming ``where``.  A unit is not checked here: the caller's ``in_si`` says what
+    the quantity accepts (a spin unit, or none at all)."""
+    units = {_word(v) if isinstance(v, str) else None for v in values}
     if len(units) > 1:
         shown = ", ".join(sorted(u or "no unit" for u in units))
         raise StabmapError(f"{where}: mixed units ({shown}); give every value of one axis in the same unit ({ACCEPTED})")
     return units.pop() if units else None
+
+
+def _word(text: str) -> str | None:
+    """The unit written after the number in ``text`` (a known one by its name in :data:`UNITS`), None if none."""
+    match = _TEXT.match(text)
+    if not match or not match["unit"]:
+        return None
+    known = UNITS.get(match["unit"].lower())
+    return known[0] if known else match["unit"]
 
 
 def check_display(where: str, unit) -> str:
