@@ -62,9 +62,11 @@ def readout():
 
 def swatch(colour: str, text: str, kind: str = "box") -> str:
     """One legend entry in HTML: a box of ``colour``, white hatched in ``colour`` (``kind="hatch"``, as the map
-    hatches cells holding a change), or a line (``kind="line"``, ``"thin"``)."""
-    if kind in ("box", "hatch"):
-        fill = colour if kind == "box" else f"repeating-linear-gradient(45deg, {colour} 0 1.2px, #FFFFFF 1.2px 5px)"
+    hatches cells holding a change), white dotted (``kind="dots"``, cells proved at the node only), or a line
+    (``kind="line"``, ``"thin"``)."""
+    if kind in ("box", "hatch", "dots"):
+        fill = {"box": colour, "hatch": f"repeating-linear-gradient(45deg, {colour} 0 1.2px, #FFFFFF 1.2px 5px)",
+                "dots": f"radial-gradient({colour} 1px, #FFFFFF 1.2px) 0 0 / 4px 4px"}[kind]
         mark = f'<span style="display:inline-block;width:14px;height:14px;background:{fill};border:1px solid #888;vertical-align:middle"></span>'
     else:
         height = 3 if kind == "line" else 1

@@ -15,11 +15,12 @@ from ..areas import AreaShares
 from ..headline import Headline
 from .captions import atlas_title, captioned_figure
 from .geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges
-from .labels import axis_label, display_ticks, log_axis, log_ticks, value_text
+from .labels import axis_label, log_axis, value_text
 from .layout import LEGEND_WIDTH, MAX_PANELS, FigurePlan, figure_size, panel_grid, panel_points, plan_figure
 from .marks import change_text, hidden_cell_axes
 from .paint import fill_classes, hatch_cells, paint_cells
 from .palette import BOUNDARY, CLASS_EDGE, class_colours, legend_handles
+from .ticks import set_axis
 from .reduce import FLAG_CHANGE, FLAG_INFERRED, FLAG_NODE_ONLY, Reduced, reduce_panels
 
 
@@ -92,7 +93,7 @@ def atlas_figure(
         if plan.facet is not None:
             ax.set_title(panel_title(ds, plan, system, blocks, r, c, None if reduced.shares is None else reduced.shares[n]), fontsize=9)
 
-    shown = set_map_axes(axes[0], ds, plan, xe, ye)
+    shown = set_map_axes(axes[0], ds, plan, xe, ye, (span[0] / 72, span[1] / 72))
     if plan.facet is None:
         axes[0].set_xlabel(axis_label(ds, plan.x, shown=shown[plan.x]))
         if plan.y:
@@ -202,29 +203,18 @@ def panel_title(ds: xr.Dataset, plan: FigurePlan, system, blocks, r: int | None,
     return "\n".join([", ".join(parts[:-1]), parts[-1]]) if two_lines else f"{parts[0]}  ({parts[1]})"
 
 
-def set_map_axes(first, ds: xr.Dataset, plan: FigurePlan, xe: np.ndarray, ye: np.ndarray) -> dict[str, str]:
-    """Scales, limits and ticks of the maps (shared, so set on the ``first``): log axes labelled between decades,
-    ticks at a few listed values, spin rates in their display units. Returns the unit each axis is shown in."""
-    if log_axis(ds, plan.x):
-        first.set_xscale("log")
-    first.set_xlim(min(xe[0], xe[-1]), max(xe[0], xe[-1]))
+def set_map_axes(first, ds: xr.Dataset, plan: FigurePlan, xe: np.ndarray, ye: np.ndarray,
+                 inches: tuple[float, float] | None = None) -> dict[str, str]:
+    """Scales, limits and ticks of the maps (shared, so set on the ``first``; :func:`stabmap.read.plot.ticks.set_axis`,
+    the rule a page follows too): log axes labelled between decades, ticks at a few listed values, spin rates in
+    their display units. ``inches``: the maps' size (y, x) in the layout. Returns the unit each axis is shown in."""
+    shown = {plan.x: set_axis(first, "x", ds, plan.x, xe[0], xe[-1], None if inches is None else inches[1])}
     if plan.y:
-        if log_axis(ds, plan.y):
-            first.set_yscale("log")
-        first.set_ylim(min(ye[0], ye[-1]), max(ye[0], ye[-1]))
+        shown[plan.y] = set_axis(first, "y", ds, plan.y, ye[0], ye[-1], None if inches is None else inches[0])
     else:
         first.set_ylim(0, 1)
         first.set_yticks([])
-    for dim, axis in ((plan.x, first.xaxis), (plan.y, first.yaxis)):
-        if dim and axis.get_scale() == "log":
-            log_ticks(axis, *sorted(np.asarray(ds[dim], dtype=float)[[0, -1]]))
-    for dim, setter, log in ((plan.x, first.set_xticks, first.get_xscale() == "log"), (plan.y, first.set_yticks, first.get_yscale() == "log")):
-        if dim and ds[dim].attrs.get("scale") == "values" and 1 < ds.sizes[dim] <= 8:  # ticks at listed values ...
-            v = np.sort(np.asarray(ds[dim], dtype=float))
-            v_ = np.log(v) if log else v
-            if np.min(np.diff(v_)) >= (v_[-1] - v_[0]) / 12:  # ... unless their labels would collide
-                setter(v)
-    return {dim: display_ticks(ds, dim, axis) for dim, axis in ((plan.x, first.xaxis), (plan.y, first.yaxis)) if dim}
+    return shown
 
 
 def add_legend(where, plan: FigurePlan, system, present: list[int], drawn: dict[str, bool], change: str = "") -> None:

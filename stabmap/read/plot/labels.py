@@ -64,9 +64,10 @@ def axis_label(ds: xr.Dataset, dim: str, width: int = 60, shown: str = "") -> st
     return textwrap.fill(text, width, break_long_words=False, break_on_hyphens=False)
 
 
-def display_ticks(ds: xr.Dataset, dim: str, axis) -> str:
-    """Tick labels of a linear spin-rate axis in its ``display_units`` (rpm, Hz), at round values of that unit; the
-    data stay in rad/s.  Returns the unit shown, or "" (no display unit, or a log axis: left as it is)."""
+def display_ticks(ds: xr.Dataset, dim: str, axis, nbins: int | str = "auto") -> str:
+    """Tick labels of a linear spin-rate axis in its ``display_units`` (rpm, Hz), at round values of that unit (at
+    most ``nbins`` intervals); the data stay in rad/s.  Returns the unit shown, or "" (no display unit, or a log
+    axis: left as it is)."""
     from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator
 
     unit = str(ds[dim].attrs.get("display_units", ""))
@@ -79,7 +80,7 @@ def display_ticks(ds: xr.Dataset, dim: str, axis) -> str:
             return super().tick_values(vmin / k, vmax / k) * k
 
     if not isinstance(axis.get_major_locator(), FixedLocator):  # ticks at listed values stay there
-        axis.set_major_locator(Scaled(nbins="auto", steps=[1, 2, 2.5, 5, 10]))
+        axis.set_major_locator(Scaled(nbins=nbins, steps=[1, 2, 2.5, 5, 10]))
     axis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v / k:g}"))
     return unit
 
