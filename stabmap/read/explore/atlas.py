@@ -22,10 +22,10 @@ from ...errors import StabmapError
 from ...store.variables import CELL
 from ..blocks import compute
 from ..plot.captions import fixed_caption
-from ..plot.marks import CHANGE_INK, change_text, hidden_cell_axes
 from ..plot.layout import SINGLE_WIDTH, panel_points
+from ..plot.marks import CHANGE_INK, change_text, hidden_cell_axes
 from ..plot.palette import BOUNDARY, CLASS_EDGE, system_colour
-from ..plot.ticks import Ticks, axis_ticks
+from ..plot.ticks import axis_ticks
 from ..summary import summary
 from . import widgets
 from .frames import EAGER_POINTS, MAP_PIXELS, Frame, map_grid, read_frame
@@ -140,9 +140,9 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: l
                y_range=Range1d(float(grid.ye[0]), float(grid.ye[-1]), bounds="auto"),
                tools="pan,wheel_zoom,box_zoom,reset,save", toolbar_location="right")
     inches = map_inches(plan)
-    p.xaxis.axis_label = axis_title(ds, plan.x, set_ticks(p.xaxis, axis_ticks(ds, plan.x, grid.xe[0], grid.xe[-1], inches[1], "x")))
+    p.xaxis.axis_label = axis_title(ds, plan.x, widgets.set_ticks(p.xaxis, axis_ticks(ds, plan.x, grid.xe[0], grid.xe[-1], inches[1], "x")))
     if plan.y:
-        p.yaxis.axis_label = axis_title(ds, plan.y, set_ticks(p.yaxis, axis_ticks(ds, plan.y, grid.ye[0], grid.ye[-1], inches[0], "y")))
+        p.yaxis.axis_label = axis_title(ds, plan.y, widgets.set_ticks(p.yaxis, axis_ticks(ds, plan.y, grid.ye[0], grid.ye[-1], inches[0], "y")))
     else:
         p.yaxis.visible = False
     p.grid.visible = False
@@ -203,16 +203,6 @@ title.text = titles[k];
 def map_inches(plan: PagePlan) -> tuple[float, float]:
     """The length (y, x) [inch] of the PNG's single map of these axes: the page's ticks are chosen as on it."""
     return tuple(v / 72 for v in panel_points(SINGLE_WIDTH, 1, 1, facets=False, strip=plan.y is None))  # type: ignore[return-value]
-
-
-def set_ticks(axis, ticks: Ticks) -> str:
-    """Put the PNG's ticks on a bokeh axis: its labelled ticks as major ticks with the PNG's texts, the others as
-    minor ticks. Returns the unit the texts are in. Fixed ticks stay where they are when the map is zoomed."""
-    from bokeh.models import FixedTicker
-
-    axis.ticker = FixedTicker(ticks=[v for v, _ in ticks.labelled], minor_ticks=ticks.unlabelled)
-    axis.major_label_overrides = {v: plain(t) for v, t in ticks.labelled}
-    return ticks.shown
 
 
 def rect_columns(f: Frame) -> dict[str, np.ndarray]:

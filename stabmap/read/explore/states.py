@@ -104,8 +104,8 @@ def cell_bit(meaning: str) -> int:
 def block_colours(blocks, legend: Legend) -> tuple[np.ndarray, set[str]]:
     """The colour id of every block, as the PNG maps draw it: a block of one class in that class's colour (dotted
     where a cell is proved at its node only, hatched lightly where inferred, hatched dark where a cell is proved to
-    hold a change, which wins where both are: the colour stays the grid points' label), a block of stable and unstable points black, other mixed blocks dark
-    grey; and the marks drawn, for the legend ("inferred", "node-only", "change", "mixed-classes",
+    hold a change, which wins where both are: the colour stays the grid points' label), a block of stable and
+    unstable points black, other mixed blocks dark grey; and the marks drawn, for the legend ("inferred", "node-only", "change", "mixed-classes",
     "mixed-stability")."""
     system = legend.system
     low, mixed = blocks.low, blocks.low != blocks.high

@@ -63,11 +63,12 @@ def name(ds: xr.Dataset, dim: str) -> str:
 
 
 def value_text(ds: xr.Dataset, dim: str, value: float) -> str:
-    """'ω = 42.5 rad s⁻¹ (406 rpm)': a value of ``dim`` with its symbol and units, and in the axis's display units
-    (rpm, Hz) when the scene gave them."""
-    text = f"{name(ds, dim)} = {value:.6g}{unit_plain(ds, dim)}"
+    """'ω = 406 rpm (42.5 rad s⁻¹)': a value of ``dim`` with its symbol, in the axis's display unit (rpm, Hz) when the
+    scene gave one, as its axis shows it, and in the stored units."""
     shown = str(ds[dim].attrs.get("display_units", ""))
-    return text + (f" ({value / units.factor(shown):.6g} {shown})" if shown else "")
+    if shown:
+        return f"{name(ds, dim)} = {value / units.factor(shown):.6g} {shown} ({value:.6g}{unit_plain(ds, dim)})"
+    return f"{name(ds, dim)} = {value:.6g}{unit_plain(ds, dim)}"
 
 
 def span_texts(ds: xr.Dataset, dim: str, k: int) -> list[str]:

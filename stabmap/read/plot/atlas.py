@@ -15,13 +15,14 @@ from ..areas import AreaShares
 from ..headline import Headline
 from .captions import atlas_title, captioned_figure
 from .geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges
+from .label_line import LABEL_HEIGHT, draw_label_line, label_legend, line_size
 from .labels import axis_label, log_axis, value_text
 from .layout import LEGEND_WIDTH, MAX_PANELS, FigurePlan, figure_size, panel_grid, panel_points, plan_figure
 from .marks import change_text, hidden_cell_axes
 from .paint import fill_classes, hatch_cells, paint_cells
 from .palette import BOUNDARY, CLASS_EDGE, class_colours, legend_handles
-from .ticks import set_axis
 from .reduce import FLAG_CHANGE, FLAG_INFERRED, FLAG_NODE_ONLY, Reduced, reduce_panels
+from .ticks import set_axis
 
 
 def atlas_figure(
@@ -71,6 +72,8 @@ def atlas_figure(
     reduced = reduce_panels(ds, plan, system, width, nrows, ncols)
     xe, ye = map_edges(ds, plan, reduced.factors)
     title = figure_title(ds, plan, system, reduced, width)
+    if plan.y is None:  # one free axis: a line of the label (and the growth rate), not a strip with an empty y axis
+        return line_figure(ds, plan, system, reduced, xe, figure_title(ds, plan, system, reduced, width, chars=52), width)
     size = figure_size(plan, width, nrows, title.count("\n") + 1, len(reduced.present))
     fig = captioned_figure(ds, size)
     if plan.facet is None:
@@ -114,6 +117,22 @@ def atlas_figure(
     return fig
 
 
+def line_figure(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, xe: np.ndarray, title: str, width: float):
+    """The figure of one free axis (:mod:`.label_line`): the label as a line over its classes' colours, the growth
+    rate beneath where stored, the class legend beside."""
+    fig = captioned_figure(ds, line_size(ds, system, width, title.count("\n") + 1))
+    cmap, norm = class_colours(reduced.present, system)
+    span = (72 * LABEL_HEIGHT, panel_points(width, 1, 1, facets=False, strip=True)[1])
+    axes, drawn, extra = draw_label_line(fig, ds, plan, system, reduced, xe, draw_panel, cmap, norm, span)
+    marks = {"stability": False, "classes": False, "inferred": False, "light": False, "node-only": False,
+             "node-only-light": False, "change": False}
+    marks.update(drawn)
+    change = change_text(hidden_cell_axes(ds, system.label, (plan.x,)), ds)
+    label_legend(fig, system, reduced.present, marks, change, extra)
+    axes[0].set_title(title, fontsize=10)
+    return fig
+
+
 def map_edges(ds: xr.Dataset, plan: FigurePlan, factors: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
     """The edges of the drawn cells along x and y: the cells the atlas proves its labels on, merged into blocks of
     ``factors`` (y, x); a strip's y runs from 0 to 1."""
@@ -122,7 +141,7 @@ def map_edges(ds: xr.Dataset, plan: FigurePlan, factors: tuple[int, int]) -> tup
     return block_edges(xe, factors[1]), block_edges(ye, factors[0]) if plan.y else ye
 
 
-def figure_title(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, width: float) -> str:
+def figure_title(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, width: float, chars: int | None = None) -> str:
     """The title over the map or the panels (:func:`stabmap.read.plot.captions.atlas_title`), in lines as wide as
     the maps, with the headline (:mod:`stabmap.read.headline`) of the grid points and cells drawn."""
     from ..summary import scanned_axes
@@ -136,7 +155,8 @@ def figure_title(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, wid
         whole=None if shares is None else shares.whole, change=0.0 if shares is None else shares.change,
         axes=scanned_axes(ds, [d for d in (plan.x, plan.y) if d]), shown=plan.facet is not None or bool(plan.fixed),
     )
-    return atlas_title(ds, plan, head.text(system), 70 if plan.facet is None else int(12 * (width - LEGEND_WIDTH)),
+    chars = chars or (70 if plan.facet is None else int(12 * (width - LEGEND_WIDTH)))
+    return atlas_title(ds, plan, head.text(system), chars,
                        reduced.factors, reduced.shape)
 
 

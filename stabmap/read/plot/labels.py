@@ -13,6 +13,7 @@ import xarray as xr
 
 from ... import systems
 from ...scene import units
+from ...scene.units import factor as unit_factor
 
 
 def mathtext(symbol: str) -> str:
@@ -86,9 +87,14 @@ def display_ticks(ds: xr.Dataset, dim: str, axis, nbins: int | str = "auto") -> 
 
 
 def value_text(ds: xr.Dataset, dim: str, value: float) -> str:
-    """'$m_{2}$ = 1 kg': the coordinate ``dim`` at ``value``, with its symbol and units."""
+    """'$m_{2}$ = 1 kg': the coordinate ``dim`` at ``value``, with its symbol and units; a spin rate the scene gave in
+    rpm or Hz (``display_units``) in that unit first, the stored unit beside it: '$\\omega$ = 1000 rpm (104.7 rad s⁻¹)'."""
     units = units_text(str(ds[dim].attrs.get("units", "")))
-    return f"{symbol(ds, dim)} = {value:.4g}" + (f" {units}" if units else "")
+    stored = f"{value:.4g}" + (f" {units}" if units else "")
+    shown = str(ds[dim].attrs.get("display_units", ""))
+    if shown:
+        return f"{symbol(ds, dim)} = {value / unit_factor(shown):.4g} {shown} ({stored})"
+    return f"{symbol(ds, dim)} = {stored}"
 
 
 def log_axis(ds: xr.Dataset, dim: str) -> bool:
