@@ -180,14 +180,31 @@ def test_single_class_map_draws_no_boundary():
     assert "100.0 % of 6 grid points stable" in fig.axes[0].get_title()
 
 
-def test_strip_for_one_axis():
-    ds = hand_atlas({"omega": (np.linspace(0, 10, 6), "linear")}, np.array([0, 0, 1, 1, 2, 0]))
+def test_one_free_axis_draws_the_label_as_a_line():
+    """One free axis: N_c against it as a line (its grid values on the y axis, not a strip with an empty y axis),
+    over its classes' colours, with the stability boundary between the stretches; the growth rate beneath where the
+    atlas stores it, on the same x axis."""
+    nc = np.array([0, 0, 1, 1, 2, 0])
+    ds = hand_atlas({"omega": (np.linspace(0, 10, 6), "linear")}, nc)
     fig = atlas_figure(ds)
-    assert len(fig.axes) == 1 and list(fig.axes[0].get_yticks()) == []
-    (stab,) = drawn(fig.axes[0], "stability-boundary")
+    (ax,) = fig.axes
+    assert [int(v) for v in ax.get_yticks()] == [0, 1, 2] and "N" in ax.get_ylabel()
+    (line,) = [a for a in ax.patches if a.get_gid() == "label-line"]  # stairs: one step a grid point, at its N_c
+    np.testing.assert_array_equal(line.get_data().values, nc)
+    np.testing.assert_array_equal(line.get_data().edges, [0, 1, 3, 5, 7, 9, 10])
+    (stab,) = drawn(ax, "stability-boundary")
     xs = sorted(float(s[0][0]) for s in stab.get_segments())
     assert xs == [3.0, 9.0]  # between omega = 2|4 and 8|10
     assert all(s[0][0] == s[1][0] for s in stab.get_segments())
+
+    growth = np.where(nc > 0, nc * 0.5, 0.0)
+    ds["growth_rate"] = ("omega", growth, {"long_name": "largest growth rate", "units": "s-1"})
+    fig = atlas_figure(ds)
+    top, bottom = fig.axes
+    assert bottom.get_shared_x_axes().joined(top, bottom) and "growth rate" in bottom.get_ylabel()
+    (values,) = [a for a in bottom.lines if a.get_gid() == "values"]
+    np.testing.assert_array_equal(values.get_ydata()[nc > 0], growth[nc > 0])
+    assert "growth rate" in [t.get_text() for t in legend_of(fig).get_texts()]
 
 
 # --------------------------------------------------------------------------------------------- real atlases

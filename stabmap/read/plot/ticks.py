@@ -72,10 +72,17 @@ def axis_ticks(ds: xr.Dataset, dim: str, lo: float, hi: float, inches: float, wh
     shown = set_axis(ax, which, ds, dim, lo, hi, inches)
     axis = ax.xaxis if which == "x" else ax.yaxis
     a, b = min(lo, hi), max(lo, hi)
-    inside = lambda v: a * (1 - 1e-9) <= v <= b * (1 + 1e-9) if a > 0 else a - 1e-9 * (b - a) <= v <= b + 1e-9 * (b - a)  # noqa: E731
+    slack = 1e-9 * (math.log(b / a) if a > 0 and axis.get_scale() == "log" else b - a)
+
+    def inside(v: float) -> bool:  # matplotlib shows a tick a rounding error beyond the limits: 0.30000000000000004 of 0.3
+        w = math.log(v / a) if a > 0 and axis.get_scale() == "log" else v - a
+        return -slack <= w <= (math.log(b / a) if a > 0 and axis.get_scale() == "log" else b - a) + slack
+
     labelled, unlabelled = [], []
     for locs, fmt in ((axis.get_majorticklocs(), axis.get_major_formatter()), (axis.get_minorticklocs(), axis.get_minor_formatter())):
-        locs = [float(v) for v in locs if inside(float(v))]
+        locs = [float(v) for v in locs if v > 0 or axis.get_scale() != "log"]
+        locs = [v for v in locs if inside(v)]
         for v, text in zip(locs, fmt.format_ticks(locs), strict=True):
+            v = min(max(v, a), b)  # on the page's range, or a browser leaves it out
             (labelled.append((v, text)) if text else unlabelled.append(v))
     return Ticks(shown, labelled, unlabelled)
