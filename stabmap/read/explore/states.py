@@ -22,7 +22,7 @@ CELL_SHIFT = 16  # provenance meanings take bits 0..15 of a point's bits, the me
 VEIL = 0.45  # share of white over a colour: "lighter" (a critical-values page's undecided gaps)
 # The page's hatches (bokeh patterns) and their ink, as the PNG maps hatch (stabmap.read.plot.paint.hatch_cells): dots
 # over cells proved at their node only, light diagonal lines over inferred ones, the change's dark lines.
-NODE_ONLY_HATCH, INFERRED_HATCH, FAINT_INK = ".", "/", "#00000059"
+NODE_ONLY_HATCH, INFERRED_HATCH, FAINT_INK = ".", "/", "#00000040"
 HATCH_INK = {NODE_ONLY_HATCH: FAINT_INK, INFERRED_HATCH: FAINT_INK, PAGE_HATCH: CHANGE_INK}
 CELL_TEXT = {
     "whole_cell": "the label holds at every point of the cell",
