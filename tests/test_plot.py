@@ -403,3 +403,30 @@ def test_bad_suffix_and_failed_save_leave_no_file(atlas3, tmp_path, monkeypatch)
     with pytest.raises(KeyboardInterrupt):
         plot_atlas(atlas3, tmp_path / "map.pdf")
     assert os.listdir(tmp_path) == []
+
+
+def test_spin_rates_in_the_scenes_unit_with_rad_s_beside():
+    """A spin-rate axis the scene gave in rpm: a panel's title, the page's hover and the critical-values figure give
+    its values in rpm with rad/s beside them (they gave rad/s only), and its axis is labelled in rpm."""
+    from stabmap.read.explore.text import value_text as page_text
+    from stabmap.read.plot.critical import critical_figure
+    from stabmap.run.critical import critical
+
+    ds = hand_atlas({"omega": ([2 * np.pi, 4 * np.pi], "linear"), "m_2": ([1.0, 2.0], "log"), "K_1": ([5.0, 20.0], "linear")},
+                    np.zeros((2, 2, 2), dtype=int))
+    ds["omega"].attrs["display_units"] = "rpm"
+    fig = atlas_figure(ds, x="m_2", y="K_1", facet="omega")
+    assert [ax.get_title().split("\n")[0].split("  ")[0] for ax in fig.axes[:2]] == \
+        ["$\\omega$ = 60 rpm (6.283 rad\u00a0s$^{-1}$)", "$\\omega$ = 120 rpm (12.57 rad\u00a0s$^{-1}$)"]
+    assert page_text(ds, "omega", 2 * np.pi) == "ω = 60 rpm (6.28319 rad s⁻¹)"
+
+    grid = SCENE[SCENE.index("[grid]"):]
+    scene = stabmap.loads_scene(SCENE.replace(grid, '[grid]\nomega = { start = "100 rpm", stop = "1400 rpm", num = 8 }\n'
+                                                    'm_2 = { start = 0.1, stop = 5.0, num = 3, scale = "log" }\n'))
+    fig = critical_figure(critical(scene, "omega", rtol=1e-6, threads=1, progress=False))
+    ax = fig.axes[0]
+    fig.canvas.draw()
+    assert ax.get_xlabel().endswith("[rpm]")
+    lo, hi = ax.get_xlim()  # 100 .. 1400 rpm, in rad/s
+    shown = [t.get_text() for t, v in zip(ax.get_xticklabels(), ax.get_xticks(), strict=True) if lo <= v <= hi]
+    assert shown[:2] == ["200", "400"] and np.isclose(hi, 1400 * 2 * np.pi / 60)
