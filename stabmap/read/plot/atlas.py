@@ -58,7 +58,9 @@ def atlas_figure(
     matplotlib.figure.Figure
         Not registered with pyplot: save it with ``fig.savefig``. ``fig.axes[0]`` is the first map (for a 2-D
         atlas the only one) in data coordinates, x and y being the grid values, so curves can be overlaid with
-        ``fig.axes[0].plot(x, y)``; its limits are fixed to the grid. The legend is ``fig.legends[0]``.
+        ``fig.axes[0].plot(x, y)``; its limits are fixed to the grid. The legend is ``fig.legends[0]``. With one
+        free axis, ``fig.axes[0]`` is the label's line against it and ``fig.axes[1]`` (where the atlas stores a
+        growth rate) the growth rate's beneath (:mod:`stabmap.read.plot.label_line`).
 
     Raises
     ------
@@ -71,9 +73,9 @@ def atlas_figure(
     nrows, ncols, width = panel_grid(plan)
     reduced = reduce_panels(ds, plan, system, width, nrows, ncols)
     xe, ye = map_edges(ds, plan, reduced.factors)
-    title = figure_title(ds, plan, system, reduced, width)
     if plan.y is None:  # one free axis: a line of the label (and the growth rate), not a strip with an empty y axis
         return line_figure(ds, plan, system, reduced, xe, figure_title(ds, plan, system, reduced, width, chars=52), width)
+    title = figure_title(ds, plan, system, reduced, width)
     size = figure_size(plan, width, nrows, title.count("\n") + 1, len(reduced.present))
     fig = captioned_figure(ds, size)
     if plan.facet is None:
