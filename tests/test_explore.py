@@ -288,13 +288,13 @@ def painted_fills(page) -> tuple[np.ndarray, object]:
 
 
 def test_a_cell_holding_a_change_keeps_its_class_colour_under_a_hatch(monkeypatch):
-    """Every block of one class is painted in its class's colour (lighter where proved at its node only or inferred),
-    hatched exactly where a cell in it is proved to hold a change: node by node, and in blocks of 2 x 2 nodes of
-    one class, some holding a change."""
+    """Every block of one class is painted in its class's colour, as the PNG paints it (never lighter), hatched dark
+    exactly where a cell in it is proved to hold a change, dotted where proved at its node only, lightly hatched
+    where inferred: node by node, and in blocks of 2 x 2 nodes of one class, some holding a change."""
     from flagged import CELLS, CHANGE, LABELS, NODE_ONLY, NOT_PROVED, flagged_atlas
 
     import stabmap.read.explore.atlas as page_module
-    from stabmap.read.explore.states import lighter
+    from stabmap.read.explore.states import INFERRED_HATCH, NODE_ONLY_HATCH
     from stabmap.read.plot.marks import PAGE_HATCH
     from stabmap.read.plot.palette import system_colour
 
@@ -308,10 +308,10 @@ def test_a_cell_holding_a_change_keeps_its_class_colour_under_a_hatch(monkeypatc
         assert ids.shape == LABELS.shape
         colour = np.array(quad.fill_color.transform.palette, dtype=object)[ids]
         want = np.array([[system_colour(int(v), system) for v in row] for row in LABELS], dtype=object)
-        light = (CELLS == NODE_ONLY) | (CELLS == NOT_PROVED)
-        want[light] = [lighter(c) for c in want[light]]
         assert (colour == want).all(), (colour, want)
         hatch = np.array(quad.hatch_pattern.transform.args["h"], dtype=object)[ids]
         assert ((hatch == PAGE_HATCH) == (CELLS == CHANGE)).all()
+        assert ((hatch == NODE_ONLY_HATCH) == (CELLS == NODE_ONLY)).all()
+        assert ((hatch == INFERRED_HATCH) == (CELLS == NOT_PROVED)).all()
         (legend,) = [m for m in page.layout.references() if getattr(m, "name", None) == "legend"]
         assert "hatched: a change of label is proved inside the cell (colour: the label at its grid point)" in legend.text

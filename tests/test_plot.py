@@ -180,14 +180,31 @@ def test_single_class_map_draws_no_boundary():
     assert "100.0 % of 6 grid points stable" in fig.axes[0].get_title()
 
 
-def test_strip_for_one_axis():
-    ds = hand_atlas({"omega": (np.linspace(0, 10, 6), "linear")}, np.array([0, 0, 1, 1, 2, 0]))
+def test_one_free_axis_draws_the_label_as_a_line():
+    """One free axis: N_c against it as a line (its grid values on the y axis, not a strip with an empty y axis),
+    over its classes' colours, with the stability boundary between the stretches; the growth rate beneath where the
+    atlas stores it, on the same x axis."""
+    nc = np.array([0, 0, 1, 1, 2, 0])
+    ds = hand_atlas({"omega": (np.linspace(0, 10, 6), "linear")}, nc)
     fig = atlas_figure(ds)
-    assert len(fig.axes) == 1 and list(fig.axes[0].get_yticks()) == []
-    (stab,) = drawn(fig.axes[0], "stability-boundary")
+    (ax,) = fig.axes
+    assert [int(v) for v in ax.get_yticks()] == [0, 1, 2] and "N" in ax.get_ylabel()
+    (line,) = [a for a in ax.patches if a.get_gid() == "label-line"]  # stairs: one step a grid point, at its N_c
+    np.testing.assert_array_equal(line.get_data().values, nc)
+    np.testing.assert_array_equal(line.get_data().edges, [0, 1, 3, 5, 7, 9, 10])
+    (stab,) = drawn(ax, "stability-boundary")
     xs = sorted(float(s[0][0]) for s in stab.get_segments())
     assert xs == [3.0, 9.0]  # between omega = 2|4 and 8|10
     assert all(s[0][0] == s[1][0] for s in stab.get_segments())
+
+    growth = np.where(nc > 0, nc * 0.5, 0.0)
+    ds["growth_rate"] = ("omega", growth, {"long_name": "largest growth rate", "units": "s-1"})
+    fig = atlas_figure(ds)
+    top, bottom = fig.axes
+    assert bottom.get_shared_x_axes().joined(top, bottom) and "growth rate" in bottom.get_ylabel()
+    (values,) = [a for a in bottom.lines if a.get_gid() == "values"]
+    np.testing.assert_array_equal(values.get_ydata()[nc > 0], growth[nc > 0])
+    assert "growth rate" in [t.get_text() for t in legend_of(fig).get_texts()]
 
 
 # --------------------------------------------------------------------------------------------- real atlases
@@ -386,3 +403,30 @@ def test_bad_suffix_and_failed_save_leave_no_file(atlas3, tmp_path, monkeypatch)
     with pytest.raises(KeyboardInterrupt):
         plot_atlas(atlas3, tmp_path / "map.pdf")
     assert os.listdir(tmp_path) == []
+
+
+def test_spin_rates_in_the_scenes_unit_with_rad_s_beside():
+    """A spin-rate axis the scene gave in rpm: a panel's title, the page's hover and the critical-values figure give
+    its values in rpm with rad/s beside them (they gave rad/s only), and its axis is labelled in rpm."""
+    from stabmap.read.explore.text import value_text as page_text
+    from stabmap.read.plot.critical import critical_figure
+    from stabmap.run.critical import critical
+
+    ds = hand_atlas({"omega": ([2 * np.pi, 4 * np.pi], "linear"), "m_2": ([1.0, 2.0], "log"), "K_1": ([5.0, 20.0], "linear")},
+                    np.zeros((2, 2, 2), dtype=int))
+    ds["omega"].attrs["display_units"] = "rpm"
+    fig = atlas_figure(ds, x="m_2", y="K_1", facet="omega")
+    assert [ax.get_title().split("\n")[0].split("  ")[0] for ax in fig.axes[:2]] == \
+        ["$\\omega$ = 60 rpm (6.283 rad\u00a0s$^{-1}$)", "$\\omega$ = 120 rpm (12.57 rad\u00a0s$^{-1}$)"]
+    assert page_text(ds, "omega", 2 * np.pi) == "ω = 60 rpm (6.28319 rad s⁻¹)"
+
+    grid = SCENE[SCENE.index("[grid]"):]
+    scene = stabmap.loads_scene(SCENE.replace(grid, '[grid]\nomega = { start = "100 rpm", stop = "1400 rpm", num = 8 }\n'
+                                                    'm_2 = { start = 0.1, stop = 5.0, num = 3, scale = "log" }\n'))
+    fig = critical_figure(critical(scene, "omega", rtol=1e-6, threads=1, progress=False))
+    ax = fig.axes[0]
+    fig.canvas.draw()
+    assert ax.get_xlabel().endswith("[rpm]")
+    lo, hi = ax.get_xlim()  # 100 .. 1400 rpm, in rad/s
+    shown = [t.get_text() for t, v in zip(ax.get_xticklabels(), ax.get_xticks(), strict=True) if lo <= v <= hi]
+    assert shown[:2] == ["200", "400"] and np.isclose(hi, 1400 * 2 * np.pi / 60)

@@ -22,14 +22,16 @@ from ...errors import StabmapError
 from ...store.variables import CELL
 from ..blocks import compute
 from ..plot.captions import fixed_caption
+from ..plot.layout import SINGLE_WIDTH, panel_points
 from ..plot.marks import CHANGE_INK, change_text, hidden_cell_axes
 from ..plot.palette import BOUNDARY, CLASS_EDGE, system_colour
+from ..plot.ticks import axis_ticks
 from ..summary import summary
 from . import widgets
 from .frames import EAGER_POINTS, MAP_PIXELS, Frame, map_grid, read_frame
 from .page import MAX_MB, Page, budget, fitted
 from .plan import PagePlan, plan_page
-from .states import Legend, lighter, point_bits, state_text
+from .states import Legend, point_bits, state_text
 from .text import axis_title, escape, plain, span_texts, value_text
 
 # The block under the pointer (data coordinates x, y) -> its text: its values along x and y, the other axes' values,
@@ -137,9 +139,10 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: l
                x_range=Range1d(float(grid.xe[0]), float(grid.xe[-1]), bounds="auto"),  # not panned past the scan
                y_range=Range1d(float(grid.ye[0]), float(grid.ye[-1]), bounds="auto"),
                tools="pan,wheel_zoom,box_zoom,reset,save", toolbar_location="right")
-    p.xaxis.axis_label = axis_title(ds, plan.x)
+    inches = map_inches(plan)
+    p.xaxis.axis_label = axis_title(ds, plan.x, widgets.set_ticks(p.xaxis, axis_ticks(ds, plan.x, grid.xe[0], grid.xe[-1], inches[1], "x")))
     if plan.y:
-        p.yaxis.axis_label = axis_title(ds, plan.y)
+        p.yaxis.axis_label = axis_title(ds, plan.y, widgets.set_ticks(p.yaxis, axis_ticks(ds, plan.y, grid.ye[0], grid.ye[-1], inches[0], "y")))
     else:
         p.yaxis.visible = False
     p.grid.visible = False
@@ -154,9 +157,12 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, grid, legend: Legend, chosen: l
     edges = {side: CustomJSExpr(args={"xe": tables["xe"], "ye": tables["ye"]}, code=code) for side, code in RECT_EDGES_JS.items()}
     # A fill id names a colour and a hatch: cells proved to hold a change keep their class colour under the hatch.
     hatch = CustomJSTransform(args={"h": legend.hatches}, v_func="return Array.from(xs, x => h[x] || ' ');")
+    ink = CustomJSTransform(args={"c": legend.inks}, v_func="return Array.from(xs, x => c[x]);")
     blocks = p.quad(left={"expr": edges["left"]}, right={"expr": edges["right"]}, bottom={"expr": edges["bottom"]},
-                    top={"expr": edges["top"]}, source=rects, fill_color={"field": "colour", "transform": mapper}, line_color=None,
-                    hatch_pattern={"field": "colour", "transform": hatch}, hatch_color=CHANGE_INK[:7], hatch_alpha=0.85,
+                    top={"expr": edges["top"]}, source=rects, fill_color={"field": "colour", "transform": mapper},
+                    # outlined in their own colour: no seam of antialiased edges shows between rows of rectangles
+                    line_color={"field": "colour", "transform": mapper}, line_width=1,
+                    hatch_pattern={"field": "colour", "transform": hatch}, hatch_color={"field": "colour", "transform": ink},
                     hatch_scale=8, hatch_weight=1.2)
     lines = []
     for kind, colour in (("classes", CLASS_EDGE), ("stability", BOUNDARY)):
@@ -192,6 +198,11 @@ title.text = titles[k];
     change = change_text(hidden_cell_axes(ds, system.label, (plan.x, plan.y)), ds, plain)
     side = widgets.legend(plain(system.label_title), legend_entries(system, chosen, change))
     return column(title, row(p, side), *controls, readout, widgets.caption(caption_lines(ds, plan, grid, None if whole else head)))
+
+
+def map_inches(plan: PagePlan) -> tuple[float, float]:
+    """The length (y, x) [inch] of the PNG's single map of these axes: the page's ticks are chosen as on it."""
+    return tuple(v / 72 for v in panel_points(SINGLE_WIDTH, 1, 1, facets=False, strip=plan.y is None))  # type: ignore[return-value]
 
 
 def rect_columns(f: Frame) -> dict[str, np.ndarray]:
@@ -241,9 +252,9 @@ def legend_entries(system, chosen: list[Frame], change: str = "") -> list[str]:
     if "classes" in drawn:
         entries.append(widgets.swatch(CLASS_EDGE, f"{plain(system.label_symbol)} changes", "thin"))
     if "inferred" in drawn:
-        entries.append(widgets.swatch(lighter("#888888"), "lighter: inferred from cell corners (not computed)"))
+        entries.append(widgets.swatch("#888888", "inferred from cell corners (not computed)", "hatch"))
     if "node-only" in drawn:
-        entries.append(widgets.swatch(lighter("#888888"), "lighter: proved at the grid node, not over its cell"))
+        entries.append(widgets.swatch("#888888", "proved at the grid node, not over its cell", "dots"))
     if "change" in drawn:
         entries.append(widgets.swatch(CHANGE_INK[:7], change, "hatch"))
     if "mixed-stability" in drawn:

@@ -9,11 +9,13 @@ import xarray as xr
 
 from ... import systems
 from ...errors import StabmapError, given
+from ...scene.units import factor as unit_factor
 from ..plot.captions import fixed_caption
-from ..plot.critical import critical_rows, critical_stretches, scanned_attrs
+from ..plot.critical import CRITICAL_INCHES, CRITICAL_INCHES_Y, critical_rows, critical_stretches, scanned_names
 from ..plot.geometry import cell_edges
 from ..plot.layout import nearest
 from ..plot.palette import system_colour
+from ..plot.ticks import axis_ticks
 from . import widgets
 from .page import MAX_MB, Page, budget, fitted
 from .plan import PagePlan
@@ -71,12 +73,6 @@ def critical_page(ds: xr.Dataset, *, y: str | None = None, sel: dict[str, float]
     return fitted(plan, dict(ds.sizes), max_mb, guess, make)
 
 
-def scanned_names(ds: xr.Dataset, system, along: str) -> xr.Dataset:
-    """A one-coordinate Dataset naming the scanned parameter as an atlas's axis (long_name, units), for its texts."""
-    attrs = scanned_attrs(ds, system, along, ds[f"{along}_stable_lower"])
-    return xr.Dataset(coords={along: ((), 0.0, attrs)}, attrs=ds.attrs)
-
-
 def stretch_columns(frame: xr.Dataset, system, along: str, y: str | None, edges: np.ndarray, stretches: list[tuple],
                     undecided: list[tuple], names: xr.Dataset, at: dict[str, int]) -> dict:
     """The stretches and the undecided gaps (``undecided``: row, x0, x1, the class at both ends) of one frame as quads:
@@ -84,6 +80,7 @@ def stretch_columns(frame: xr.Dataset, system, along: str, y: str | None, edges:
     rows = [value_text(frame, y, float(v)) for v in np.asarray(frame[y])] if y else [""] * (len(edges) - 1)
     cols: dict[str, list] = {"left": [], "right": [], "bottom": [], "top": [], "cls": [], "colour": [], "text": []}
     unit = unit_plain(names, along).strip()
+    display = str(names[along].attrs.get("display_units", ""))
     symbol = name(names, along)
     where = [value_text(frame, d, float(frame[d])) for d in at]
     label = plain(system.label_symbol)
@@ -94,10 +91,11 @@ def stretch_columns(frame: xr.Dataset, system, along: str, y: str | None, edges:
         cols["top"].append(edges[r + 1])
         cols["cls"].append(int(c))
         colour = system_colour(int(c), system)
+        shown = f" ({x0 / unit_factor(display):.6g} to {x1 / unit_factor(display):.6g} {display})" if display else ""
         cols["colour"].append(lighter(colour) if gap else colour)
         head = (f"undecided gap: {label} = {c} ({system.class_name(int(c))}) at both ends, not proved inside" if gap
                 else f"{label} = {c}: {system.class_name(int(c))}")
-        cols["text"].append("\n".join(t for t in [head, f"{symbol} from {x0:.10g} to {x1:.10g} {unit}".rstrip(), rows[r], *where] if t))
+        cols["text"].append("\n".join(t for t in [head, f"{symbol} from {x0:.10g} to {x1:.10g} {unit}".rstrip() + shown, rows[r], *where] if t))
     return {k: np.asarray(v, dtype=float) if k in ("left", "right", "bottom", "top") else np.asarray(v, dtype=np.int16) if k == "cls" else v
             for k, v in cols.items()}
 
@@ -128,15 +126,17 @@ def draw(ds: xr.Dataset, system, plan: PagePlan, edges: np.ndarray, scan: list[f
     p = figure(name="map", frame_width=600, frame_height=450 if y else 80, x_range=(scan[0], scan[1]),
                y_range=(float(edges[0]), float(edges[-1])), y_axis_type="log" if log_y else "linear",
                tools="pan,wheel_zoom,box_zoom,reset,save", toolbar_location="right")
-    p.xaxis.axis_label = axis_title(names, plan.x)
+    shown = widgets.set_ticks(p.xaxis, axis_ticks(names, plan.x, scan[0], scan[1], CRITICAL_INCHES, "x"))  # as the PNG's
+    p.xaxis.axis_label = axis_title(names, plan.x, shown)
     if y:
-        p.yaxis.axis_label = axis_title(ds, y)
+        p.yaxis.axis_label = axis_title(ds, y, widgets.set_ticks(p.yaxis, axis_ticks(ds, y, edges[0], edges[-1], CRITICAL_INCHES_Y, "y")))
     else:
         p.yaxis.visible = False
     p.grid.visible = False
     quads = ColumnDataSource(frames[0][0])
     dots = ColumnDataSource(frames[0][1])
-    glyph = p.quad(left="left", right="right", bottom="bottom", top="top", fill_color="colour", line_color=None, source=quads)
+    glyph = p.quad(left="left", right="right", bottom="bottom", top="top", fill_color="colour", line_color="colour",
+                   line_width=1, source=quads)  # outlined in their own colour: no seams between rows
     p.scatter(x="x", y="y", size=4, color="black", source=dots)
     readout = widgets.readout()
     p.add_tools(HoverTool(renderers=[glyph], tooltips='<div style="white-space: pre-line; max-width: 420px">@text</div>',

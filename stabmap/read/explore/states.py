@@ -14,12 +14,16 @@ import numpy as np
 import xarray as xr
 
 from ...store.variables import CELL, INFERRED
-from ..plot.marks import PAGE_HATCH
+from ..plot.marks import CHANGE_INK, PAGE_HATCH
 from ..plot.palette import BOUNDARY, CLASS_EDGE, system_colour
 from .text import plain
 
 CELL_SHIFT = 16  # provenance meanings take bits 0..15 of a point's bits, the meanings of ``cell`` the bits above
-VEIL = 0.45  # share of white over the class colour of cells proved at their node only, or inferred: "lighter"
+VEIL = 0.45  # share of white over a colour: "lighter" (a critical-values page's undecided gaps)
+# The page's hatches (bokeh patterns) and their ink, as the PNG maps hatch (stabmap.read.plot.paint.hatch_cells): dots
+# over cells proved at their node only, light diagonal lines over inferred ones, the change's dark lines.
+NODE_ONLY_HATCH, INFERRED_HATCH, FAINT_INK = ".", "/", "#00000040"
+HATCH_INK = {NODE_ONLY_HATCH: FAINT_INK, INFERRED_HATCH: FAINT_INK, PAGE_HATCH: CHANGE_INK}
 CELL_TEXT = {
     "whole_cell": "the label holds at every point of the cell",
     "contains_change": "the cell is proved to hold a change of label (the label given is its grid point's)",
@@ -80,6 +84,11 @@ class Legend:
         """The hatch pattern of each id (bokeh's ``hatch_pattern``; "" for none)."""
         return [h for _, h in self.fills]
 
+    @property
+    def inks(self) -> list[str]:
+        """The colour of each id's hatch (bokeh's ``hatch_color``)."""
+        return [HATCH_INK.get(h, CHANGE_INK) for _, h in self.fills]
+
 
 def lighter(colour: str) -> str:
     """``colour`` under a white veil of VEIL."""
@@ -93,10 +102,10 @@ def cell_bit(meaning: str) -> int:
 
 
 def block_colours(blocks, legend: Legend) -> tuple[np.ndarray, set[str]]:
-    """The colour id of every block, as the PNG maps draw it: a block of one class in that class's colour (lighter
-    where a cell is proved at its node only or inferred, hatched where a cell is proved to hold a change: the
-    colour stays the grid points' label), a block of stable and unstable points black, other mixed blocks dark
-    grey; and the marks drawn, for the legend ("inferred", "node-only", "change", "mixed-classes",
+    """The colour id of every block, as the PNG maps draw it: a block of one class in that class's colour (dotted
+    where a cell is proved at its node only, hatched lightly where inferred, hatched dark where a cell is proved to
+    hold a change, which wins where both are: the colour stays the grid points' label), a block of stable and
+    unstable points black, other mixed blocks dark grey; and the marks drawn, for the legend ("inferred", "node-only", "change", "mixed-classes",
     "mixed-stability")."""
     system = legend.system
     low, mixed = blocks.low, blocks.low != blocks.high
@@ -107,11 +116,11 @@ def block_colours(blocks, legend: Legend) -> tuple[np.ndarray, set[str]]:
     out = np.empty(low.shape, dtype=np.int64)
     for v in np.unique(low):
         base = system_colour(int(v), system)
-        for light in (False, True):
-            for hatched in (False, True):
-                at = (low == v) & ((inferred | node_only) == light) & (change == hatched)
-                if at.any():
-                    out[at] = legend.id(lighter(base) if light else base, PAGE_HATCH if hatched else "")
+        for hatch, at in ((PAGE_HATCH, change), (INFERRED_HATCH, inferred & ~change), (NODE_ONLY_HATCH, node_only & ~change),
+                          ("", ~(change | inferred | node_only))):
+            at = at & (low == v)
+            if at.any():
+                out[at] = legend.id(base, hatch)
     marks = {entry for mask, entry in ((inferred & ~mixed, "inferred"), (node_only & ~mixed, "node-only"), (change, "change"))
              if mask.any()}
     for mask, colour, entry in ((mixed & ~blocks.mixed_stability, CLASS_EDGE, "mixed-classes"),

@@ -29,11 +29,20 @@ def _script(text: str, table: dict, mark: str) -> str:
 
 
 def plain(text: str) -> str:
-    """Mathtext as plain Unicode: ``$m_{2}$`` -> m₂, ``$\\omega$`` -> ω, ``s$^{-1}$`` -> s⁻¹, ``c_1^2`` -> c₁²."""
-    out = re.sub(r"\\([A-Za-z]+)", lambda m: GREEK.get(m.group(1), m.group(1)), str(text))
+    """Mathtext as plain Unicode, as matplotlib shows it: ``$m_{2}$`` -> m₂, ``$\\omega$`` -> ω, ``s$^{-1}$`` -> s⁻¹,
+    ``$c_1^2$`` -> c₁²; outside ``$...$`` the text is shown as written (``half_height_1`` stays so)."""
+    parts = str(text).split("$")
+    if len(parts) % 2 == 0:  # an unpaired $: matplotlib shows the text as written
+        return str(text)
+    return "".join(_math(p) if k % 2 else p for k, p in enumerate(parts))
+
+
+def _math(text: str) -> str:
+    """One ``$...$`` segment as Unicode."""
+    out = re.sub(r"\\([A-Za-z]+)", lambda m: GREEK.get(m.group(1), m.group(1)), text)
     out = re.sub(r"_\{([^{}]*)\}|_(\w)", lambda m: _script(m.group(1) or m.group(2), _SUB, "_"), out)
     out = re.sub(r"\^\{([^{}]*)\}|\^(\w)", lambda m: _script(m.group(1) or m.group(2), _SUP, "^"), out)
-    return out.replace("$", "").replace("{", "").replace("}", "")
+    return out.replace("{", "").replace("}", "").replace("\\,", " ").replace("\\ ", " ")
 
 
 def unit_plain(ds: xr.Dataset, dim: str) -> str:
@@ -42,9 +51,10 @@ def unit_plain(ds: xr.Dataset, dim: str) -> str:
     return f" {u}" if u else ""
 
 
-def axis_title(ds: xr.Dataset, dim: str) -> str:
-    """'common spin rate ω [rad s⁻¹]': the figures' axis label, one line, plain Unicode."""
-    return plain(axis_label(ds, dim, width=10_000)).replace("\u00a0", " ")
+def axis_title(ds: xr.Dataset, dim: str, shown: str = "") -> str:
+    """'common spin rate ω [rpm]': the figures' axis label (:func:`stabmap.read.plot.labels.axis_label`, ``shown``:
+    the unit its ticks are shown in), one line, plain Unicode."""
+    return plain(axis_label(ds, dim, width=10_000, shown=shown)).replace("\u00a0", " ")
 
 
 def name(ds: xr.Dataset, dim: str) -> str:
@@ -53,11 +63,12 @@ def name(ds: xr.Dataset, dim: str) -> str:
 
 
 def value_text(ds: xr.Dataset, dim: str, value: float) -> str:
-    """'ω = 42.5 rad s⁻¹ (406 rpm)': a value of ``dim`` with its symbol and units, and in the axis's display units
-    (rpm, Hz) when the scene gave them."""
-    text = f"{name(ds, dim)} = {value:.6g}{unit_plain(ds, dim)}"
+    """'ω = 406 rpm (42.5 rad s⁻¹)': a value of ``dim`` with its symbol, in the axis's display unit (rpm, Hz) when the
+    scene gave one, as its axis shows it, and in the stored units."""
     shown = str(ds[dim].attrs.get("display_units", ""))
-    return text + (f" ({value / units.factor(shown):.6g} {shown})" if shown else "")
+    if shown:
+        return f"{name(ds, dim)} = {value / units.factor(shown):.6g} {shown} ({value:.6g}{unit_plain(ds, dim)})"
+    return f"{name(ds, dim)} = {value:.6g}{unit_plain(ds, dim)}"
 
 
 def span_texts(ds: xr.Dataset, dim: str, k: int) -> list[str]:

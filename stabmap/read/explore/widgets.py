@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .text import escape, value_text
+from ..plot.ticks import Ticks
+from .text import escape, plain, value_text
 
 # The frame shown: the slider positions read as one mixed-radix number, the first slider turning slowest.
 FRAME_JS = """
@@ -62,9 +63,11 @@ def readout():
 
 def swatch(colour: str, text: str, kind: str = "box") -> str:
     """One legend entry in HTML: a box of ``colour``, white hatched in ``colour`` (``kind="hatch"``, as the map
-    hatches cells holding a change), or a line (``kind="line"``, ``"thin"``)."""
-    if kind in ("box", "hatch"):
-        fill = colour if kind == "box" else f"repeating-linear-gradient(45deg, {colour} 0 1.2px, #FFFFFF 1.2px 5px)"
+    hatches cells holding a change), white dotted (``kind="dots"``, cells proved at the node only), or a line
+    (``kind="line"``, ``"thin"``)."""
+    if kind in ("box", "hatch", "dots"):
+        fill = {"box": colour, "hatch": f"repeating-linear-gradient(45deg, {colour} 0 1.2px, #FFFFFF 1.2px 5px)",
+                "dots": f"radial-gradient({colour} 1px, #FFFFFF 1.2px) 0 0 / 4px 4px"}[kind]
         mark = f'<span style="display:inline-block;width:14px;height:14px;background:{fill};border:1px solid #888;vertical-align:middle"></span>'
     else:
         height = 3 if kind == "line" else 1
@@ -103,3 +106,13 @@ def array(a) -> np.ndarray:
     """The smallest unsigned integer type that holds ``a`` (a page stores state indices, not labels)."""
     a = np.asarray(a)
     return a.astype(np.uint8 if a.max(initial=0) < 256 else np.uint16)
+
+
+def set_ticks(axis, ticks: Ticks) -> str:
+    """Put the PNG's ticks on a bokeh axis: its labelled ticks as major ticks with the PNG's texts, the others as
+    minor ticks. Returns the unit the texts are in. Fixed ticks stay where they are when the map is zoomed."""
+    from bokeh.models import FixedTicker
+
+    axis.ticker = FixedTicker(ticks=[v for v, _ in ticks.labelled], minor_ticks=ticks.unlabelled)
+    axis.major_label_overrides = {v: plain(t) for v, t in ticks.labelled}
+    return ticks.shown

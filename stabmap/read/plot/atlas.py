@@ -15,12 +15,14 @@ from ..areas import AreaShares
 from ..headline import Headline
 from .captions import atlas_title, captioned_figure
 from .geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges
-from .labels import axis_label, display_ticks, log_axis, log_ticks, value_text
+from .label_line import LABEL_HEIGHT, draw_label_line, label_legend, line_size
+from .labels import axis_label, log_axis, value_text
 from .layout import LEGEND_WIDTH, MAX_PANELS, FigurePlan, figure_size, panel_grid, panel_points, plan_figure
 from .marks import change_text, hidden_cell_axes
 from .paint import fill_classes, hatch_cells, paint_cells
 from .palette import BOUNDARY, CLASS_EDGE, class_colours, legend_handles
 from .reduce import FLAG_CHANGE, FLAG_INFERRED, FLAG_NODE_ONLY, Reduced, reduce_panels
+from .ticks import set_axis
 
 
 def atlas_figure(
@@ -56,7 +58,9 @@ def atlas_figure(
     matplotlib.figure.Figure
         Not registered with pyplot: save it with ``fig.savefig``. ``fig.axes[0]`` is the first map (for a 2-D
         atlas the only one) in data coordinates, x and y being the grid values, so curves can be overlaid with
-        ``fig.axes[0].plot(x, y)``; its limits are fixed to the grid. The legend is ``fig.legends[0]``.
+        ``fig.axes[0].plot(x, y)``; its limits are fixed to the grid. The legend is ``fig.legends[0]``. With one
+        free axis, ``fig.axes[0]`` is the label's line against it and ``fig.axes[1]`` (where the atlas stores a
+        growth rate) the growth rate's beneath (:mod:`stabmap.read.plot.label_line`).
 
     Raises
     ------
@@ -69,6 +73,8 @@ def atlas_figure(
     nrows, ncols, width = panel_grid(plan)
     reduced = reduce_panels(ds, plan, system, width, nrows, ncols)
     xe, ye = map_edges(ds, plan, reduced.factors)
+    if plan.y is None:  # one free axis: a line of the label (and the growth rate), not a strip with an empty y axis
+        return line_figure(ds, plan, system, reduced, xe, figure_title(ds, plan, system, reduced, width, chars=52), width)
     title = figure_title(ds, plan, system, reduced, width)
     size = figure_size(plan, width, nrows, title.count("\n") + 1, len(reduced.present))
     fig = captioned_figure(ds, size)
@@ -92,7 +98,7 @@ def atlas_figure(
         if plan.facet is not None:
             ax.set_title(panel_title(ds, plan, system, blocks, r, c, None if reduced.shares is None else reduced.shares[n]), fontsize=9)
 
-    shown = set_map_axes(axes[0], ds, plan, xe, ye)
+    shown = set_map_axes(axes[0], ds, plan, xe, ye, (span[0] / 72, span[1] / 72))
     if plan.facet is None:
         axes[0].set_xlabel(axis_label(ds, plan.x, shown=shown[plan.x]))
         if plan.y:
@@ -113,6 +119,22 @@ def atlas_figure(
     return fig
 
 
+def line_figure(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, xe: np.ndarray, title: str, width: float):
+    """The figure of one free axis (:mod:`.label_line`): the label as a line over its classes' colours, the growth
+    rate beneath where stored, the class legend beside."""
+    fig = captioned_figure(ds, line_size(ds, system, width, title.count("\n") + 1))
+    cmap, norm = class_colours(reduced.present, system)
+    span = (72 * LABEL_HEIGHT, panel_points(width, 1, 1, facets=False, strip=True)[1])
+    axes, drawn, extra = draw_label_line(fig, ds, plan, system, reduced, xe, draw_panel, cmap, norm, span)
+    marks = {"stability": False, "classes": False, "inferred": False, "light": False, "node-only": False,
+             "node-only-light": False, "change": False}
+    marks.update(drawn)
+    change = change_text(hidden_cell_axes(ds, system.label, (plan.x,)), ds)
+    label_legend(fig, system, reduced.present, marks, change, extra)
+    axes[0].set_title(title, fontsize=10)
+    return fig
+
+
 def map_edges(ds: xr.Dataset, plan: FigurePlan, factors: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
     """The edges of the drawn cells along x and y: the cells the atlas proves its labels on, merged into blocks of
     ``factors`` (y, x); a strip's y runs from 0 to 1."""
@@ -121,7 +143,7 @@ def map_edges(ds: xr.Dataset, plan: FigurePlan, factors: tuple[int, int]) -> tup
     return block_edges(xe, factors[1]), block_edges(ye, factors[0]) if plan.y else ye
 
 
-def figure_title(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, width: float) -> str:
+def figure_title(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, width: float, chars: int | None = None) -> str:
     """The title over the map or the panels (:func:`stabmap.read.plot.captions.atlas_title`), in lines as wide as
     the maps, with the headline (:mod:`stabmap.read.headline`) of the grid points and cells drawn."""
     from ..summary import scanned_axes
@@ -135,7 +157,8 @@ def figure_title(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, wid
         whole=None if shares is None else shares.whole, change=0.0 if shares is None else shares.change,
         axes=scanned_axes(ds, [d for d in (plan.x, plan.y) if d]), shown=plan.facet is not None or bool(plan.fixed),
     )
-    return atlas_title(ds, plan, head.text(system), 70 if plan.facet is None else int(12 * (width - LEGEND_WIDTH)),
+    chars = chars or (70 if plan.facet is None else int(12 * (width - LEGEND_WIDTH)))
+    return atlas_title(ds, plan, head.text(system), chars,
                        reduced.factors, reduced.shape)
 
 
@@ -202,29 +225,18 @@ def panel_title(ds: xr.Dataset, plan: FigurePlan, system, blocks, r: int | None,
     return "\n".join([", ".join(parts[:-1]), parts[-1]]) if two_lines else f"{parts[0]}  ({parts[1]})"
 
 
-def set_map_axes(first, ds: xr.Dataset, plan: FigurePlan, xe: np.ndarray, ye: np.ndarray) -> dict[str, str]:
-    """Scales, limits and ticks of the maps (shared, so set on the ``first``): log axes labelled between decades,
-    ticks at a few listed values, spin rates in their display units. Returns the unit each axis is shown in."""
-    if log_axis(ds, plan.x):
-        first.set_xscale("log")
-    first.set_xlim(min(xe[0], xe[-1]), max(xe[0], xe[-1]))
+def set_map_axes(first, ds: xr.Dataset, plan: FigurePlan, xe: np.ndarray, ye: np.ndarray,
+                 inches: tuple[float, float] | None = None) -> dict[str, str]:
+    """Scales, limits and ticks of the maps (shared, so set on the ``first``; :func:`stabmap.read.plot.ticks.set_axis`,
+    the rule a page follows too): log axes labelled between decades, ticks at a few listed values, spin rates in
+    their display units. ``inches``: the maps' size (y, x) in the layout. Returns the unit each axis is shown in."""
+    shown = {plan.x: set_axis(first, "x", ds, plan.x, xe[0], xe[-1], None if inches is None else inches[1])}
     if plan.y:
-        if log_axis(ds, plan.y):
-            first.set_yscale("log")
-        first.set_ylim(min(ye[0], ye[-1]), max(ye[0], ye[-1]))
+        shown[plan.y] = set_axis(first, "y", ds, plan.y, ye[0], ye[-1], None if inches is None else inches[0])
     else:
         first.set_ylim(0, 1)
         first.set_yticks([])
-    for dim, axis in ((plan.x, first.xaxis), (plan.y, first.yaxis)):
-        if dim and axis.get_scale() == "log":
-            log_ticks(axis, *sorted(np.asarray(ds[dim], dtype=float)[[0, -1]]))
-    for dim, setter, log in ((plan.x, first.set_xticks, first.get_xscale() == "log"), (plan.y, first.set_yticks, first.get_yscale() == "log")):
-        if dim and ds[dim].attrs.get("scale") == "values" and 1 < ds.sizes[dim] <= 8:  # ticks at listed values ...
-            v = np.sort(np.asarray(ds[dim], dtype=float))
-            v_ = np.log(v) if log else v
-            if np.min(np.diff(v_)) >= (v_[-1] - v_[0]) / 12:  # ... unless their labels would collide
-                setter(v)
-    return {dim: display_ticks(ds, dim, axis) for dim, axis in ((plan.x, first.xaxis), (plan.y, first.yaxis)) if dim}
+    return shown
 
 
 def add_legend(where, plan: FigurePlan, system, present: list[int], drawn: dict[str, bool], change: str = "") -> None:

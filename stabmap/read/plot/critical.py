@@ -10,16 +10,22 @@ from ... import systems
 from ...errors import StabmapError, given
 from .captions import captioned_figure, fill_title
 from .geometry import cell_edges
-from .labels import axis_label, log_ticks, mathtext, symbol, value_text
+from .labels import axis_label, mathtext, symbol, value_text
 from .layout import VALUE
 from .palette import HATCH_DEGENERATE, HATCH_NODE_ONLY, class_patch, system_colour
+from .ticks import set_axis
+
+CRITICAL_INCHES, CRITICAL_INCHES_Y = 5.4, 4.0  # [inch] the axes' lengths their ticks are chosen for, on the PNG and the page
 
 
 def scanned_attrs(ds: xr.Dataset, system, along: str, lower: xr.DataArray) -> dict:
-    """long_name and units of the scanned parameter, as an atlas's axis has them (from the stored scene)."""
+    """long_name, units and display unit (rpm, Hz) of the scanned parameter, as an atlas's axis has them (from the
+    stored scene)."""
     try:
-        info = system.parameter(systems.loads_scene(str(ds.attrs["scene"]), "the file's scene"), along)
-        return {"long_name": info.long_name, "units": info.units}
+        scene = systems.loads_scene(str(ds.attrs["scene"]), "the file's scene")
+        info = system.parameter(scene, along)
+        shown = next((a.display_units for a in getattr(scene, "grid", ()) if a.name == along and a.display_units), "")
+        return {"long_name": info.long_name, "units": info.units, **({"display_units": shown} if shown else {})}
     except (KeyError, StabmapError):  # no scene, or one this version does not read: the symbol and units only
         return {"units": lower.attrs.get("units", "")}
 
@@ -51,20 +57,25 @@ def critical_figure(ds: xr.Dataset, *, sel: dict[str, float] | None = None):
     ends = np.concatenate([b_lo.ravel(), b_hi.ravel()])
     ys = np.broadcast_to(((edges[:-1] + edges[1:]) / 2 if free else np.array([0.5]))[:, None], b_lo.shape).ravel()
     ax.plot(ends, np.concatenate([ys, ys]), "k.", ms=2.5 if free else 6)
-    ax.set_xlim(scan[0], scan[1])
-    ax.set_ylim(edges[0], edges[-1])
     if free:
-        ax.set_ylabel(axis_label(ds, free[0], width=45))
-        if ds[free[0]].attrs.get("scale") == "log":
-            ax.set_yscale("log")
-            log_ticks(ax.yaxis, float(np.min(y)), float(np.max(y)))
+        shown_y = set_axis(ax, "y", ds, free[0], edges[0], edges[-1], CRITICAL_INCHES_Y)
+        ax.set_ylabel(axis_label(ds, free[0], width=45, shown=shown_y))
     else:
+        ax.set_ylim(edges[0], edges[-1])
         ax.set_yticks([])
-    lower = ds[f"{along}_stable_lower"]
-    ax.set_xlabel(axis_label(xr.Dataset(coords={along: ((), 0.0, scanned_attrs(ds, system, along, lower))}, attrs=ds.attrs), along, width=60))
+    names = scanned_names(ds, system, along)
+    shown = set_axis(ax, "x", names, along, scan[0], scan[1], CRITICAL_INCHES)  # in the scene's unit, as the page
+    ax.set_xlabel(axis_label(names, along, width=60, shown=shown))
     critical_legend(fig, system, present, bool(gaps))
     ax.set_title(critical_title(ds, along, start is None, chosen), fontsize=10)
     return fig
+
+
+def scanned_names(ds: xr.Dataset, system, along: str) -> xr.Dataset:
+    """A one-coordinate Dataset naming the scanned parameter as an atlas's axis (long_name, units, display unit),
+    for its axis label, ticks and texts."""
+    attrs = scanned_attrs(ds, system, along, ds[f"{along}_stable_lower"])
+    return xr.Dataset(coords={along: ((), 0.0, attrs)}, attrs=ds.attrs)
 
 
 def free_axes(ds: xr.Dataset, along: str, sel: dict[str, float] | None) -> tuple[list[str], dict[str, float]]:

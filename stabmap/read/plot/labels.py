@@ -13,6 +13,7 @@ import xarray as xr
 
 from ... import systems
 from ...scene import units
+from ...scene.units import factor as unit_factor
 
 
 def mathtext(symbol: str) -> str:
@@ -64,9 +65,10 @@ def axis_label(ds: xr.Dataset, dim: str, width: int = 60, shown: str = "") -> st
     return textwrap.fill(text, width, break_long_words=False, break_on_hyphens=False)
 
 
-def display_ticks(ds: xr.Dataset, dim: str, axis) -> str:
-    """Tick labels of a linear spin-rate axis in its ``display_units`` (rpm, Hz), at round values of that unit; the
-    data stay in rad/s.  Returns the unit shown, or "" (no display unit, or a log axis: left as it is)."""
+def display_ticks(ds: xr.Dataset, dim: str, axis, nbins: int | str = "auto") -> str:
+    """Tick labels of a linear spin-rate axis in its ``display_units`` (rpm, Hz), at round values of that unit (at
+    most ``nbins`` intervals); the data stay in rad/s.  Returns the unit shown, or "" (no display unit, or a log
+    axis: left as it is)."""
     from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator
 
     unit = str(ds[dim].attrs.get("display_units", ""))
@@ -79,15 +81,20 @@ def display_ticks(ds: xr.Dataset, dim: str, axis) -> str:
             return super().tick_values(vmin / k, vmax / k) * k
 
     if not isinstance(axis.get_major_locator(), FixedLocator):  # ticks at listed values stay there
-        axis.set_major_locator(Scaled(nbins="auto", steps=[1, 2, 2.5, 5, 10]))
+        axis.set_major_locator(Scaled(nbins=nbins, steps=[1, 2, 2.5, 5, 10]))
     axis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v / k:g}"))
     return unit
 
 
 def value_text(ds: xr.Dataset, dim: str, value: float) -> str:
-    """'$m_{2}$ = 1 kg': the coordinate ``dim`` at ``value``, with its symbol and units."""
+    """'$m_{2}$ = 1 kg': the coordinate ``dim`` at ``value``, with its symbol and units; a spin rate the scene gave in
+    rpm or Hz (``display_units``) in that unit first, the stored unit beside it: '$\\omega$ = 1000 rpm (104.7 rad s⁻¹)'."""
     units = units_text(str(ds[dim].attrs.get("units", "")))
-    return f"{symbol(ds, dim)} = {value:.4g}" + (f" {units}" if units else "")
+    stored = f"{value:.4g}" + (f" {units}" if units else "")
+    shown = str(ds[dim].attrs.get("display_units", ""))
+    if shown:
+        return f"{symbol(ds, dim)} = {value / unit_factor(shown):.4g} {shown} ({stored})"
+    return f"{symbol(ds, dim)} = {stored}"
 
 
 def log_axis(ds: xr.Dataset, dim: str) -> bool:

@@ -15,6 +15,7 @@ from ...scene.units import unit_suffix
 
 MAX_PANELS = 12  # default limit of small multiples
 LEGEND_WIDTH = 2.5  # [inch] beside small multiples
+SINGLE_WIDTH = 7.5  # [inch] a figure of a single map
 DPI = 150  # of a PNG; a map with more grid points than its pixels at this resolution is drawn in blocks
 # Lower bounds of the room the layout leaves a map [inch] (checked against the drawn figures in tests/test_plot.py)
 _SINGLE_MARGIN = 3.6  # a single map: figure width less the legend, the y label and the margins
@@ -195,7 +196,7 @@ def panel_grid(plan: FigurePlan) -> tuple[int, int, float]:
         nrows = math.ceil(k / ncols)
     else:
         nrows = ncols = 1
-    width = 7.5 if plan.facet is None else max(3.5, 2.6 * ncols + 0.9) + LEGEND_WIDTH
+    width = SINGLE_WIDTH if plan.facet is None else max(3.5, 2.6 * ncols + 0.9) + LEGEND_WIDTH
     return nrows, ncols, width
 
 
