@@ -377,7 +377,7 @@ def plot(
         if max_mb is not None:
             raise StabmapError(f"{param('max_mb')} applies to .html pages; {output} is a figure (use a .html name for a page)")
     check_new_output(output, overwrite)
-    ds = open_atlas(path, lazy=True)  # read chunk by chunk: bounded memory at any size
+    ds = _derived_axes(open_atlas(path, lazy=True), x, y)  # read chunk by chunk: bounded memory at any size
     chosen = _selection(ds, sel)
     if page:
         if is_critical(ds) and x is not None:
@@ -407,6 +407,17 @@ def plot(
     figures.plot_atlas(ds, output, x=x, y=y, sel=chosen, facet=facet, max_panels=panels, var=var)
     plan = figures.plan_figure(ds, x=x, y=y, sel=chosen, facet=facet, max_panels=panels)
     return Done([f"note: {note}" for note in plan.notes] + [f"wrote {output}"])
+
+
+def _derived_axes(ds, *axes: str | None):
+    """``ds`` with each of ``axes`` that is a derived quantity (a projectile's S_g) as the index of the grid axis it is
+    monotone along, so a figure can be drawn against it; one line naming it where it is not (``read.derived``)."""
+    from .read import derived
+
+    for name in axes:
+        if name is not None and name not in ds.dims and name in ds.coords:
+            ds = derived.as_axis(ds, name)
+    return ds
 
 
 def _campbell(path, output, *, x, y, sel, facet, max_panels, max_mb, var, overwrite) -> Done:

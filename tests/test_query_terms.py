@@ -280,3 +280,20 @@ def test_a_unit_on_an_axis_that_takes_none_is_refused_for_that(shell_file, capsy
     assert code == 2 and "a unit is accepted for spin rates only" in err
     code, _, err = run(capsys, "query", shell_file, "omega=100 rpx", "m_1=1")
     assert code == 2 and "unknown unit 'rpx'" in err
+
+
+def test_a_plot_against_S_g_puts_the_boundary_at_S_g_1(shell_file, tmp_path, capsys):
+    """``stabmap plot --x S_g``: the spin axis drawn as the stability factor it moves, so the stability boundary of
+    the rigid shell lies at S_g = 1 (its closed form), inside the one grid cell proved to contain a change."""
+    from stabmap.read import derived
+    from stabmap.read.plot.atlas import atlas_figure
+
+    code, out, err = run(capsys, "plot", shell_file, "--x", "S_g", "--sel", "m_1=1", "-o", tmp_path / "sg.png")
+    assert code == 0 and (tmp_path / "sg.png").stat().st_size > 0, err
+    ds = derived.as_axis(stabmap.open_atlas(shell_file), "S_g").sel(m_1=1)
+    fig = atlas_figure(ds, x="S_g")
+    assert "S_g" in fig.axes[0].get_xlabel() or "S_g" in fig.axes[-1].get_xlabel()
+    change = ds.S_g.values[ds.cell.values == 2]  # contains_change
+    assert change.size == 1 and abs(change[0] - 1) < np.diff(ds.S_g.values).max()
+    code, _, err = run(capsys, "plot", shell_file, "--x", "nothing_like_it", "-o", tmp_path / "bad.png")
+    assert code == 2 and not (tmp_path / "bad.png").exists()
