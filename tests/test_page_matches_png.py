@@ -42,6 +42,9 @@ cavity = { shape = "cylinder", radius = 0.05, half_height = 0.05, density = 1000
 omega = { start = "200 rpm", stop = "1900 rpm", num = 7 }
 half_height_1 = { start = 0.01, stop = 0.15, num = 5 }
 """
+# The same top over a log scan of its spin rate in rpm: round rpm ticks on a log axis, on both.
+LOG_RPM_SCENE = RPM_SCENE.replace('omega = { start = "200 rpm", stop = "1900 rpm", num = 7 }',
+                                  'omega = { start = "100 rpm", stop = "5000 rpm", num = 7, scale = "log" }')
 # The page's marks (bokeh hatch patterns) and the PNG's (gids of its hatch patches).
 MARKS = {NODE_ONLY_HATCH: "node-only-cells", INFERRED_HATCH: "inferred-cells", PAGE_HATCH: "change-cells"}
 
@@ -73,6 +76,7 @@ def small(scene):
 
 SCENES = {name: (lambda name=name: small(example(name))) for name in example_names()}
 SCENES["rpm-scene"] = lambda: stabmap.loads_scene(RPM_SCENE)
+SCENES["log-rpm-scene"] = lambda: stabmap.loads_scene(LOG_RPM_SCENE)
 
 
 @pytest.fixture(scope="module")
@@ -145,3 +149,13 @@ def test_an_rpm_axis_reads_rpm_and_half_height_1_as_written(new_page, tmp_path):
     assert axes["x"]["title"].endswith("ω [rpm]")
     assert [float(t) for t in axes["x"]["texts"]] == [200.0 * k for k in range(1, 10)]
     assert "(half_height_1) [m]" in axes["y"]["title"]
+
+
+def test_a_log_rpm_axis_reads_rpm_at_round_rpm_on_both(new_page, tmp_path):
+    """A log scan given in rpm is labelled in rpm at 1, 2 and 5 times powers of ten of rpm, on the page as on the PNG
+    (before, a log spin axis stayed in rad/s on both)."""
+    stabmap.write_atlas(stabmap.compute_atlas(SCENES["log-rpm-scene"](), threads=1, progress=False), tmp_path / "atlas.nc")
+    assert main(["plot", str(tmp_path / "atlas.nc"), "-o", str(tmp_path / "atlas.html")]) == 0
+    axes = new_page().open(tmp_path / "atlas.html").js(READ_PAGE)["axes"]
+    assert axes["x"]["title"].endswith("ω [rpm]")
+    assert sorted(float(t) for t in axes["x"]["texts"]) == [100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0]

@@ -66,15 +66,18 @@ def axis_label(ds: xr.Dataset, dim: str, width: int = 60, shown: str = "") -> st
 
 
 def display_ticks(ds: xr.Dataset, dim: str, axis, nbins: int | str = "auto") -> str:
-    """Tick labels of a linear spin-rate axis in its ``display_units`` (rpm, Hz), at round values of that unit (at
-    most ``nbins`` intervals); the data stay in rad/s.  Returns the unit shown, or "" (no display unit, or a log
-    axis: left as it is)."""
+    """Tick labels of a spin-rate axis in its ``display_units`` (rpm, Hz), at round values of that unit (at most
+    ``nbins`` intervals; on a log axis, as ``log_ticks`` places them in that unit); the data stay in rad/s.  Returns
+    the unit shown, or "" (no display unit)."""
     from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator
 
     unit = str(ds[dim].attrs.get("display_units", ""))
-    if not unit or axis.get_scale() == "log":
+    if not unit:
         return ""
     k = units.factor(unit)
+    if axis.get_scale() == "log":
+        log_ticks(axis, *sorted(axis.get_view_interval()), k)
+        return unit
 
     class Scaled(MaxNLocator):
         def tick_values(self, vmin, vmax):
@@ -102,18 +105,25 @@ def log_axis(ds: xr.Dataset, dim: str) -> bool:
     return ds[dim].attrs.get("scale") == "log" and bool(np.all(np.asarray(ds[dim]) > 0))
 
 
-def log_ticks(axis, lo: float, hi: float) -> None:
+def log_ticks(axis, lo: float, hi: float, k: float = 1.0) -> None:
     """Label a log axis between its decades too: at 2 and 5 times a power of ten over up to three decades, at 3
     over up to one (unlabelled minor ticks at every integer multiple); numbers as ``0.2``, ``50``, or, on an axis
-    that reaches below 10⁻³ or to 10⁴, all as powers of ten (``2×10⁻⁵``)."""
+    that reaches below 10⁻³ or to 10⁴, all as powers of ten (``2×10⁻⁵``).  ``k``: the data's unit per shown unit
+    (a spin axis shown in rpm: ticks at round numbers of rpm, labelled in rpm)."""
     from matplotlib.ticker import FuncFormatter, LogLocator
 
+    class Scaled(LogLocator):
+        def tick_values(self, vmin, vmax):
+            return super().tick_values(vmin / k, vmax / k) * k
+
+    lo, hi = lo / k, hi / k
     decades = math.log10(hi / lo) if lo > 0 and hi > lo else 0.0
     labelled = (2, 3, 5) if decades <= 1.2 else (2, 5) if decades <= 3.5 else ()
 
     plain = 1e-3 <= lo and hi < 1e4  # one style an axis: "1000" beside "10⁴" would read as two scales
 
     def text(v: float, _pos=None) -> str:
+        v = v / k
         e = math.floor(math.log10(v) + 1e-9)
         mantissa = round(v / 10.0**e, 6)
         if plain:
@@ -121,11 +131,11 @@ def log_ticks(axis, lo: float, hi: float) -> None:
         return f"$10^{{{e}}}$" if mantissa == 1 else f"${mantissa:g}\\times10^{{{e}}}$"
 
     def minor(v: float, pos=None) -> str:
-        e = math.floor(math.log10(v) + 1e-9)
-        return text(v) if round(v / 10.0**e, 6) in labelled else ""
+        e = math.floor(math.log10(v / k) + 1e-9)
+        return text(v) if round(v / k / 10.0**e, 6) in labelled else ""
 
-    axis.set_major_locator(LogLocator(base=10))
-    axis.set_minor_locator(LogLocator(base=10, subs=tuple(range(2, 10))))
+    axis.set_major_locator(Scaled(base=10))
+    axis.set_minor_locator(Scaled(base=10, subs=tuple(range(2, 10))))
     axis.set_major_formatter(FuncFormatter(text))
     axis.set_minor_formatter(FuncFormatter(minor))
     axis.set_tick_params(which="minor", labelsize=8)
