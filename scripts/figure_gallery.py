@@ -163,7 +163,7 @@ KINDS = [
     Kind("critical", "critical values put the scanned parameter (ω) on x as the atlas maps do, "
          "each stretch in its class's colour as on the maps, a labelled log axis and the caption of fixed parameters", LOG_MASS,
          [["critical", "{scene}", "--along", "omega", "-o", "{nc}", "--png", "{png}", "-q"]]),
-    Kind("closed", "closed chains: only the caption of fixed parameters (h₁, c₁²) is new", HINGE, ATLAS),
+    Kind("closed", "closed chains: one axis is a line of the class over its colours; fixed parameters captioned", HINGE, ATLAS),
     Kind("reactions", "reactions maps: only the caption of fixed parameters is new", PLATE, ATLAS),
 ]
 

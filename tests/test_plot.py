@@ -207,6 +207,19 @@ def test_one_free_axis_draws_the_label_as_a_line():
     assert "growth rate" in [t.get_text() for t in legend_of(fig).get_texts()]
 
 
+def test_one_free_axis_of_a_flag_label_names_its_classes():
+    """A closed chain's label is a flag variable, whose codes order nothing (absent is -2): its line's y ticks are the
+    classes' names, not the codes."""
+    import stabmap
+    from stabmap.scene.grid import resample
+
+    ds = stabmap.compute_atlas(resample(stabmap.example("closed-hinge"), ratio=24), threads=1, progress=False)
+    (ax,) = atlas_figure(ds).axes
+    names = [t.get_text() for t in ax.get_yticklabels()]
+    assert "stable" in names and "unstable" in names and "absent (no equilibrium)" in names, names
+    assert not any(n.lstrip("\u2212-").isdigit() for n in names), names
+
+
 # --------------------------------------------------------------------------------------------- real atlases
 SCENE = """
 title = "two tops, tiny grid"

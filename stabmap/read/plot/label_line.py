@@ -51,6 +51,8 @@ def draw_label_line(fig, ds: xr.Dataset, plan: FigurePlan, system, reduced, xe: 
     set_axis(top, "x", ds, plan.x, xe[0], xe[-1], span[1] / 72)
     top.set_ylim(lo, hi)
     top.set_yticks(present)
+    if system.variable(system.label).flags:  # the codes of a flag variable order nothing: name the classes
+        top.set_yticklabels([system.class_name(v) for v in present], fontsize=8)
     top.set_ylabel(mathtext(system.label_symbol))
     extra = []
     if growth:
