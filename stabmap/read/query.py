@@ -39,6 +39,7 @@ import xarray as xr
 from .. import systems
 from ..errors import StabmapError, given, param
 from ..scene.units import common_unit, in_si, looks_like_rate
+from ..scene.values import is_plain_number
 from ..store.dataset import is_critical
 from ..store.variables import INFERRED
 from . import derived, shown
@@ -201,14 +202,6 @@ def _number(name: str, value, units: str = "") -> float:
     if math.isnan(value):
         raise StabmapError(f"{name}=nan: give a number (the nearest grid value is used) or a range (lo, hi)")
     return value
-
-
-def is_plain_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def requested_value(name: str, value, units: str = "") -> float | tuple[float | None, float | None]:

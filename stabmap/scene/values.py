@@ -25,7 +25,7 @@ def check_value(where: str, value, info: Parameter) -> float:
     """Return ``value`` as a float or raise a StabmapError naming ``where``; a spin rate may carry a unit ("14000 rpm")."""
     value = in_si(where, value, info.units)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        quoted = " (remove the quotes: TOML reads a quoted number as text)" if isinstance(value, str) and _is_number(value) else ""
+        quoted = " (remove the quotes: TOML reads a quoted number as text)" if isinstance(value, str) and is_plain_number(value) else ""
         raise StabmapError(f"{where} must be a number, got {value!r}{quoted}")
     value = float(value)
     if not math.isfinite(value):
@@ -38,7 +38,8 @@ def check_value(where: str, value, info: Parameter) -> float:
     return value
 
 
-def _is_number(text: str) -> bool:
+def is_plain_number(text: str) -> bool:
+    """Whether ``text`` reads as a float ("9.81", "1e-3", "nan"), with no unit after it."""
     try:
         float(text)
     except ValueError:

@@ -76,7 +76,8 @@ def display_ticks(ds: xr.Dataset, dim: str, axis, nbins: int | str = "auto") -> 
         return ""
     k = units.factor(unit)
     if axis.get_scale() == "log":
-        log_ticks(axis, *sorted(axis.get_view_interval()), k)
+        lo, hi = sorted(axis.get_view_interval())
+        log_ticks(axis, lo, hi, k)
         return unit
 
     class Scaled(MaxNLocator):
