@@ -14,7 +14,8 @@ from ... import systems
 from ..areas import AreaShares
 from ..headline import Headline
 from .captions import atlas_title, captioned_figure
-from .geometry import block_classes, block_edges, boundary_widths, cell_edge_boundaries, proved_cell_edges
+from .frame import map_edges, set_map_axes
+from .geometry import block_classes, boundary_widths, cell_edge_boundaries
 from .label_line import LABEL_HEIGHT, draw_label_line, label_legend, line_size
 from .labels import axis_label, log_axis, value_text
 from .layout import LEGEND_WIDTH, MAX_PANELS, FigurePlan, figure_size, panel_grid, panel_points, plan_figure
@@ -22,7 +23,6 @@ from .marks import change_text, hidden_cell_axes
 from .paint import fill_classes, hatch_cells, paint_cells
 from .palette import BOUNDARY, CLASS_EDGE, class_colours, legend_handles
 from .reduce import FLAG_CHANGE, FLAG_INFERRED, FLAG_NODE_ONLY, Reduced, reduce_panels
-from .ticks import set_axis
 
 
 def atlas_figure(
@@ -135,14 +135,6 @@ def line_figure(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, xe: 
     return fig
 
 
-def map_edges(ds: xr.Dataset, plan: FigurePlan, factors: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
-    """The edges of the drawn cells along x and y: the cells the atlas proves its labels on, merged into blocks of
-    ``factors`` (y, x); a strip's y runs from 0 to 1."""
-    xe = proved_cell_edges(np.asarray(ds[plan.x], dtype=float), log_axis(ds, plan.x))
-    ye = proved_cell_edges(np.asarray(ds[plan.y], dtype=float), log_axis(ds, plan.y)) if plan.y else np.array([0.0, 1.0])
-    return block_edges(xe, factors[1]), block_edges(ye, factors[0]) if plan.y else ye
-
-
 def figure_title(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, width: float, chars: int | None = None) -> str:
     """The title over the map or the panels (:func:`stabmap.read.plot.captions.atlas_title`), in lines as wide as
     the maps, with the headline (:mod:`stabmap.read.headline`) of the grid points and cells drawn."""
@@ -223,20 +215,6 @@ def panel_title(ds: xr.Dataset, plan: FigurePlan, system, blocks, r: int | None,
     parts.append(text)
     two_lines = plan.row is not None or proved  # the longer text of areas needs its own line
     return "\n".join([", ".join(parts[:-1]), parts[-1]]) if two_lines else f"{parts[0]}  ({parts[1]})"
-
-
-def set_map_axes(first, ds: xr.Dataset, plan: FigurePlan, xe: np.ndarray, ye: np.ndarray,
-                 inches: tuple[float, float] | None = None) -> dict[str, str]:
-    """Scales, limits and ticks of the maps (shared, so set on the ``first``; :func:`stabmap.read.plot.ticks.set_axis`,
-    the rule a page follows too): log axes labelled between decades, ticks at a few listed values, spin rates in
-    their display units. ``inches``: the maps' size (y, x) in the layout. Returns the unit each axis is shown in."""
-    shown = {plan.x: set_axis(first, "x", ds, plan.x, xe[0], xe[-1], None if inches is None else inches[1])}
-    if plan.y:
-        shown[plan.y] = set_axis(first, "y", ds, plan.y, ye[0], ye[-1], None if inches is None else inches[0])
-    else:
-        first.set_ylim(0, 1)
-        first.set_yticks([])
-    return shown
 
 
 def add_legend(where, plan: FigurePlan, system, present: list[int], drawn: dict[str, bool], change: str = "") -> None:

@@ -66,7 +66,7 @@ def draw_label_line(fig, ds: xr.Dataset, plan: FigurePlan, system, reduced, xe: 
 def draw_growth(ax, ds: xr.Dataset, plan: FigurePlan, system, var: str) -> list:
     """The growth rate along the axis, as ``stabmap plot --var growth_rate`` draws its line; returns its legend
     entries that the class legend has not (the line, the proved enclosure)."""
-    from .atlas import map_edges
+    from .frame import map_edges
     from .value_map import draw_line, marks, reduce_map, values_axis
     from .value_map import legend_handles as value_handles
 

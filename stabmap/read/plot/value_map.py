@@ -27,9 +27,9 @@ import xarray as xr
 from ... import systems
 from ...errors import StabmapError, given, param
 from ..blocks import ValueBlocks, block_factors, reduce_values
-from .atlas import map_edges, set_map_axes
 from .captions import atlas_title, captioned_figure, fill_mathtext
 from .floats import check_variable, colour_norm, colour_scale, drawable, number, short_name, value_label, values_text
+from .frame import map_edges, set_map_axes
 from .geometry import boundary_widths, cell_edge_boundaries, rectangles, runs
 from .labels import axis_label, log_axis, log_ticks, units_text, value_text
 from .layout import DPI, VALUE, FigurePlan, plan_figure
