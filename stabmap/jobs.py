@@ -90,10 +90,8 @@ def atlas(
         check_new_output(png, overwrite, param("png"))
     check_grid(scene)
     check_chunk_points(chunk_points)
-    size = sizes.of(scene)  # a grid that cannot fit is refused before any work
-    sizes.check_disk(size, output)
-    if refine:
-        sizes.check_memory(size, f"an adaptive atlas ({param('refine')}), held in memory,")
+    if refine:  # written at the end, so its disk is checked here; compute_refined checks the memory, compute_to_file a dense run's disk
+        sizes.check_disk(sizes.of(scene), output)
     if not refine:
         extra = [name for name, v in (("coarse_stride", coarse_stride), ("margin", margin)) if v is not None]
         if extra:
@@ -125,8 +123,7 @@ def atlas(
         with open_atlas(output, lazy=True) as ds:
             plot_atlas(ds, png)
         lines.append(f"wrote {png}")
-    unused = scene.unused() if hasattr(scene, "unused") else []  # values given that the model does not use
-    return Done(lines + unused + ([note] if note else []))  # last: what the user may change before the next run
+    return Done(lines + scene.unused() + ([note] if note else []))  # last: what the user may change before the next run
 
 
 @contextlib.contextmanager

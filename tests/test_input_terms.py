@@ -104,6 +104,8 @@ def test_an_atlas_in_memory_larger_than_the_memory_is_refused(monkeypatch):
     with pytest.raises(StabmapError, match=r"an atlas in memory of 40 points needs [\d,]+ bytes, but 100 bytes of memory is "
                                            r"available; make the grid coarser"):
         stabmap.compute_atlas(loads_scene(TOP), threads=1, progress=False)
+    with pytest.raises(StabmapError, match=r"an adaptive atlas, held in memory, of 40 points needs [\d,]+ bytes, but 100 bytes"):
+        stabmap.compute_refined(loads_scene(TOP), threads=1, progress=False)
 
 
 def test_a_large_run_says_its_size_and_time_before_it_starts(tmp_path, capsys, monkeypatch):

@@ -36,7 +36,7 @@ from ..errors import StabmapError, given
 from ..store.dataset import empty_arrays, finished_atlas
 from ..store.variables import CELL
 from ..systems.base import SceneBase
-from . import costs, runner
+from . import costs, runner, sizes
 from .atlas import decide_points
 from .chunks import check_chunk_points
 from .progress import ProgressLine, wanted
@@ -354,6 +354,7 @@ def compute_refined(
     if system.inferred(np.zeros(0, dtype=np.int64)) is None:  # the system cannot say what a filled point holds
         raise StabmapError(f"adaptive refinement is not available for {system.name} atlases (the system infers no labels "
                            "from cell corners: System.inferred); compute a dense one")
+    sizes.check_memory(sizes.of(scene), "an adaptive atlas, held in memory,")
     shape = scene.shape
     strides = tuple(coarse_stride or default_coarse_stride(n) for n in shape)
     total = math.prod(shape)

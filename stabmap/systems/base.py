@@ -80,6 +80,11 @@ class SceneBase(ABC):
         group a heading of ``System.fixed_groups`` (``""``: the whole scene).  Default: nothing."""
         return []
 
+    def unused(self) -> list[str]:
+        """Notes on values the scene gives that its model does not use (``note: ...`` lines that ``stabmap atlas``
+        ends with); not refused, as a scene may be written that way naturally.  Default: none."""
+        return []
+
     def with_grid(self, grid: tuple[Axis, ...]) -> Self:
         """The same scene on ``grid`` (a subset of its own, ``read.subset``), with every choice this scene made from
         its grid kept as it is, so that each point is decided as before."""
