@@ -240,7 +240,7 @@ def select(ds: xr.Dataset, sel: dict, *, along: str | None = None, nearest_edge:
     """
     dims = grid_axes(ds)
     index, axes = {}, {}
-    for name, (requested, via) in _on_axes(ds, sel, dims, nearest_edge).items():
+    for name, (requested, via, edge) in _on_axes(ds, sel, dims, nearest_edge).items():
         units = str(ds[name].attrs.get("units", ""))
         disp = shown.display_unit(ds, name)
         grid = np.asarray(ds[name].values, dtype=np.float64)
@@ -269,7 +269,7 @@ def select(ds: xr.Dataset, sel: dict, *, along: str | None = None, nearest_edge:
                 raise outside_error(ds, name, requested, grid)
             i = int(ds.indexes[name].get_indexer([requested], method="nearest")[0])
             index[name] = i
-            axes[name] = AxisSelection(name, units, requested, (float(grid[i]),), outside or "nearest edge" in via,
+            axes[name] = AxisSelection(name, units, requested, (float(grid[i]),), outside or edge,
                                        display_units=disp, via=via)
     for d in dims:
         if d not in axes:
@@ -289,12 +289,14 @@ def outside_error(ds: xr.Dataset, name: str, value: float, grid: np.ndarray) -> 
 
 
 def _on_axes(ds: xr.Dataset, sel: dict, dims: list[str], nearest_edge: bool) -> dict[str, tuple]:
-    """``sel`` with every entry on a grid axis: ``{axis: (number or (lo, hi), how a derived quantity gave it or "")}``."""
+    """``sel`` with every entry on a grid axis: ``{axis: (number or (lo, hi), how a derived quantity gave it or "",
+    whether that quantity lay outside its range on the grid and gave the nearest edge)}``."""
     out: dict[str, tuple] = {}
     made_by: dict[str, str] = {}
     extra = derived.names(ds, dims)
     for name, value in sel.items():
         units = str(ds[name].attrs.get("units", "")) if name in ds.variables else ""
+        edge = False
         if name in dims:
             axis, requested, via = name, requested_value(name, value, units), ""
         elif name in extra:
@@ -309,13 +311,13 @@ def _on_axes(ds: xr.Dataset, sel: dict, dims: list[str], nearest_edge: bool) -> 
                 requested = (ends[0], ends[1])
             else:
                 inv = derived.invert(ds, name, requested, nearest_edge=nearest_edge)
-                axis, requested, via = inv.axis, inv.value, inv.describe(ds)
+                axis, requested, via, edge = inv.axis, inv.value, inv.describe(ds), inv.edge
         else:
             raise _not_an_axis(ds, name, dims)
         if axis in out:
             first = made_by.get(axis, axis)
             raise StabmapError(f"{name} and {first} both set {axis}; give one of them")
-        out[axis] = (requested, via)
+        out[axis] = (requested, via, edge)
         made_by[axis] = name
     return out
 
@@ -365,11 +367,11 @@ def label_at(ds: xr.Dataset, /, *, nearest_edge: bool = False, **point: float) -
     missing = [d for d in dims if d not in asked]
     if missing:
         raise StabmapError(f"give a value for every axis; missing: {', '.join(missing)} (e.g. {missing[0]}={float(ds[missing[0]][0]):g})")
-    at = {k: float(v) for k, (v, _) in asked.items()}
+    at = {k: float(v) for k, (v, _, _) in asked.items()}
     outside = tuple(d for d in dims if not derived.within(at[d], float(ds[d].min()), float(ds[d].max())))
     if outside and not nearest_edge:
         raise outside_error(ds, outside[0], at[outside[0]], np.asarray(ds[outside[0]].values, dtype=np.float64))
-    outside += tuple(d for d, (_, via) in asked.items() if "nearest edge" in via and d not in outside)
+    outside += tuple(d for d, (_, _, edge) in asked.items() if edge and d not in outside)
     index = {d: int(ds.indexes[d].get_indexer([at[d]], method="nearest")[0]) for d in dims}
     sel = ds.isel(index) if dims else ds
     system = systems.of_atlas(ds.attrs)
@@ -389,7 +391,7 @@ def label_at(ds: xr.Dataset, /, *, nearest_edge: bool = False, **point: float) -
         outside=outside,
         provenance=system.provenance if system.provenance in values else None,
         derived={k: float(sel[k]) for k in extra},
-        via={k: via for k, (_, via) in asked.items() if via},
+        via={k: via for k, (_, via, _) in asked.items() if via},
     )
 
 
@@ -686,7 +688,7 @@ def smallest_stable(ds: xr.Dataset, /, along: str | None = None, over: str | Non
     return out
 
 
-def _end(text: str, where: str) -> float | str | None:
+def _end(text: str) -> float | str | None:
     """One end of a selection: None (open), a number, or a number with a unit, kept as text: ``select`` converts it
     by the axis's units, so that a unit on an axis that takes none is refused for that (``units.in_si``) rather than
     as a spin unit it is not; anything else a ValueError."""
@@ -718,7 +720,7 @@ def parse_selection(items: list[str], *, ranges: bool = True, option: str = "") 
             fix = f"a range is NAME=LO:HI, e.g. {key}=0:10" if ranges else f"give one value, e.g. {key}=42.5"
             raise StabmapError(f"{prefix}{item!r}: {fix}")
         try:
-            numbers = [_end(e.strip(), f"{prefix}{key}") for e in ends]
+            numbers = [_end(e.strip()) for e in ends]
         except ValueError:
             what = "a number or a range LO:HI" if ranges else "a number"
             raise StabmapError(f"{prefix}{item!r}: {value!r} is not {what}; write e.g. {key}=42.5" + (f" or {key}=0:10" if ranges else "")

@@ -228,8 +228,8 @@ def _column(result: xr.Dataset, name: str) -> str:
 
 
 def _cell(result: xr.Dataset, name: str, value) -> str:
-    disp = shown.display_unit(result, name)
-    return shown.cell(float(value), disp) if disp and not _missing(value) else short_number(value)
+    """A table cell of the axis ``name``: a spin rate in its display unit, SI beside (``_along_cell``)."""
+    return _along_cell(value, shown.display_unit(result, name))
 
 
 def _along_cell(value, disp: str) -> str:
