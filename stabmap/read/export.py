@@ -10,7 +10,6 @@ bounded whatever the size of the atlas.  A file is written to a temporary name a
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterable
 from pathlib import Path
 from typing import TextIO
@@ -20,7 +19,7 @@ import pandas as pd
 import xarray as xr
 
 from .. import systems
-from ..store.files import READ_CHUNK_POINTS, check_writable
+from ..store.files import READ_CHUNK_POINTS, atomic_text
 from . import derived, shown
 from .blocks import compute
 from .query import grid_axes
@@ -88,14 +87,7 @@ def _spread(slab: xr.Dataset, name: str, axes: list[str]) -> np.ndarray:
 
 
 def save_csv(ds: xr.Dataset, path: str | Path) -> tuple[Path, int]:
-    """:func:`write_csv` to ``path`` atomically (a temporary file renamed when complete): (path, rows)."""
-    path = check_writable(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "w", encoding="utf-8", newline="") as f:
-            rows = write_csv(ds, f)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    return path, rows
+    """:func:`write_csv` to ``path`` atomically (``store.files.atomic_text``): (path, rows)."""
+    with atomic_text(path, newline="") as f:
+        rows = write_csv(ds, f)
+    return Path(path), rows

@@ -7,8 +7,9 @@ import math
 import os
 import shutil
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import TextIO
 
 import dask
 import netCDF4
@@ -183,16 +184,26 @@ def _cf_bounds(ds: xr.Dataset) -> xr.Dataset:
 
 
 def write_text(text: str, path: str | Path) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically: a temporary file in the same directory, renamed when complete."""
+    """Write ``text`` (UTF-8) to ``path`` atomically (``atomic_text``)."""
+    path = check_writable(path)
+    with atomic_text(path) as f:
+        f.write(text)
+    return path
+
+
+@contextlib.contextmanager
+def atomic_text(path: str | Path, newline: str | None = None) -> Iterator[TextIO]:
+    """A UTF-8 text file to write ``path`` through: a temporary file in the same directory, renamed onto ``path``
+    when the block ends, removed if it raises, so that a reader never sees part of it (``newline`` as for ``open``)."""
     path = check_writable(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
-        tmp.write_text(text, encoding="utf-8")
+        with open(tmp, "w", encoding="utf-8", newline=newline) as f:
+            yield f
         os.replace(tmp, path)
     except BaseException:
         _remove(tmp)
         raise
-    return path
 
 
 def _chunksizes(var: xr.DataArray) -> dict:

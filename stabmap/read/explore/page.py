@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...errors import StabmapError, given, param
-from ...store.files import check_writable
+from ...store.files import check_writable, write_text
 from .plan import PagePlan, thin
 
 BASE_BYTES = 1_700_000  # BokehJS inlined (bokeh 3.x: about 1.7 MB), the layout and its texts: every page's floor
@@ -40,15 +40,8 @@ class Page:
         return len(self.html().encode())
 
     def save(self, path: str | Path) -> Path:
-        """Write the page atomically (a temporary file renamed into place); returns the path."""
-        path = check_page_path(path)
-        tmp = path.with_name(f".{path.name}.tmp")
-        try:
-            tmp.write_text(self.html(), encoding="utf-8")
-            tmp.replace(path)
-        finally:
-            tmp.unlink(missing_ok=True)
-        return path
+        """Write the page atomically (``store.files.write_text``); returns the path."""
+        return write_text(self.html(), check_page_path(path))
 
     def _repr_html_(self) -> str:
         # An iframe of the whole page: it runs its own BokehJS, so nothing has to be loaded into the notebook first.
