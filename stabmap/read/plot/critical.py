@@ -8,6 +8,7 @@ import xarray as xr
 
 from ... import systems
 from ...errors import StabmapError, given
+from ..shown import display_unit
 from .captions import captioned_figure, fill_title
 from .geometry import cell_edges
 from .labels import axis_label, mathtext, symbol, value_text
@@ -22,9 +23,8 @@ def scanned_attrs(ds: xr.Dataset, system, along: str, lower: xr.DataArray) -> di
     """long_name, units and display unit (rpm, Hz) of the scanned parameter, as an atlas's axis has them (from the
     stored scene)."""
     try:
-        scene = systems.loads_scene(str(ds.attrs["scene"]), "the file's scene")
-        info = system.parameter(scene, along)
-        shown = next((a.display_units for a in getattr(scene, "grid", ()) if a.name == along and a.display_units), "")
+        info = system.parameter(systems.loads_scene(str(ds.attrs["scene"]), "the file's scene"), along)
+        shown = display_unit(ds, along)  # the stored scene's, as the text answers read it
         return {"long_name": info.long_name, "units": info.units, **({"display_units": shown} if shown else {})}
     except (KeyError, StabmapError):  # no scene, or one this version does not read: the symbol and units only
         return {"units": lower.attrs.get("units", "")}
