@@ -24,6 +24,10 @@ from .paint import fill_classes, hatch_cells, paint_cells
 from .palette import BOUNDARY, CLASS_EDGE, class_colours, legend_handles
 from .reduce import FLAG_CHANGE, FLAG_INFERRED, FLAG_NODE_ONLY, Reduced, reduce_panels
 
+# What a figure's panels drew, for its legend (``palette.legend_handles``): nothing yet.
+NO_MARKS = {"stability": False, "classes": False, "inferred": False, "light": False, "node-only": False,
+            "node-only-light": False, "change": False}
+
 
 def atlas_figure(
     ds: xr.Dataset,
@@ -90,8 +94,7 @@ def atlas_figure(
     cmap, norm = class_colours(reduced.present, system)
     span = panel_points(width, nrows, ncols, facets=plan.facet is not None, strip=plan.y is None)
     log = (log_axis(ds, plan.x), plan.y is not None and log_axis(ds, plan.y))
-    drawn = {"stability": False, "classes": False, "inferred": False, "light": False, "node-only": False,
-             "node-only-light": False, "change": False}
+    drawn = dict(NO_MARKS)
     for n, (ax, blocks, (r, c)) in enumerate(zip(axes, reduced.blocks, reduced.panels, strict=True)):
         for key, value in draw_panel(ax, blocks, xe, ye, system, cmap, norm, span, log).items():
             drawn[key] |= value
@@ -126,9 +129,7 @@ def line_figure(ds: xr.Dataset, plan: FigurePlan, system, reduced: Reduced, xe: 
     cmap, norm = class_colours(reduced.present, system)
     span = (72 * LABEL_HEIGHT, panel_points(width, 1, 1, facets=False, strip=True)[1])
     axes, drawn, extra = draw_label_line(fig, ds, plan, system, reduced, xe, draw_panel, cmap, norm, span)
-    marks = {"stability": False, "classes": False, "inferred": False, "light": False, "node-only": False,
-             "node-only-light": False, "change": False}
-    marks.update(drawn)
+    marks = {**NO_MARKS, **drawn}
     change = change_text(hidden_cell_axes(ds, system.label, (plan.x,)), ds)
     label_legend(fig, system, reduced.present, marks, change, extra)
     axes[0].set_title(title, fontsize=10)
