@@ -293,7 +293,8 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
     disp = shown.display_unit(ds, along)
     u = shown.header_units(s["units"], disp)
     lines = [counts_line(s, dims, disp)]
-    header = [d + shown.header_units(units.get(d, ""), shown.display_unit(ds, d)) for d in dims]
+    shown_in = {d: shown.display_unit(ds, d) for d in dims}
+    header = [d + shown.header_units(units.get(d, ""), shown_in[d]) for d in dims]
     header += ["row", f"{along} lower{u}", f"{along} upper{u}", "note"]
     rows = []
     for r in (table if not limit else table.iloc[:limit]).to_dict(orient="records"):
@@ -308,7 +309,7 @@ def render_table(ds: xr.Dataset, fmt: str = "text", *, limit: int = 40) -> str:
         else:
             note = f"nothing stable from {s['scan_range'][0]:.8g} to {s['scan_range'][1]:.8g}"
         ends = [r[f"{along}_lower"], r[f"{along}_upper"]]
-        rows.append([shown.cell(r[d], shown.display_unit(ds, d)) for d in dims]
+        rows.append([shown.cell(r[d], shown_in[d]) for d in dims]
                     + [kind.replace("_", " "), *(shown.cell(v, disp, 10) if v == v else "-" for v in ends), note])
     lines += text_table(header, rows) if rows else ["(no rows)"]
     lines += more_rows_line(len(table), limit)
